@@ -1,0 +1,32 @@
+"""qropt: optimisation-based dimensional synthesis of quick-return mechanisms."""
+
+from qropt.errors import AssemblyError, GrashofError, InvalidParameter, NoDeadCentres, ProblemError, QroptError
+from qropt.mechanisms import (
+    CrankRockerSlider,
+    CrankShaper,
+    DragLinkSlider,
+    FourBar,
+    SliderCrank,
+    Whitworth,
+    grashof,
+    mechanism_type,
+)
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "SliderCrank",
+    "CrankShaper",
+    "Whitworth",
+    "CrankRockerSlider",
+    "DragLinkSlider",
+    "FourBar",
+    "grashof",
+    "mechanism_type",
+    "QroptError",
+    "InvalidParameter",
+    "GrashofError",
+    "AssemblyError",
+    "NoDeadCentres",
+    "ProblemError",
+]

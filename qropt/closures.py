@@ -1,0 +1,58 @@
+"""Closures shared by every mechanism type, each written once over a math namespace ``xp``.
+
+Points are ``(x, y)`` tuples of numbers, arrays, jets or CasADi expressions.
+Each closure returns its result and an assembly ``margin``: >= 0 where the
+closure has a real solution, < 0 where it cannot assemble.
+"""
+
+from __future__ import annotations
+
+import math
+
+
+def circle_circle(xp, p, a, q, b, sigma, around=0.0):
+    """RRR: the point X with |X - P| = a and |X - Q| = b on branch sigma.
+
+    ``sigma = sign((P - Q) x (X - Q))``. Returns ``(X, angle of X - Q, margin)``.
+    The angle is continuous except where P - Q points along ``around + pi``.
+    """
+    ux, uy = p[0] - q[0], p[1] - q[1]
+    ll = ux * ux + uy * uy
+    c = (b * b + ll - a * a) / (2.0 * b * xp.sqrt(ll))
+    ca, sa = math.cos(around), math.sin(around)
+    psi = around + xp.atan2(uy * ca - ux * sa, ux * ca + uy * sa)
+    angle = psi + sigma * xp.acos(c)
+    x = (q[0] + b * xp.cos(angle), q[1] + b * xp.sin(angle))
+    return x, angle, 1.0 - c * c
+
+
+def rod_to_line(xp, p, r, h, sigma):
+    """RRP: the end D of a rod of length r from pin P that slides on the line y = h.
+
+    ``sigma = +1`` puts D on the +x side of P. Returns ``(D, margin)``.
+    """
+    dy = h - p[1]
+    w = r * r - dy * dy
+    return (p[0] + sigma * xp.sqrt(w), h + 0.0 * p[0]), w / (r * r)
+
+
+def pin_in_slot(xp, pivot, pin):
+    """RPR: the angle of a slotted lever that turns about ``pivot`` and carries the block at ``pin``."""
+    return xp.atan2(pin[1] - pivot[1], pin[0] - pivot[0])
+
+
+def on_ray(xp, origin, angle, length):
+    """The point at ``length`` from ``origin`` along ``angle``."""
+    return (origin[0] + length * xp.cos(angle), origin[1] + length * xp.sin(angle))
+
+
+def acute_angle(xp, u, w):
+    """The acute angle (radians, in [0, pi/2]) between the lines along vectors u and w."""
+    cross = u[0] * w[1] - u[1] * w[0]
+    dot = u[0] * w[0] + u[1] * w[1]
+    return xp.atan2(xp.fabs(cross), xp.fabs(dot))
+
+
+def rod_transmission(xp, pin, slider):
+    """Transmission angle at a slider on a +x slide line driven by the rod pin -> slider."""
+    return acute_angle(xp, (slider[0] - pin[0], slider[1] - pin[1]), (0.0, 1.0))

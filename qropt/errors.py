@@ -1,0 +1,46 @@
+"""Typed errors: the only exceptions qropt raises, all for invalid input."""
+
+from __future__ import annotations
+
+import math
+
+
+class QroptError(ValueError):
+    """Base class of every qropt error: the input cannot be used as given."""
+
+
+class InvalidParameter(QroptError):
+    """A parameter is missing, unknown, not a finite number, out of range, or of the wrong sign."""
+
+
+class GrashofError(QroptError):
+    """A four-bar is not of the Grashof class the mechanism type needs."""
+
+    def __init__(self, message, *, params, kind, required):
+        super().__init__(message)
+        self.params, self.kind, self.required = dict(params), kind, required
+
+
+class AssemblyError(QroptError):
+    """The mechanism cannot assemble over a full crank turn.
+
+    ``failures`` lists ``(closure, theta2_from, theta2_to)`` in radians.
+    """
+
+    def __init__(self, mechanism, params, failures):
+        self.mechanism, self.params, self.failures = mechanism, dict(params), list(failures)
+        by_closure: dict[str, list[str]] = {}
+        for what, lo, hi in self.failures:
+            span = f"[{math.degrees(lo) % 360:.4f}, {math.degrees(hi) % 360:.4f}]"
+            by_closure.setdefault(what, []).append(span)
+        parts = [f"{what} fails for theta2 in {' and '.join(s)} deg" for what, s in by_closure.items()]
+        given = ", ".join(f"{k}={v:g}" for k, v in self.params.items())
+        super().__init__(f"{mechanism}({given}) cannot turn through a full revolution: " + "; ".join(parts))
+
+
+class NoDeadCentres(QroptError):
+    """The output has no extremes over a crank turn (for example a drag-link follower)."""
+
+
+class ProblemError(QroptError):
+    """A synthesis problem is malformed: unknown names, empty or contradictory bounds, no free parameter."""

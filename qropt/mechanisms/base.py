@@ -1,0 +1,286 @@
+"""The mechanism protocol: parameters, one closed-form loop per type, and the exact cycle quantities.
+
+A type defines ``PARAMS`` (name -> default, ``REQUIRED`` for none), the names of
+its ``LENGTHS`` (positive) and ``loop(xp, theta2, p) -> Loop`` written once over a
+math namespace. Everything else (positions, rates, dead centres, time ratio,
+stroke, transmission angles, gamma_min, the assembly check) is derived here.
+Angles are radians; lengths in any consistent unit; theta2 counter-clockwise from +x.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Any, ClassVar, NamedTuple
+
+import numpy as np
+
+from qropt import cycle
+from qropt.errors import AssemblyError, InvalidParameter, NoDeadCentres
+from qropt.ops import JET, NUMPY, Jet
+
+REQUIRED = object()
+REGISTRY: dict[str, type[Mechanism]] = {}
+
+
+class Loop(NamedTuple):
+    """One evaluation of a mechanism's closed-form loop.
+
+    points: joint name -> (x, y); angles: link angle name -> angle (direction
+    from the first-named joint to the second, e.g. theta3 = A->B); x: the output
+    (slider position along +x, or theta4 for FourBar); transmission: joint ->
+    transmission angle; margins: (closure description, margin >= 0 if it assembles).
+    """
+
+    points: dict
+    angles: dict
+    x: Any
+    transmission: dict
+    margins: list
+
+
+@dataclass(frozen=True)
+class Positions:
+    """Joint coordinates (arrays of shape (n, 2)) and link angles (rad) at the crank angles theta2."""
+
+    theta2: np.ndarray
+    points: dict
+    angles: dict
+    x: np.ndarray
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Output position x, velocity v, acceleration a and every link's angle, omega, alpha.
+
+    Units: length, length/s, length/s^2, rad, rad/s, rad/s^2 (for FourBar x is theta4 in rad).
+    """
+
+    theta2: np.ndarray
+    x: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    angles: dict = field(default_factory=dict)
+    omega: dict = field(default_factory=dict)
+    alpha: dict = field(default_factory=dict)
+
+
+class DeadCentres(NamedTuple):
+    """Crank angles (rad, in [0, 2pi)) of the largest and smallest output, and those outputs.
+
+    ``reversals`` counts the output's local maxima over a turn: 1 for a proper
+    quick-return; more means the slider reverses inside a stroke and TR is ill-posed.
+    """
+
+    theta_max: float
+    theta_min: float
+    x_max: float
+    x_min: float
+    reversals: int = 1
+
+
+class GammaMin(NamedTuple):
+    """Smallest transmission angle over a full turn and every joint: value (rad), theta2 (rad), joint."""
+
+    value: float
+    theta2: float
+    joint: str
+
+
+class Mechanism:
+    """Base of every quick-return type; instances are immutable."""
+
+    PARAMS: ClassVar[dict[str, Any]] = {}
+    LENGTHS: ClassVar[tuple[str, ...]] = ()
+    REQUIRES_FULL_TURN: ClassVar[bool] = True
+    OUTPUT: ClassVar[str] = "slider"
+
+    def __init_subclass__(cls, **kw):
+        super().__init_subclass__(**kw)
+        if getattr(cls, "KIND", None):
+            REGISTRY[cls.KIND] = cls
+
+    def __init__(self, **params):
+        name = type(self).__name__
+        unknown = sorted(set(params) - set(self.PARAMS))
+        if unknown:
+            raise InvalidParameter(f"{name}: unknown parameter(s) {unknown}; it takes {list(self.PARAMS)}")
+        values = {}
+        for k, default in self.PARAMS.items():
+            v = params.get(k, default)
+            if v is REQUIRED:
+                raise InvalidParameter(f"{name}: missing parameter {k!r}; it needs {self.required()}")
+            if v is None:
+                continue
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+                raise InvalidParameter(f"{name}: {k} must be a number, got {v!r}")
+            v = float(v)
+            if not math.isfinite(v):
+                raise InvalidParameter(f"{name}: {k} must be finite, got {v}")
+            if k in self.LENGTHS and v <= 0:
+                raise InvalidParameter(f"{name}: length {k} must be positive, got {v:g}")
+            if k.startswith("sigma") and v not in (-1.0, 1.0):
+                raise InvalidParameter(f"{name}: branch sign {k} must be +1 or -1, got {v:g}")
+            values[k] = v
+        object.__setattr__(self, "params", values)
+        self.validate()
+        if self.REQUIRES_FULL_TURN:
+            failures = self.assembly_failures()
+            if failures:
+                raise AssemblyError(name, self.params, failures)
+
+    def __setattr__(self, k, v):
+        if k in type(self).__dict__ and isinstance(type(self).__dict__[k], cached_property):
+            object.__setattr__(self, k, v)
+            return
+        raise AttributeError(f"{type(self).__name__} is immutable")
+
+    def __repr__(self):
+        return f"{type(self).__name__}(" + ", ".join(f"{k}={v:g}" for k, v in self.params.items()) + ")"
+
+    def __eq__(self, other):
+        return type(self) is type(other) and self.params == other.params
+
+    def __hash__(self):
+        return hash((type(self).__name__, tuple(sorted(self.params.items()))))
+
+    @classmethod
+    def required(cls) -> list[str]:
+        return [k for k, v in cls.PARAMS.items() if v is REQUIRED]
+
+    def validate(self) -> None:
+        """Type-specific checks beyond positive lengths (override)."""
+
+    @staticmethod
+    def loop(xp, theta2, p) -> Loop:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    # ---- evaluation -------------------------------------------------------
+    def evaluate(self, xp, theta2) -> Loop:
+        """The loop at theta2 in namespace xp with this mechanism's parameters."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return self.loop(xp, theta2, self.params)
+
+    def positions(self, theta2) -> Positions:
+        """Every joint (n, 2) and link angle at crank angles theta2 (rad); nan where it cannot assemble."""
+        t = np.atleast_1d(np.asarray(theta2, float))
+        lp = self.evaluate(NUMPY, t)
+        pts = {k: np.column_stack(np.broadcast_arrays(x, y, t)[:2]) for k, (x, y) in lp.points.items()}
+        ang = {k: np.broadcast_to(v, t.shape).astype(float) for k, v in lp.angles.items()}
+        return Positions(t, pts, ang, np.broadcast_to(lp.x, t.shape).astype(float))
+
+    def motion(self, theta2, omega2: float = 1.0, alpha2: float = 0.0) -> Motion:
+        """Exact output and link rates at theta2 (rad) for crank rate omega2 (rad/s) and alpha2 (rad/s^2)."""
+        t = np.atleast_1d(np.asarray(theta2, float))
+        lp = self.evaluate(JET, Jet.seed(t, omega2, alpha2))
+
+        def parts(j):
+            if isinstance(j, Jet):
+                return [np.broadcast_to(c, t.shape).astype(float) for c in (j.v, j.d1, j.d2)]
+            return [np.broadcast_to(float(j), t.shape).astype(float), np.zeros_like(t), np.zeros_like(t)]
+
+        x, v, a = parts(lp.x)
+        rates = {k: parts(j) for k, j in lp.angles.items()}
+        return Motion(
+            t,
+            x,
+            v,
+            a,
+            {k: r[0] for k, r in rates.items()},
+            {k: r[1] for k, r in rates.items()},
+            {k: r[2] for k, r in rates.items()},
+        )
+
+    def slider(self, theta2, omega2: float = 1.0, alpha2: float = 0.0) -> Motion:
+        """Slider position x, velocity v, acceleration a (and link rates) at theta2; see ``motion``."""
+        return self.motion(theta2, omega2, alpha2)
+
+    def transmission_angles(self, theta2) -> dict[str, np.ndarray]:
+        """Transmission angle (rad, in [0, pi/2]) of every transmitting joint at theta2."""
+        t = np.atleast_1d(np.asarray(theta2, float))
+        lp = self.evaluate(NUMPY, t)
+        return {k: np.broadcast_to(v, t.shape).astype(float) for k, v in lp.transmission.items()}
+
+    # ---- exact cycle quantities -------------------------------------------
+    def _output(self, th):
+        return self.evaluate(JET, th).x
+
+    def _require_full_turn(self):
+        if not self.REQUIRES_FULL_TURN:
+            failures = self.assembly_failures()
+            if failures:
+                raise AssemblyError(type(self).__name__, self.params, failures)
+
+    @cached_property
+    def _dead_centres(self) -> DeadCentres:
+        self._require_full_turn()
+        tmax, xmax = cycle.extremes(self._output, "max")
+        tmin, xmin = cycle.extremes(self._output, "min")
+        if tmax.size == 0 or tmin.size == 0:
+            raise NoDeadCentres(f"{self!r}: the output has no extremes over a crank turn (it turns fully)")
+        i, j = int(np.argmax(xmax)), int(np.argmin(xmin))
+        return DeadCentres(float(tmax[i]), float(tmin[j]), float(xmax[i]), float(xmin[j]), int(tmax.size))
+
+    def dead_centres(self) -> DeadCentres:
+        """Exact crank angles of the largest and smallest output (zero output velocity)."""
+        return self._dead_centres
+
+    def stroke_angles(self) -> tuple[float, float]:
+        """(a, b): crank turn (rad) from theta_max to theta_min counter-clockwise, and the rest."""
+        d = self.dead_centres()
+        a = (d.theta_min - d.theta_max) % cycle.TWO_PI
+        return a, cycle.TWO_PI - a
+
+    def time_ratio(self) -> float:
+        """TR = slow crank interval / fast crank interval (>= 1)."""
+        a, b = self.stroke_angles()
+        return max(a, b) / min(a, b)
+
+    def stroke(self) -> float:
+        """Output travel between the dead centres (length; rad for FourBar)."""
+        d = self.dead_centres()
+        return d.x_max - d.x_min
+
+    def working_direction(self, omega2: float = 1.0) -> str | None:
+        """'+x' or '-x': the way the output moves during the slow (working) stroke; None if TR = 1."""
+        a, b = self.stroke_angles()
+        if a == b:
+            return None
+        minus_is_slow = (a > b) == (omega2 > 0)
+        return "-x" if minus_is_slow else "+x"
+
+    @cached_property
+    def _gamma_min(self) -> GammaMin:
+        self._require_full_turn()
+        best = GammaMin(math.pi / 2, 0.0, "")
+        lp = self.evaluate(NUMPY, np.zeros(1))
+        for joint, g in lp.transmission.items():
+            if isinstance(g, float):
+                val, th = g, 0.0
+            else:
+                th, val = cycle.minimum(lambda t, j=joint: self.evaluate(JET, t).transmission[j])
+            if not best.joint or val < best.value:
+                best = GammaMin(val, th, joint)
+        return best
+
+    def gamma_min(self) -> GammaMin:
+        """Smallest transmission angle over the full turn and every joint, exact (not a grid sample)."""
+        return self._gamma_min
+
+    def assembly_failures(self) -> list[tuple[str, float, float]]:
+        """(closure, theta2_from, theta2_to) intervals (rad) where the loop cannot close; [] if it turns fully."""
+        lp = self.evaluate(NUMPY, np.zeros(1))
+        for k, (what, _) in enumerate(lp.margins):
+
+            def margin(t, k=k):
+                return np.asarray(self.evaluate(NUMPY, t).margins[k][1], float) + 0 * t
+
+            found = cycle.negative_intervals(margin)
+            if not found:
+                tmin, mmin = cycle.minimum(lambda t, k=k: self.evaluate(JET, t).margins[k][1])
+                if mmin < 0:
+                    found = [(tmin, tmin)]
+            if found:
+                return [(what, lo, hi) for lo, hi in found]
+        return []

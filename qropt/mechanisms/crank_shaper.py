@@ -1,0 +1,48 @@
+"""Crank-shaper: inverted slider-crank with r2 < r1; the slotted lever swings about O4 = (0, -r1)."""
+
+from __future__ import annotations
+
+import math
+
+from qropt.closures import on_ray, pin_in_slot, rod_to_line, rod_transmission
+from qropt.errors import InvalidParameter
+from qropt.mechanisms.base import REQUIRED, Loop, Mechanism
+
+
+class CrankShaper(Mechanism):
+    """Crank-shaper (r1 centres, r2 crank, r4 lever O4C; optional rod r6 to a slide line y = -r1 + h).
+
+    Without r6 the ram is driven by a yoke and x = x_C (the lab rig of seed 001).
+    """
+
+    KIND = "crank-shaper"
+    PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r4": REQUIRED, "r6": None, "h": None, "sigma_slider": 1.0}
+    LENGTHS = ("r1", "r2", "r4", "r6")
+
+    def validate(self):
+        p = self.params
+        if p["r2"] >= p["r1"]:
+            raise InvalidParameter(
+                f"CrankShaper: needs crank r2 < centres r1, got r2={p['r2']:g} >= r1={p['r1']:g} "
+                "(r2 > r1 is a Whitworth)"
+            )
+        if "h" in p and "r6" not in p:
+            raise InvalidParameter("CrankShaper: h (slide-line height) needs the rod length r6")
+        if "r6" in p and "h" not in p:
+            object.__setattr__(self, "params", {**p, "h": 0.0})
+
+    @staticmethod
+    def loop(xp, theta2, p):
+        o4 = (0.0, -p["r1"])
+        a = (p["r2"] * xp.cos(theta2), p["r2"] * xp.sin(theta2))
+        theta4 = pin_in_slot(xp, o4, a)
+        c = on_ray(xp, o4, theta4, p["r4"])
+        points = {"O2": (0.0, 0.0), "A": a, "O4": o4, "C": c}
+        angles = {"theta2": theta2, "theta4": theta4}
+        if "r6" not in p:
+            return Loop(points, angles, c[0], {"A": math.pi / 2, "C": math.pi / 2}, [])
+        d, m = rod_to_line(xp, c, p["r6"], -p["r1"] + p["h"], p["sigma_slider"])
+        points["D"] = d
+        angles["theta6"] = xp.atan2(d[1] - c[1], d[0] - c[0])
+        trans = {"A": math.pi / 2, "D": rod_transmission(xp, c, d)}
+        return Loop(points, angles, d[0], trans, [("rod CD reaching the slide line", m)])

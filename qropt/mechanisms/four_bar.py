@@ -1,0 +1,152 @@
+"""The four-bar O2-A-B-O4 with O4 = (r1, 0): Grashof class, toggle positions, the FourBar type,
+and the shared loop of the four-bar-driven sliders (C on ray O4->B at r5, rod CD to y = h)."""
+
+from __future__ import annotations
+
+import math
+from typing import ClassVar, NamedTuple
+
+
+from qropt.closures import acute_angle, circle_circle, on_ray, rod_to_line, rod_transmission
+from qropt.errors import GrashofError
+from qropt.mechanisms.base import REQUIRED, Loop, Mechanism
+
+LINKS = ("r1", "r2", "r3", "r4")
+
+
+class Grashof(NamedTuple):
+    """Grashof class of r1..r4: kind, the shortest link's name, s + l and p + q."""
+
+    kind: str
+    shortest: str
+    s_plus_l: float
+    p_plus_q: float
+
+
+def grashof(r1: float, r2: float, r3: float, r4: float, rtol: float = 1e-12) -> Grashof:
+    """Classify a four-bar: 'drag-link' (r1 shortest), 'crank-rocker' (r2), 'double-rocker' (r3),
+    'rocker-crank' (r4), 'change-point' (s + l = p + q) or 'non-Grashof' (s + l > p + q)."""
+    r = {"r1": r1, "r2": r2, "r3": r3, "r4": r4}
+    v = sorted(r.values())
+    shortest = min(r, key=r.get)
+    sl, pq = v[0] + v[3], v[1] + v[2]
+    if abs(sl - pq) <= rtol * pq:
+        kind = "change-point"
+    elif sl > pq:
+        kind = "non-Grashof"
+    else:
+        kind = {"r1": "drag-link", "r2": "crank-rocker", "r3": "double-rocker", "r4": "rocker-crank"}[shortest]
+    return Grashof(kind, shortest, sl, pq)
+
+
+def four_bar(xp, theta2, p):
+    """The driving four-bar: (A, O4, B, theta3, theta4, margin) on branch p['sigma']."""
+    o4 = (p["r1"], 0.0)
+    a = (p["r2"] * xp.cos(theta2), p["r2"] * xp.sin(theta2))
+    b, theta4, m = circle_circle(xp, a, p["r3"], o4, p["r4"], p["sigma"], around=math.pi)
+    theta3 = xp.atan2(b[1] - a[1], b[0] - a[0])
+    return a, o4, b, theta3, theta4, m
+
+
+def _coupler_follower(xp, a, o4, b):
+    return acute_angle(xp, (a[0] - b[0], a[1] - b[1]), (o4[0] - b[0], o4[1] - b[1]))
+
+
+class _FourBarBase(Mechanism):
+    LENGTHS: ClassVar[tuple[str, ...]] = LINKS
+
+    def grashof(self) -> Grashof:
+        """Grashof class and shortest link of r1..r4."""
+        return grashof(*(self.params[k] for k in LINKS))
+
+    def toggle_positions(self) -> list[tuple[float, str]]:
+        """Crank angles (rad, [0, 2pi)) where coupler and follower are collinear: 'extended' or 'folded'."""
+        r1, r2, r3, r4 = (self.params[k] for k in LINKS)
+        out = []
+        for d, kind in ((r3 + r4, "extended"), (abs(r3 - r4), "folded")):
+            c = (r1 * r1 + r2 * r2 - d * d) / (2 * r1 * r2)
+            if -1.0 <= c <= 1.0:
+                t = math.acos(c)
+                out += [(t, kind)] + ([(2 * math.pi - t, kind)] if 0.0 < t < math.pi else [])
+        return sorted(out)
+
+
+class FourBar(_FourBarBase):
+    """Four-bar r1 ground, r2 crank, r3 coupler, r4 follower; output theta4 (rad), branch sigma.
+
+    Any Grashof class may be built (non-Grashof too); dead centres, swing and
+    time ratio need a crank that turns fully and a follower that rocks.
+    """
+
+    KIND = "four-bar"
+    PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r3": REQUIRED, "r4": REQUIRED, "sigma": -1.0}
+    REQUIRES_FULL_TURN = False
+    OUTPUT = "follower"
+
+    @staticmethod
+    def loop(xp, theta2, p):
+        a, o4, b, theta3, theta4, m = four_bar(xp, theta2, p)
+        return Loop(
+            points={"O2": (0.0, 0.0), "A": a, "B": b, "O4": o4},
+            angles={"theta2": theta2, "theta3": theta3, "theta4": theta4},
+            x=theta4,
+            transmission={"B": _coupler_follower(xp, a, o4, b)},
+            margins=[("four-bar closure at B", m)],
+        )
+
+    def follower(self, theta2, omega2: float = 1.0, alpha2: float = 0.0):
+        """Follower angle theta4 (x), omega4 (v), alpha4 (a) and all link rates; see ``motion``."""
+        return self.motion(theta2, omega2, alpha2)
+
+    def swing(self) -> float:
+        """theta4_max - theta4_min (rad)."""
+        return self.stroke()
+
+
+class FourBarSlider(_FourBarBase):
+    """Four-bar-driven slider: C on ray O4->B at r5, rod r6 from C to D on y = h. Subclasses fix the class."""
+
+    PARAMS = {
+        **{k: REQUIRED for k in ("r1", "r2", "r3", "r4", "r5", "r6")},
+        "h": 0.0,
+        "sigma": -1.0,
+        "sigma_slider": 1.0,
+    }
+    LENGTHS = ("r1", "r2", "r3", "r4", "r5", "r6")
+    CLASS: ClassVar[str] = ""
+    SHORTEST: ClassVar[str] = ""
+
+    def validate(self):
+        g = self.grashof()
+        p = {k: self.params[k] for k in LINKS}
+        ok = g.s_plus_l <= g.p_plus_q * (1 + 1e-12) and p[self.SHORTEST] <= min(p.values())
+        if not ok:
+            raise GrashofError(
+                f"{type(self).__name__} needs a Grashof {self.CLASS} ({self.SHORTEST} shortest, s + l <= p + q); "
+                f"got {g.kind}: shortest {g.shortest}={p[g.shortest]:g}, s + l = {g.s_plus_l:g}, "
+                f"p + q = {g.p_plus_q:g}",
+                params=self.params,
+                kind=g.kind,
+                required=self.CLASS,
+            )
+
+    @staticmethod
+    def loop(xp, theta2, p):
+        a, o4, b, theta3, theta4, m4 = four_bar(xp, theta2, p)
+        c = on_ray(xp, o4, theta4, p["r5"])
+        d, m6 = rod_to_line(xp, c, p["r6"], p["h"], p["sigma_slider"])
+        return Loop(
+            points={"O2": (0.0, 0.0), "A": a, "B": b, "O4": o4, "C": c, "D": d},
+            angles={
+                "theta2": theta2,
+                "theta3": theta3,
+                "theta4": theta4,
+                "theta6": xp.atan2(d[1] - c[1], d[0] - c[0]),
+            },
+            x=d[0],
+            transmission={"B": _coupler_follower(xp, a, o4, b), "D": rod_transmission(xp, c, d)},
+            margins=[("four-bar closure at B", m4), ("rod CD reaching the slide line", m6)],
+        )
+
+
+__all__ = ["FourBar", "FourBarSlider", "Grashof", "grashof", "four_bar"]

@@ -1,0 +1,122 @@
+"""Every type against the independent brute-force simulation, finite differences and CasADi AD."""
+
+from __future__ import annotations
+
+import casadi
+import numpy as np
+import pytest
+
+from qropt.ops import CASADI
+from tests import brute
+from tests.randmech import KINDS, random_mechanisms
+
+N_RANDOM = 200
+
+
+def _rel(a, b):
+    return abs(a - b) / max(1.0, abs(b))
+
+
+def _angle_diff(a, b):
+    return abs((a - b + np.pi) % (2 * np.pi) - np.pi)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_cycle_quantities_match_brute_force(kind):
+    for p, m in random_mechanisms(kind, N_RANDOM, seed=1):
+        t_max, t_min, x_max, x_min = brute.dead_centres(kind, p)
+        d = m.dead_centres()
+        scale = max(1.0, x_max - x_min)
+        assert _angle_diff(d.theta_max, t_max) < 1e-9, (p, d, t_max)
+        assert _angle_diff(d.theta_min, t_min) < 1e-9, (p, d, t_min)
+        assert abs(d.x_max - x_max) < 1e-9 * scale and abs(d.x_min - x_min) < 1e-9 * scale
+        assert _rel(m.stroke(), x_max - x_min) < 1e-9
+        assert _rel(m.time_ratio(), brute.time_ratio(t_max, t_min)) < 1e-9
+        assert _rel(m.gamma_min().value, brute.gamma_min(kind, p)) < 1e-9, p
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_gamma_min_is_a_lower_bound_attained(kind):
+    for _, m in random_mechanisms(kind, 50, seed=2):
+        g = m.gamma_min()
+        th = np.linspace(0, 2 * np.pi, 5001)
+        sampled = min(v.min() for v in m.transmission_angles(th).values())
+        assert g.value <= sampled + 1e-12
+        at = m.transmission_angles(np.array([g.theta2]))
+        assert abs(at[g.joint][0] - g.value) < 1e-14
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_rates_match_finite_differences(kind):
+    h = 1e-4
+    for _, m in random_mechanisms(kind, 50, seed=3):
+        th = np.linspace(0.1, 2 * np.pi - 0.1, 17)
+        w, al = 7.0, -3.0
+        mo = m.motion(th, w, al)
+        x = lambda t: m.positions(t).x  # noqa: E731
+        dx = (x(th + h) - x(th - h)) / (2 * h)
+        ddx = (x(th + h) - 2 * x(th) + x(th - h)) / h**2
+        scale = max(1.0, np.abs(mo.x).max())
+        np.testing.assert_allclose(mo.v, dx * w, atol=1e-6 * scale * w)
+        np.testing.assert_allclose(mo.a, ddx * w * w + dx * al, atol=1e-4 * scale * w * w)
+        for k in mo.angles:
+            ang = lambda t, k=k: np.unwrap(m.positions(t).angles[k])  # noqa: E731
+            da = (ang(th + h) - ang(th - h)) / (2 * h)
+            np.testing.assert_allclose(mo.omega[k], da * w, atol=1e-5 * w)
+
+
+def _casadi_derivatives(m):
+    t = casadi.SX.sym("t")
+    lp = m.loop(CASADI, t, m.params)
+    outs = [lp.x] + list(lp.angles.values())
+    jac = [casadi.jacobian(o, t) for o in outs]
+    hes = [casadi.jacobian(j, t) for j in jac]
+    return casadi.Function("d", [t], [casadi.vertcat(*outs), casadi.vertcat(*jac), casadi.vertcat(*hes)])
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_rates_match_casadi_ad(kind):
+    for _, m in random_mechanisms(kind, 25, seed=4):
+        f = _casadi_derivatives(m)
+        for th in np.linspace(0.05, 2 * np.pi - 0.05, 9):
+            val, d1, d2 = (np.array(v).ravel() for v in f(th))
+            mo = m.motion(th, 1.0, 0.0)
+            jets = [(mo.x[0], mo.v[0], mo.a[0])] + [(mo.angles[k][0], mo.omega[k][0], mo.alpha[k][0]) for k in mo.angles]
+            for i, (v0, v1, v2) in enumerate(jets):
+                assert abs(np.cos(val[i]) - np.cos(v0)) < 1e-12 and abs(np.sin(val[i]) - np.sin(v0)) < 1e-12
+                assert abs(d1[i] - v1) < 1e-9 * max(1.0, abs(v1))
+                assert abs(d2[i] - v2) < 1e-8 * max(1.0, abs(v2))
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_numpy_and_casadi_namespaces_agree(kind):
+    from qropt.ops import NUMPY
+
+    for _, m in random_mechanisms(kind, 40, seed=5):
+        t = casadi.SX.sym("t")
+        ps = {k: casadi.SX.sym(k) for k in m.params}
+        lp = m.loop(CASADI, t, ps)
+        names = list(lp.points)
+        flat = [lp.x] + [c for k in names for c in lp.points[k]] + list(lp.angles.values())
+        flat += list(lp.transmission.values()) + [mg for _, mg in lp.margins]
+        f = casadi.Function("f", [t, *ps.values()], [casadi.vertcat(*[casadi.SX(v) for v in flat])])
+        for th in np.linspace(0.0, 2 * np.pi, 13):
+            sym = np.array(f(th, *m.params.values())).ravel()
+            ln = m.loop(NUMPY, th, m.params)
+            num = [ln.x] + [c for k in names for c in ln.points[k]] + list(ln.angles.values())
+            num += list(ln.transmission.values()) + [mg for _, mg in ln.margins]
+            np.testing.assert_allclose(sym, np.array(num, float), rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_positions_close_every_loop(kind):
+    for p, m in random_mechanisms(kind, 30, seed=6):
+        th = np.linspace(0, 2 * np.pi, 101)
+        pos = m.positions(th)
+        ref = brute.joints(kind, p, th)
+        for name in ("A", "B", "C", "D"):
+            if name in pos.points and name in ref and not (kind == "slider-crank" and name == "C"):
+                np.testing.assert_allclose(pos.points[name][:, 0], np.real(ref[name][0]), atol=1e-12)
+                np.testing.assert_allclose(pos.points[name][:, 1], np.real(ref[name][1]), atol=1e-12)
+        if kind == "slider-crank":
+            np.testing.assert_allclose(pos.points["C"][:, 0], np.real(ref["D"][0]), atol=1e-12)
