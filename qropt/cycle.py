@@ -71,8 +71,14 @@ def extremes(fun, kind, n: int = GRID):
     """All local maxima or minima of fun over a turn: (theta2 in [0, 2pi), values)."""
     theta = grid(n)
     lo, hi = brackets(theta, jet_of(fun, theta).d1, kind)
-    t = np.mod(stationary(fun, lo, hi), TWO_PI)
+    t = wrap(stationary(fun, lo, hi))
     return t, jet_of(fun, t).v
+
+
+def wrap(theta):
+    """Crank angles reduced to [0, 2pi), with values within 1e-12 of 2pi sent to 0."""
+    t = np.mod(theta, TWO_PI)
+    return np.where(t > TWO_PI - 1e-12, 0.0, t)
 
 
 def minimum(fun, n: int = GRID):

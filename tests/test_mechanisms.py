@@ -53,14 +53,14 @@ def test_rates_match_finite_differences(kind):
         th = np.linspace(0.1, 2 * np.pi - 0.1, 17)
         w, al = 7.0, -3.0
         mo = m.motion(th, w, al)
-        x = lambda t: m.positions(t).x  # noqa: E731
+        x = lambda t, m=m: m.positions(t).x  # noqa: E731
         dx = (x(th + h) - x(th - h)) / (2 * h)
         ddx = (x(th + h) - 2 * x(th) + x(th - h)) / h**2
         scale = max(1.0, np.abs(mo.x).max())
         np.testing.assert_allclose(mo.v, dx * w, atol=1e-6 * scale * w)
         np.testing.assert_allclose(mo.a, ddx * w * w + dx * al, atol=1e-4 * scale * w * w)
         for k in mo.angles:
-            ang = lambda t, k=k: np.unwrap(m.positions(t).angles[k])  # noqa: E731
+            ang = lambda t, k=k, m=m: np.unwrap(m.positions(t).angles[k])  # noqa: E731
             da = (ang(th + h) - ang(th - h)) / (2 * h)
             np.testing.assert_allclose(mo.omega[k], da * w, atol=1e-5 * w)
 
@@ -81,7 +81,8 @@ def test_rates_match_casadi_ad(kind):
         for th in np.linspace(0.05, 2 * np.pi - 0.05, 9):
             val, d1, d2 = (np.array(v).ravel() for v in f(th))
             mo = m.motion(th, 1.0, 0.0)
-            jets = [(mo.x[0], mo.v[0], mo.a[0])] + [(mo.angles[k][0], mo.omega[k][0], mo.alpha[k][0]) for k in mo.angles]
+            jets = [(mo.x[0], mo.v[0], mo.a[0])]
+            jets += [(mo.angles[k][0], mo.omega[k][0], mo.alpha[k][0]) for k in mo.angles]
             for i, (v0, v1, v2) in enumerate(jets):
                 assert abs(np.cos(val[i]) - np.cos(v0)) < 1e-12 and abs(np.sin(val[i]) - np.sin(v0)) < 1e-12
                 assert abs(d1[i] - v1) < 1e-9 * max(1.0, abs(v1))

@@ -6,7 +6,6 @@ from __future__ import annotations
 import math
 from typing import ClassVar, NamedTuple
 
-
 from qropt.closures import acute_angle, circle_circle, on_ray, rod_to_line, rod_transmission
 from qropt.errors import GrashofError
 from qropt.mechanisms.base import REQUIRED, Loop, Mechanism

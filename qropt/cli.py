@@ -1,0 +1,221 @@
+"""Command line: ``qropt analyze`` (and, built on ``solve``, ``qropt synth``). Errors print one line."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import sys
+
+import numpy as np
+
+from qropt.errors import QroptError
+from qropt.mechanisms import REGISTRY, Mechanism, mechanism_type
+
+PARAM_NAMES = ("r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider")
+
+
+class CliError(Exception):
+    """A command-line usage error (exit code 2)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        raise CliError(message)
+
+
+def angle(text: str) -> float:
+    """An angle from the command line: '60', '60deg' (degrees) or '1.05rad' (radians) -> radians."""
+    t = text.strip().lower()
+    try:
+        if t.endswith("rad"):
+            return float(t[:-3])
+        return math.radians(float(t.removesuffix("deg")))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an angle: {text!r} (use e.g. 60deg or 1.05rad)") from None
+
+
+def paper_example() -> Mechanism:
+    """The paper's project mechanism: TR 1.5, stroke 0.3 m, r3 from eqs. (7)-(13) (larger root)."""
+    from qropt import analytic
+    from qropt.mechanisms import DragLinkSlider
+
+    r3 = analytic.drag_link_r3(1.5, 0.1, 0.225, 0.275)[-1].r3
+    return DragLinkSlider(r1=0.1, r2=0.225, r3=r3, r4=0.275, r5=0.15, r6=0.3)
+
+
+def build_mechanism(args) -> Mechanism:
+    given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
+    if args.type is None:
+        if given:
+            raise CliError("give the mechanism TYPE before its parameters (types: " + ", ".join(sorted(REGISTRY)) + ")")
+        return paper_example()
+    return mechanism_type(args.type)(**given)
+
+
+def report(m: Mechanism, theta2: float, omega2: float, alpha2: float) -> dict:
+    """Every analysed quantity as plain JSON-ready values (angles in degrees, suffix _deg)."""
+    d, g = m.dead_centres(), m.gamma_min()
+    a, b = m.stroke_angles()
+    mo = m.motion(np.array([theta2]), omega2, alpha2)
+    out = {
+        "type": m.KIND,
+        "params": dict(m.params),
+        "time_ratio": m.time_ratio(),
+        "stroke": m.stroke(),
+        "dead_centres": {
+            "theta_max_deg": math.degrees(d.theta_max),
+            "theta_min_deg": math.degrees(d.theta_min),
+            "x_max": d.x_max,
+            "x_min": d.x_min,
+            "reversals": d.reversals,
+        },
+        "stroke_angles_deg": [math.degrees(max(a, b)), math.degrees(min(a, b))],
+        "working_direction": m.working_direction(omega2),
+        "gamma_min": {"value_deg": math.degrees(g.value), "theta2_deg": math.degrees(g.theta2), "joint": g.joint},
+        "state": {
+            "theta2_deg": math.degrees(theta2),
+            "omega2": omega2,
+            "alpha2": alpha2,
+            "x": float(mo.x[0]),
+            "v": float(mo.v[0]),
+            "a": float(mo.a[0]),
+            "links": {
+                k: {
+                    "angle_deg": math.degrees(float(mo.angles[k][0])),
+                    "omega": float(mo.omega[k][0]),
+                    "alpha": float(mo.alpha[k][0]),
+                }
+                for k in mo.angles
+            },
+        },
+    }
+    if hasattr(m, "grashof"):
+        out["grashof"] = m.grashof()._asdict()
+    return out
+
+
+def print_report(r: dict, out=None):
+    w = (out or sys.stdout).write
+    out_name = "follower theta4 [rad]" if r["type"] == "four-bar" else "slider x"
+    w(f"{r['type']}: " + ", ".join(f"{k}={v:g}" for k, v in r["params"].items()) + "\n")
+    if "grashof" in r:
+        g = r["grashof"]
+        w(
+            f"  Grashof class     {g['kind']} (shortest {g['shortest']}; s+l = {g['s_plus_l']:.6g}, "
+            f"p+q = {g['p_plus_q']:.6g})\n"
+        )
+    d = r["dead_centres"]
+    w(f"  time ratio        {r['time_ratio']:.10f}\n")
+    w(f"  stroke            {r['stroke']:.10g}\n")
+    w(
+        f"  dead centres      theta_max = {d['theta_max_deg']:.6f} deg ({out_name} = {d['x_max']:.10g}); "
+        f"theta_min = {d['theta_min_deg']:.6f} deg ({d['x_min']:.10g})\n"
+    )
+    if d["reversals"] != 1:
+        w(f"  warning           the output reverses {d['reversals']} times a turn: TR is ill-posed\n")
+    sa = r["stroke_angles_deg"]
+    w(f"  stroke angles     {sa[0]:.6f} deg working / {sa[1]:.6f} deg return\n")
+    w(f"  working stroke    {r['working_direction']} (omega2 = {r['state']['omega2']:g} rad/s)\n")
+    g = r["gamma_min"]
+    w(f"  gamma_min         {g['value_deg']:.6f} deg at theta2 = {g['theta2_deg']:.6f} deg, joint {g['joint']}\n")
+    s = r["state"]
+    w(f"  at theta2 = {s['theta2_deg']:g} deg, omega2 = {s['omega2']:g} rad/s, alpha2 = {s['alpha2']:g} rad/s^2:\n")
+    w(f"    {out_name}: x = {s['x']:.6g}, v = {s['v']:.6g}, a = {s['a']:.6g}\n")
+    for k, v in s["links"].items():
+        w(
+            f"    {k:7s} = {v['angle_deg']:11.5f} deg   omega = {v['omega']:11.5g} rad/s   "
+            f"alpha = {v['alpha']:11.5g} rad/s^2\n"
+        )
+
+
+def write_table(m: Mechanism, step: float, omega2: float, alpha2: float, path: str):
+    """Full-cycle table at crank-angle steps (rad): every joint, link angle, x, v, a, transmission angle."""
+    n = max(1, round(2 * math.pi / step))
+    th = np.linspace(0.0, 2 * math.pi, n + 1)
+    pos, mo, tr = m.positions(th), m.motion(th, omega2, alpha2), m.transmission_angles(th)
+    cols = {"theta2_deg": np.degrees(th)}
+    for k, xy in pos.points.items():
+        cols[f"{k}_x"], cols[f"{k}_y"] = xy[:, 0], xy[:, 1]
+    for k in mo.angles:
+        cols[f"{k}_deg"], cols[f"omega_{k}"], cols[f"alpha_{k}"] = np.degrees(mo.angles[k]), mo.omega[k], mo.alpha[k]
+    cols.update(x=mo.x, v=mo.v, a=mo.a)
+    for k, g in tr.items():
+        cols[f"gamma_{k}_deg"] = np.degrees(g)
+    f = sys.stdout if path == "-" else open(path, "w", newline="")  # noqa: SIM115
+    try:
+        wr = csv.writer(f)
+        wr.writerow(cols)
+        for i in range(th.size):
+            wr.writerow([f"{cols[c][i]:.12g}" for c in cols])
+    finally:
+        if f is not sys.stdout:
+            f.close()
+
+
+def cmd_analyze(args):
+    m = build_mechanism(args)
+    r = report(m, args.theta2, args.omega2, args.alpha2)
+    if args.json:
+        json.dump(r, sys.stdout, indent=2)
+        sys.stdout.write("\n")
+    else:
+        print_report(r)
+    if args.table is not None or args.csv is not None:
+        write_table(
+            m, args.table if args.table is not None else math.radians(1.0), args.omega2, args.alpha2, args.csv or "-"
+        )
+    if args.plot:
+        from qropt import plots
+
+        plots.save(plots.cycle_figure(m, args.theta2, args.omega2, args.alpha2), args.plot)
+        if not args.json:
+            print(f"  picture written to {args.plot}")
+
+
+def parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="qropt", description="Quick-return mechanism analysis and synthesis.")
+    sub = p.add_subparsers(dest="command", required=True)
+    a = sub.add_parser("analyze", help="exact TR, stroke, dead centres, gamma_min and slider state")
+    a.add_argument("type", nargs="?", help="mechanism type: " + ", ".join(sorted(REGISTRY)))
+    for k in PARAM_NAMES:
+        a.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
+    a.add_argument("--theta2", type=angle, default=math.radians(60.0), help="crank angle (deg, or 1.05rad)")
+    a.add_argument("--omega2", type=float, default=1.0, help="crank speed, rad/s (sign = direction)")
+    a.add_argument("--alpha2", type=float, default=0.0, help="crank acceleration, rad/s^2")
+    a.add_argument("--json", action="store_true", help="print JSON instead of text")
+    a.add_argument("--table", type=angle, help="full-cycle table step (deg, or rad with suffix)")
+    a.add_argument("--csv", help="file for the full-cycle table ('-' for standard output)")
+    a.add_argument("--plot", help="PNG file: mechanism at theta2 beside x, v, a over the cycle")
+    a.set_defaults(run=cmd_analyze)
+    try:
+        from qropt import cli_synth
+
+        cli_synth.add_commands(sub)
+    except ImportError:  # pragma: no cover - synthesis not installed
+        pass
+    return p
+
+
+def main(argv=None) -> int:
+    try:
+        args = parser().parse_args(argv)
+        args.run(args)
+        return 0
+    except CliError as e:
+        print(f"qropt: error: {e}", file=sys.stderr)
+        return 2
+    except QroptError as e:
+        print(f"qropt: {type(e).__name__}: {e}", file=sys.stderr)
+        return 1
+    except BrokenPipeError:
+        sys.stderr.close()
+        return 0
+    except OSError as e:
+        print(f"qropt: error: {e}", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
