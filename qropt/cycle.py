@@ -2,8 +2,8 @@
 
 A function is given as ``fun(theta2) -> Jet`` (value, d/dtheta2, d2/dtheta2^2).
 Stationary points are bracketed on a uniform grid by sign changes of the first
-derivative and refined by a vectorised, bisection-safeguarded Newton iteration
-to machine precision.
+derivative and refined to machine precision by a vectorised Newton iteration,
+safeguarded by false position inside the bracket.
 """
 
 from __future__ import annotations
@@ -25,8 +25,8 @@ def jet_of(fun, theta):
     """fun evaluated on the jet seeded at theta, broadcast to theta's shape."""
     j = fun(Jet.seed(theta))
     if not isinstance(j, Jet):
-        j = Jet(np.asarray(j, float), 0.0, 0.0)
-    return Jet(*(np.broadcast_to(c, np.shape(theta)) for c in (j.v, j.d1, j.d2)))
+        return Jet.of(np.broadcast_to(np.asarray(j, float), np.shape(theta)), 0.0, 0.0)
+    return Jet(np.broadcast_to(j.c, (3,) + np.shape(theta)))
 
 
 def brackets(theta, d1, kind):
@@ -47,38 +47,75 @@ def stationary(fun, lo, hi, iters: int = 100):
     lo, hi = np.array(lo, float), np.array(hi, float)
     if lo.size == 0:
         return lo
-    glo = jet_of(fun, lo).d1
+    glo, ghi = jet_of(fun, lo).d1, jet_of(fun, hi).d1
     x = 0.5 * (lo + hi)
+    eps = 4.0 * np.finfo(float).eps
     for _ in range(iters):
         j = jet_of(fun, x)
         g, h = j.d1, j.d2
-        same = np.sign(g) == np.sign(glo)
-        lo, glo = np.where(same, x, lo), np.where(same, g, glo)
-        hi = np.where(same, hi, x)
         with np.errstate(divide="ignore", invalid="ignore"):
-            xn = x - g / h
-        bad = ~np.isfinite(xn) | (xn <= lo) | (xn >= hi)
-        xn = np.where(bad, 0.5 * (lo + hi), xn)
-        xn = np.where(g == 0.0, x, xn)
-        done = np.abs(xn - x) <= 4.0 * np.finfo(float).eps * np.maximum(1.0, np.abs(x))
-        x = xn
+            step = g / h
+        done = (g == 0.0) | (np.abs(step) <= eps * np.maximum(1.0, np.abs(x)))
         if done.all():
             break
+        same = np.sign(g) == np.sign(glo)
+        lo, glo = np.where(same, x, lo), np.where(same, g, glo)
+        hi, ghi = np.where(same, hi, x), np.where(same, ghi, g)
+        xn = x - step
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xf = lo - glo * (hi - lo) / (ghi - glo)  # false position: lands on a root at a bracket end
+        xf = np.where(np.isfinite(xf) & (xf >= lo) & (xf <= hi), xf, 0.5 * (lo + hi))
+        bad = ~np.isfinite(xn) | (xn <= lo) | (xn >= hi)
+        x = np.where(done, x, np.where(bad, xf, xn))
     return x
-
-
-def extremes(fun, kind, n: int = GRID):
-    """All local maxima or minima of fun over a turn: (theta2 in [0, 2pi), values)."""
-    theta = grid(n)
-    lo, hi = brackets(theta, jet_of(fun, theta).d1, kind)
-    t = wrap(stationary(fun, lo, hi))
-    return t, jet_of(fun, t).v
 
 
 def wrap(theta):
     """Crank angles reduced to [0, 2pi), with values within 1e-12 of 2pi sent to 0."""
     t = np.mod(theta, TWO_PI)
     return np.where(t > TWO_PI - 1e-12, 0.0, t)
+
+
+def stack(jets, shape) -> np.ndarray:
+    """Jets (or constants) as one array (Q, 3, *shape)."""
+    out = np.zeros((len(jets), 3) + tuple(shape))
+    for k, j in enumerate(jets):
+        if isinstance(j, Jet):
+            out[k] = j.c
+        else:
+            out[k, 0] = j
+    return out
+
+
+def extremes_many(fun, specs, n: int = GRID):
+    """Local extremes of several quantities at once, from one grid evaluation and one Newton run.
+
+    fun(theta_jet) -> array (Q, 3, m) of the Q quantities' jets; specs: [(q, 'max' | 'min')].
+    Returns ([(theta2 array, value array) per spec], grid values (Q, n)).
+    """
+    theta = grid(n)
+    g = fun(Jet.seed(theta))
+    parts = [brackets(theta, g[q, 1], kind) for q, kind in specs]
+    lo = np.concatenate([p[0] for p in parts])
+    hi = np.concatenate([p[1] for p in parts])
+    which = np.concatenate([np.full(p[0].size, q, int) for (q, _), p in zip(specs, parts, strict=True)])
+
+    def selected(t):
+        return Jet(fun(t)[which, :, np.arange(which.size)].T)
+
+    x = wrap(stationary(selected, lo, hi)) if which.size else lo
+    vals = jet_of(selected, x).v if which.size else lo
+    out, start = [], 0
+    for p in parts:
+        out.append((x[start : start + p[0].size], vals[start : start + p[0].size]))
+        start += p[0].size
+    return out, g[:, 0]
+
+
+def extremes(fun, kind, n: int = GRID):
+    """All local maxima or minima of fun over a turn: (theta2 in [0, 2pi), values)."""
+    (res,), _ = extremes_many(lambda t: stack([fun(t)], np.shape(t.v)), [(0, kind)], n)
+    return res
 
 
 def minimum(fun, n: int = GRID):

@@ -8,9 +8,7 @@ exactly), and ``CASADI`` builds CasADi SX/MX expressions for the NLP.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from types import SimpleNamespace
-from typing import Any
 
 import casadi
 import numpy as np
@@ -53,59 +51,92 @@ CASADI = SimpleNamespace(
 )
 
 
-@dataclass(frozen=True, slots=True)
 class Jet:
-    """Truncated Taylor jet (f, f', f'') of arrays, derivatives in the seeded variable."""
+    """Truncated Taylor jet (f, f', f'') of arrays, derivatives in the seeded variable.
 
-    v: Any
-    d1: Any
-    d2: Any
+    Stored as one array ``c`` of shape (3, ...) so that linear operations are single numpy calls.
+    """
+
+    __slots__ = ("c", "_sc")
+
+    def __init__(self, c):
+        self.c = c
+        self._sc = None
+
+    def sincos(self):
+        """(sin, cos) of the value, computed once per jet (positions take both of the same angle)."""
+        if self._sc is None:
+            self._sc = (np.sin(self.c[0]), np.cos(self.c[0]))
+        return self._sc
+
+    v = property(lambda self: self.c[0])
+    d1 = property(lambda self: self.c[1])
+    d2 = property(lambda self: self.c[2])
 
     @staticmethod
     def seed(x, d1=1.0, d2=0.0) -> Jet:
         """The independent variable: value x with derivatives d1, d2 (e.g. omega2, alpha2)."""
         x = np.asarray(x, dtype=float)
-        return Jet(x, np.broadcast_to(np.asarray(d1, float), x.shape), np.broadcast_to(np.asarray(d2, float), x.shape))
+        c = np.empty((3,) + x.shape)
+        c[0], c[1], c[2] = x, d1, d2
+        return Jet(c)
+
+    @staticmethod
+    def of(v, d1, d2) -> Jet:
+        """A jet from its three components (broadcast together)."""
+        return Jet(np.array(np.broadcast_arrays(v, d1, d2), dtype=float))
 
     def _chain(self, g0, g1, g2) -> Jet:
         # f = g(u): f' = g'(u) u', f'' = g''(u) u'^2 + g'(u) u''
-        return Jet(g0, g1 * self.d1, g2 * self.d1 * self.d1 + g1 * self.d2)
+        u1 = self.c[1]
+        c = np.empty_like(self.c)
+        c[0] = g0
+        c[1] = g1 * u1
+        c[2] = g2 * u1 * u1 + g1 * self.c[2]
+        return Jet(c)
+
+    def _plus_value(self, o):
+        c = self.c.copy()
+        c[0] += o
+        return Jet(c)
 
     def __add__(self, o):
         if isinstance(o, Jet):
-            return Jet(self.v + o.v, self.d1 + o.d1, self.d2 + o.d2)
-        return Jet(self.v + o, self.d1, self.d2)
+            return Jet(self.c + o.c)
+        if np.ndim(o) <= np.ndim(self.c) - 1:
+            return self._plus_value(o)
+        return Jet.of(self.c[0] + o, self.c[1], self.c[2])
 
     __radd__ = __add__
 
     def __neg__(self):
-        return Jet(-self.v, -self.d1, -self.d2)
+        return Jet(-self.c)
 
     def __sub__(self, o):
         return self + (-o)
 
     def __rsub__(self, o):
-        return (-self) + o
+        return Jet(-self.c) + o
 
     def __mul__(self, o):
         if isinstance(o, Jet):
-            return Jet(
-                self.v * o.v,
-                self.d1 * o.v + self.v * o.d1,
-                self.d2 * o.v + 2.0 * self.d1 * o.d1 + self.v * o.d2,
-            )
-        return Jet(self.v * o, self.d1 * o, self.d2 * o)
+            a, b = self.c, o.c
+            c = a * b[0]
+            c[1] += a[0] * b[1]
+            c[2] += a[0] * b[2] + 2.0 * a[1] * b[1]
+            return Jet(c)
+        return Jet(self.c * o)
 
     __rmul__ = __mul__
 
     def _reciprocal(self) -> Jet:
-        r = 1.0 / self.v
+        r = 1.0 / self.c[0]
         return self._chain(r, -r * r, 2.0 * r * r * r)
 
     def __truediv__(self, o):
         if isinstance(o, Jet):
             return self * o._reciprocal()
-        return Jet(self.v / o, self.d1 / o, self.d2 / o)
+        return Jet(self.c / o)
 
     def __rtruediv__(self, o):
         return self._reciprocal() * o
@@ -138,21 +169,20 @@ def _lift(x) -> Jet:
     if isinstance(x, Jet):
         return x
     x = np.asarray(x, dtype=float)
-    z = np.zeros_like(x)
-    return Jet(x, z, z)
+    return Jet.of(x, 0.0, 0.0)
 
 
 def _jsin(u):
     if not isinstance(u, Jet):
         return np.sin(u)
-    s, c = np.sin(u.v), np.cos(u.v)
+    s, c = u.sincos()
     return u._chain(s, c, -s)
 
 
 def _jcos(u):
     if not isinstance(u, Jet):
         return np.cos(u)
-    s, c = np.sin(u.v), np.cos(u.v)
+    s, c = u.sincos()
     return u._chain(c, -s, -c)
 
 
@@ -183,18 +213,18 @@ def _jatan2(y, x):
     if not isinstance(y, Jet) and not isinstance(x, Jet):
         return np.arctan2(y, x)
     y, x = _lift(y), _lift(x)
-    d = x.v * x.v + y.v * y.v
-    n = x.v * y.d1 - y.v * x.d1
-    dn = x.v * y.d2 - y.v * x.d2
-    dd = 2.0 * (x.v * x.d1 + y.v * y.d1)
-    return Jet(np.arctan2(y.v, x.v), n / d, (dn * d - n * dd) / (d * d))
+    (x0, x1, x2), (y0, y1, y2) = x.c, y.c
+    d = x0 * x0 + y0 * y0
+    n = x0 * y1 - y0 * x1
+    dn = x0 * y2 - y0 * x2
+    dd = 2.0 * (x0 * x1 + y0 * y1)
+    return Jet.of(np.arctan2(y0, x0), n / d, (dn * d - n * dd) / (d * d))
 
 
 def _jfabs(u):
     if not isinstance(u, Jet):
         return np.abs(u)
-    s = np.where(u.v < 0, -1.0, 1.0)
-    return Jet(s * u.v, s * u.d1, s * u.d2)
+    return Jet(np.where(u.c[0] < 0, -1.0, 1.0) * u.c)
 
 
 def _jif_else(cond, a, b):
@@ -202,7 +232,7 @@ def _jif_else(cond, a, b):
     if not isinstance(a, Jet) and not isinstance(b, Jet):
         return np.where(cond, a, b)
     a, b = _lift(a), _lift(b)
-    return Jet(np.where(cond, a.v, b.v), np.where(cond, a.d1, b.d1), np.where(cond, a.d2, b.d2))
+    return Jet(np.where(cond, a.c, b.c))
 
 
 def _jfmin(a, b):

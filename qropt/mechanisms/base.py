@@ -203,8 +203,31 @@ class Mechanism:
         return {k: np.broadcast_to(v, t.shape).astype(float) for k, v in lp.transmission.items()}
 
     # ---- exact cycle quantities -------------------------------------------
-    def _output(self, th):
-        return self.evaluate(JET, th).x
+    @cached_property
+    def _cycle(self) -> dict:
+        """Slider extremes, transmission minima and assembly-margin minima from one refined grid pass."""
+        lp0 = self.evaluate(NUMPY, np.zeros(1))
+        varying = [j for j, g in lp0.transmission.items() if not isinstance(g, float)]
+        n_margin = len(lp0.margins)
+
+        def quantities(t):
+            lp = self.evaluate(JET, t)
+            qs = [lp.x] + [lp.transmission[j] for j in varying] + [m for _, m in lp.margins]
+            return cycle.stack(qs, np.shape(t.v))
+
+        specs = [(0, "max"), (0, "min")] + [(1 + k, "min") for k in range(len(varying) + n_margin)]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            res, on_grid = cycle.extremes_many(quantities, specs)
+        gammas = {j: res[2 + k] for k, j in enumerate(varying)}
+        gammas.update({j: (np.zeros(1), np.full(1, g)) for j, g in lp0.transmission.items() if isinstance(g, float)})
+        margins = []
+        for k in range(n_margin):
+            t, v = res[2 + len(varying) + k]
+            grid_min = (
+                np.nanmin(on_grid[1 + len(varying) + k]) if np.isfinite(on_grid[1 + len(varying) + k]).any() else 0.0
+            )
+            margins.append(min(grid_min, np.nanmin(v, initial=np.inf)))
+        return {"max": res[0], "min": res[1], "gamma": gammas, "margins": margins}
 
     def _require_full_turn(self):
         if not self.REQUIRES_FULL_TURN:
@@ -215,8 +238,7 @@ class Mechanism:
     @cached_property
     def _dead_centres(self) -> DeadCentres:
         self._require_full_turn()
-        tmax, xmax = cycle.extremes(self._output, "max")
-        tmin, xmin = cycle.extremes(self._output, "min")
+        (tmax, xmax), (tmin, xmin) = self._cycle["max"], self._cycle["min"]
         if tmax.size == 0 or tmin.size == 0:
             raise NoDeadCentres(f"{self!r}: the output has no extremes over a crank turn (it turns fully)")
         i, j = int(np.argmax(xmax)), int(np.argmin(xmin))
@@ -253,15 +275,13 @@ class Mechanism:
     @cached_property
     def _gamma_min(self) -> GammaMin:
         self._require_full_turn()
-        best = GammaMin(math.pi / 2, 0.0, "")
-        lp = self.evaluate(NUMPY, np.zeros(1))
-        for joint, g in lp.transmission.items():
-            if isinstance(g, float):
-                val, th = g, 0.0
-            else:
-                th, val = cycle.minimum(lambda t, j=joint: self.evaluate(JET, t).transmission[j])
-            if not best.joint or val < best.value:
-                best = GammaMin(val, th, joint)
+        best = None
+        for joint, (t, v) in self._cycle["gamma"].items():
+            ok = np.flatnonzero(np.isfinite(v))
+            if ok.size:
+                k = ok[np.argmin(v[ok])]
+                if best is None or v[k] < best.value:
+                    best = GammaMin(float(v[k]), float(t[k]), joint)
         return best
 
     def gamma_min(self) -> GammaMin:
@@ -272,15 +292,21 @@ class Mechanism:
         """(closure, theta2_from, theta2_to) intervals (rad) where the loop cannot close; [] if it turns fully."""
         lp = self.evaluate(NUMPY, np.zeros(1))
         for k, (what, _) in enumerate(lp.margins):
+            if not self._cycle["margins"][k] < 0:
+                continue
 
             def margin(t, k=k):
                 return np.asarray(self.evaluate(NUMPY, t).margins[k][1], float) + 0 * t
 
             found = cycle.negative_intervals(margin)
-            if not found:
-                tmin, mmin = cycle.minimum(lambda t, k=k: self.evaluate(JET, t).margins[k][1])
-                if mmin < 0:
-                    found = [(tmin, tmin)]
-            if found:
-                return [(what, lo, hi) for lo, hi in found]
+            if not found:  # a failure narrower than the check grid: around the refined minimum
+                t, v = self._cycle_margin_argmin(k)
+                found = [(t, t)]
+            return [(what, lo, hi) for lo, hi in found]
         return []
+
+    def _cycle_margin_argmin(self, k):
+        def margin(t):
+            return self.evaluate(JET, t).margins[k][1]
+
+        return cycle.minimum(margin)

@@ -1,0 +1,1 @@
+"""qropt benchmarks: speed as ratios against baselines run in the same process."""
