@@ -53,6 +53,30 @@ def acute_angle(xp, u, w):
     return xp.atan2(xp.fabs(cross), xp.fabs(dot))
 
 
-def rod_transmission(xp, pin, slider):
-    """Transmission angle at a slider on a +x slide line driven by the rod pin -> slider."""
-    return acute_angle(xp, (slider[0] - pin[0], slider[1] - pin[1]), (0.0, 1.0))
+# A transmitting joint is described by its two lines: the line along which the driving element
+# carries force and the velocity direction of the driven point (or None: a block in a slot or a
+# yoke, whose transmission angle is 90 degrees). Angle and cosine are derived here, once.
+RIGHT_ANGLE = None
+
+
+def joint_lines(a, o, b):
+    """Coupler-follower joint B: force along B->A, driven point B moves normal to O->B (so use B->O)."""
+    return (a[0] - b[0], a[1] - b[1]), (o[0] - b[0], o[1] - b[1])
+
+
+def rod_lines(pin, slider):
+    """Rod pin -> slider on a +x slide line: force along the rod, compared with the line's normal."""
+    return (slider[0] - pin[0], slider[1] - pin[1]), (0.0, 1.0)
+
+
+def transmission_angle(xp, lines):
+    """Transmission angle (rad, [0, pi/2]) of a joint given by its lines; pi/2 for RIGHT_ANGLE."""
+    return math.pi / 2 if lines is None else acute_angle(xp, *lines)
+
+
+def transmission_cos(xp, lines):
+    """Signed cosine of the angle between a joint's lines: gamma >= g  <=>  |cos| <= cos(g). Smooth."""
+    if lines is None:
+        return 0.0
+    (ux, uy), (wx, wy) = lines
+    return (ux * wx + uy * wy) / xp.sqrt((ux * ux + uy * uy) * (wx * wx + wy * wy))

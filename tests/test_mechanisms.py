@@ -6,6 +6,7 @@ import casadi
 import numpy as np
 import pytest
 
+from qropt.closures import transmission_angle, transmission_cos
 from qropt.ops import CASADI
 from tests import brute
 from tests.randmech import KINDS, random_mechanisms
@@ -99,13 +100,15 @@ def test_numpy_and_casadi_namespaces_agree(kind):
         lp = m.loop(CASADI, t, ps)
         names = list(lp.points)
         flat = [lp.x] + [c for k in names for c in lp.points[k]] + list(lp.angles.values())
-        flat += list(lp.transmission.values()) + [mg for _, mg in lp.margins]
+        flat += [f(CASADI, v) for v in lp.transmission.values() for f in (transmission_angle, transmission_cos)]
+        flat += [mg for _, mg in lp.margins]
         f = casadi.Function("f", [t, *ps.values()], [casadi.vertcat(*[casadi.SX(v) for v in flat])])
         for th in np.linspace(0.0, 2 * np.pi, 13):
             sym = np.array(f(th, *m.params.values())).ravel()
             ln = m.loop(NUMPY, th, m.params)
             num = [ln.x] + [c for k in names for c in ln.points[k]] + list(ln.angles.values())
-            num += list(ln.transmission.values()) + [mg for _, mg in ln.margins]
+            num += [f(NUMPY, v) for v in ln.transmission.values() for f in (transmission_angle, transmission_cos)]
+            num += [mg for _, mg in ln.margins]
             np.testing.assert_allclose(sym, np.array(num, float), rtol=1e-12, atol=1e-12)
 
 

@@ -17,6 +17,7 @@ from typing import Any, ClassVar, NamedTuple
 import numpy as np
 
 from qropt import cycle
+from qropt.closures import RIGHT_ANGLE, transmission_angle
 from qropt.errors import AssemblyError, InvalidParameter, NoDeadCentres
 from qropt.ops import JET, NUMPY, Jet
 
@@ -29,8 +30,8 @@ class Loop(NamedTuple):
 
     points: joint name -> (x, y); angles: link angle name -> angle (direction
     from the first-named joint to the second, e.g. theta3 = A->B); x: the output
-    (slider position along +x, or theta4 for FourBar); transmission: joint ->
-    transmission angle; margins: (closure description, margin >= 0 if it assembles).
+    (slider position along +x, or theta4 for FourBar); transmission: joint -> its
+    lines (see ``closures``) or RIGHT_ANGLE; margins: (closure, margin >= 0 if it assembles).
     """
 
     points: dict
@@ -200,26 +201,30 @@ class Mechanism:
         """Transmission angle (rad, in [0, pi/2]) of every transmitting joint at theta2."""
         t = np.atleast_1d(np.asarray(theta2, float))
         lp = self.evaluate(NUMPY, t)
-        return {k: np.broadcast_to(v, t.shape).astype(float) for k, v in lp.transmission.items()}
+        return {
+            k: np.broadcast_to(transmission_angle(NUMPY, v), t.shape).astype(float) for k, v in lp.transmission.items()
+        }
 
     # ---- exact cycle quantities -------------------------------------------
     @cached_property
     def _cycle(self) -> dict:
         """Slider extremes, transmission minima and assembly-margin minima from one refined grid pass."""
         lp0 = self.evaluate(NUMPY, np.zeros(1))
-        varying = [j for j, g in lp0.transmission.items() if not isinstance(g, float)]
+        varying = [j for j, g in lp0.transmission.items() if g is not RIGHT_ANGLE]
         n_margin = len(lp0.margins)
 
         def quantities(t):
             lp = self.evaluate(JET, t)
-            qs = [lp.x] + [lp.transmission[j] for j in varying] + [m for _, m in lp.margins]
+            qs = [lp.x] + [transmission_angle(JET, lp.transmission[j]) for j in varying]
+            qs += [m for _, m in lp.margins]
             return cycle.stack(qs, np.shape(t.v))
 
         specs = [(0, "max"), (0, "min")] + [(1 + k, "min") for k in range(len(varying) + n_margin)]
         with np.errstate(invalid="ignore", divide="ignore"):
             res, on_grid = cycle.extremes_many(quantities, specs)
         gammas = {j: res[2 + k] for k, j in enumerate(varying)}
-        gammas.update({j: (np.zeros(1), np.full(1, g)) for j, g in lp0.transmission.items() if isinstance(g, float)})
+        right = [j for j, g in lp0.transmission.items() if g is RIGHT_ANGLE]
+        gammas.update({j: (np.zeros(1), np.full(1, math.pi / 2)) for j in right})
         margins = []
         for k in range(n_margin):
             t, v = res[2 + len(varying) + k]

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import math
-
-from qropt.closures import on_ray, pin_in_slot, rod_to_line, rod_transmission
+from qropt.closures import RIGHT_ANGLE, on_ray, pin_in_slot, rod_lines, rod_to_line
 from qropt.errors import InvalidParameter
 from qropt.mechanisms.base import REQUIRED, Loop, Mechanism
 
@@ -40,9 +38,9 @@ class CrankShaper(Mechanism):
         points = {"O2": (0.0, 0.0), "A": a, "O4": o4, "C": c}
         angles = {"theta2": theta2, "theta4": theta4}
         if "r6" not in p:
-            return Loop(points, angles, c[0], {"A": math.pi / 2, "C": math.pi / 2}, [])
+            return Loop(points, angles, c[0], {"A": RIGHT_ANGLE, "C": RIGHT_ANGLE}, [])
         d, m = rod_to_line(xp, c, p["r6"], -p["r1"] + p["h"], p["sigma_slider"])
         points["D"] = d
         angles["theta6"] = xp.atan2(d[1] - c[1], d[0] - c[0])
-        trans = {"A": math.pi / 2, "D": rod_transmission(xp, c, d)}
+        trans = {"A": RIGHT_ANGLE, "D": rod_lines(c, d)}
         return Loop(points, angles, d[0], trans, [("rod CD reaching the slide line", m)])

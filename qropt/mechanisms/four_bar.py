@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from typing import ClassVar, NamedTuple
 
-from qropt.closures import acute_angle, circle_circle, on_ray, rod_to_line, rod_transmission
+from qropt.closures import circle_circle, joint_lines, on_ray, rod_lines, rod_to_line
 from qropt.errors import GrashofError
 from qropt.mechanisms.base import REQUIRED, Loop, Mechanism
 
@@ -47,10 +47,6 @@ def four_bar(xp, theta2, p):
     return a, o4, b, theta3, theta4, m
 
 
-def _coupler_follower(xp, a, o4, b):
-    return acute_angle(xp, (a[0] - b[0], a[1] - b[1]), (o4[0] - b[0], o4[1] - b[1]))
-
-
 class _FourBarBase(Mechanism):
     LENGTHS: ClassVar[tuple[str, ...]] = LINKS
 
@@ -89,7 +85,7 @@ class FourBar(_FourBarBase):
             points={"O2": (0.0, 0.0), "A": a, "B": b, "O4": o4},
             angles={"theta2": theta2, "theta3": theta3, "theta4": theta4},
             x=theta4,
-            transmission={"B": _coupler_follower(xp, a, o4, b)},
+            transmission={"B": joint_lines(a, o4, b)},
             margins=[("four-bar closure at B", m)],
         )
 
@@ -143,7 +139,7 @@ class FourBarSlider(_FourBarBase):
                 "theta6": xp.atan2(d[1] - c[1], d[0] - c[0]),
             },
             x=d[0],
-            transmission={"B": _coupler_follower(xp, a, o4, b), "D": rod_transmission(xp, c, d)},
+            transmission={"B": joint_lines(a, o4, b), "D": rod_lines(c, d)},
             margins=[("four-bar closure at B", m4), ("rod CD reaching the slide line", m6)],
         )
 

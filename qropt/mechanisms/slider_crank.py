@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from qropt.closures import rod_to_line, rod_transmission
+from qropt.closures import rod_lines, rod_to_line
 from qropt.errors import InvalidParameter
 from qropt.mechanisms.base import REQUIRED, Loop, Mechanism
 
@@ -30,6 +30,6 @@ class SliderCrank(Mechanism):
             points={"O2": (0.0, 0.0), "A": a, "C": c},
             angles={"theta2": theta2, "theta3": xp.atan2(c[1] - a[1], c[0] - a[0])},
             x=c[0],
-            transmission={"C": rod_transmission(xp, a, c)},
+            transmission={"C": rod_lines(a, c)},
             margins=[("rod AC reaching the slide line", m)],
         )

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import math
-
-from qropt.closures import on_ray, pin_in_slot, rod_to_line, rod_transmission
+from qropt.closures import RIGHT_ANGLE, on_ray, pin_in_slot, rod_lines, rod_to_line
 from qropt.errors import InvalidParameter
 from qropt.mechanisms.base import REQUIRED, Loop, Mechanism
 
@@ -35,6 +33,6 @@ class Whitworth(Mechanism):
             points={"O2": (0.0, 0.0), "A": a, "O4": o4, "C": c, "D": d},
             angles={"theta2": theta2, "theta4": theta4, "theta6": xp.atan2(d[1] - c[1], d[0] - c[0])},
             x=d[0],
-            transmission={"A": math.pi / 2, "D": rod_transmission(xp, c, d)},
+            transmission={"A": RIGHT_ANGLE, "D": rod_lines(c, d)},
             margins=[("rod CD reaching the slide line", m)],
         )
