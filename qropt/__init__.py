@@ -11,6 +11,9 @@ from qropt.mechanisms import (
     grashof,
     mechanism_type,
 )
+from qropt.problem import Problem
+from qropt.result import Result
+from qropt.solve import solve, target_range
 
 __version__ = "0.1.0"
 
@@ -22,6 +25,10 @@ __all__ = [
     "DragLinkSlider",
     "FourBar",
     "grashof",
+    "Problem",
+    "Result",
+    "solve",
+    "target_range",
     "mechanism_type",
     "QroptError",
     "InvalidParameter",

@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+import numpy as np
+
 
 def _acos(c: float) -> float:
     if not -1.0 <= c <= 1.0:
@@ -167,3 +169,127 @@ def crank_rocker_extremes(r1: float, r2: float, r3: float, r4: float, sigma: flo
         out.append((math.atan2(ay, ax) % (2 * math.pi), math.pi + math.atan2(-by, r1 - bx)))
     (t2e, t4e), (t2f, t4f) = out
     return RockerExtremes(t2e, t2f, t4e, t4f, abs(t4e - t4f), time_ratio_from_centres(t2e, t2f))
+
+
+# ---- synthesis families -----------------------------------------------------------------------
+class SliderCrankDesign(NamedTuple):
+    """An offset slider-crank meeting a TR and stroke: r2, r3, e."""
+
+    r2: float
+    r3: float
+    e: float
+
+
+def slider_crank_design(time_ratio: float, stroke: float, r2: float) -> list[SliderCrankDesign]:
+    """Offset slider-crank with crank r2 giving TR and stroke (e > 0 and its mirror e < 0).
+
+    Triangle O2, D_max, D_min: sides r3 + r2 and r3 - r2 enclose phi (eq. 7) opposite the stroke.
+    """
+    phi = tr_deviation(time_ratio)
+    k = 1.0 - math.cos(phi)
+    if k == 0.0:  # TR = 1: in-line, stroke 2 r2 for any r3 > r2; no isolated design
+        return []
+    # 2k L^2 + 4 r2 k L + (4 r2^2 - S^2) = 0 for L = r3 - r2
+    a, b, c = 2 * k, 4 * r2 * k, 4 * r2 * r2 - stroke * stroke
+    disc = b * b - 4 * a * c
+    if disc < 0:
+        return []
+    low = (-b + math.sqrt(disc)) / (2 * a)
+    if low <= 0:
+        return []
+    high = low + 2 * r2
+    e = high * low * math.sin(phi) / stroke
+    r3 = low + r2
+    return [SliderCrankDesign(r2, r3, e), SliderCrankDesign(r2, r3, -e)]
+
+
+class CrankRockerDesign(NamedTuple):
+    """A crank-rocker four-bar for a TR and swing (either branch sigma: they are mirror images)."""
+
+    r1: float
+    r2: float
+    r3: float
+    r4: float
+
+
+def crank_rocker_design(time_ratio: float, swing: float, r1: float, position: float) -> CrankRockerDesign | None:
+    """Classical crank-rocker synthesis: the family of designs with ground r1, by ``position`` in (0, 1).
+
+    The rocker limits B1, B2 (|O4B| = 1, swing apart) are seen from O2 under phi (eq. 7): O2 lies on
+    the circle through B1, B2 with that inscribed angle; ``position`` walks along its major arc. With
+    B1 extended (|O2B1| = r3 + r2) and B2 folded, r2 and r3 follow; everything is scaled to ground r1.
+    Positions p and 1 - p are mirror images (the same lengths). Returns None where r2 vanishes.
+    """
+    phi = tr_deviation(time_ratio)
+    if not 0 < phi < math.pi or not 0 < swing < math.pi:
+        return None
+    b1 = complex(math.cos(-swing / 2), math.sin(-swing / 2))
+    b2 = complex(math.cos(swing / 2), math.sin(swing / 2))
+    chord = abs(b2 - b1)
+    radius = chord / (2 * math.sin(phi))
+    mid = (b1 + b2) / 2
+    # centre on the x-axis, on the side of O2 (the major arc for phi < pi/2, minor beyond)
+    centre = mid - radius * math.cos(phi)
+    start = math.atan2((b1 - centre).imag, (b1 - centre).real)
+    stop = math.atan2((b2 - centre).imag, (b2 - centre).real)
+    span = (start - stop) % (2 * math.pi)
+    o2 = centre + radius * complex(math.cos(stop + position * span), math.sin(stop + position * span))
+    l1, l2 = abs(b1 - o2), abs(b2 - o2)
+    r3, r2, ground = (l1 + l2) / 2, abs(l1 - l2) / 2, abs(o2)
+    if r2 <= 0 or ground <= 0:
+        return None
+    scale = r1 / ground
+    return CrankRockerDesign(r1, r2 * scale, r3 * scale, scale)
+
+
+# ---- warm starts ----------------------------------------------------------------------------------
+def warm_starts(problem) -> list[dict]:
+    """Free-parameter values from every closed form that applies to a problem (others at mid-bounds).
+
+    Each start is verified later by the solver; a start that does not build is dropped there.
+    """
+    from qropt.mechanisms import CrankShaper, DragLinkSlider, FourBar, SliderCrank, Whitworth
+
+    cls, fixed, free, tg = problem.mechanism, problem.fixed, problem.free, problem.targets
+    val = {**fixed, **{k: 0.5 * (lo + hi) for k, (lo, hi) in free.items()}}
+    tr, stroke = tg.get("time_ratio"), tg.get("stroke")
+    out = []
+
+    def emit(**set_):
+        if all(k in free for k in set_):
+            v = {**val, **set_}
+            out.append({k: v[k] for k in free})
+
+    if cls is DragLinkSlider and tr is not None and "r3" in free and fixed.get("h", 0.0) == 0.0:
+        r5 = {"r5": stroke / 2} if stroke is not None and "r5" in free else {}
+        for s in drag_link_r3(tr, val["r1"], val["r2"], val["r4"]):
+            emit(r3=s.r3, **r5)
+    if cls is CrankShaper and tr is not None:
+        ratio = crank_shaper_ratio(tr)
+        lever = {"r4": stroke / (2 * ratio)} if stroke is not None and "r4" in free else {}
+        if "r2" in free:
+            emit(r2=ratio * val["r1"], **lever)
+        elif "r1" in free:
+            emit(r1=val["r2"] / ratio, **lever)
+        elif stroke is not None and "r4" in free:
+            emit(r4=stroke * val["r1"] / (2 * val["r2"]))
+    if cls is Whitworth and tr is not None and fixed.get("h", 0.0) == 0.0:
+        ratio = whitworth_ratio(tr)
+        r5 = {"r5": stroke / 2} if stroke is not None and "r5" in free else {}
+        if "r2" in free:
+            emit(r2=val["r1"] / ratio, **r5)
+        elif "r1" in free:
+            emit(r1=ratio * val["r2"], **r5)
+        elif r5:
+            emit(**r5)
+    if cls is SliderCrank and tr is not None and stroke is not None:
+        crank = [val["r2"]] if "r2" not in free else list(np.linspace(*free["r2"], 7)[1:-1])
+        for r2 in crank:
+            for d in slider_crank_design(tr, stroke, r2):
+                emit(**{k: getattr(d, k) for k in ("r2", "r3", "e") if k in free})
+    if cls is FourBar and tr is not None and "swing" in tg:
+        for pos in np.linspace(0.04, 0.46, 7):
+            d = crank_rocker_design(tr, tg["swing"], val["r1"], float(pos))
+            if d is not None:
+                emit(**{k: getattr(d, k) for k in ("r2", "r3", "r4") if k in free})
+    return out

@@ -14,6 +14,7 @@ from qropt.ops import Jet
 
 TWO_PI = 2.0 * np.pi
 GRID = 720
+FD_XTOL = 1e-10
 
 
 def grid(n: int = GRID) -> np.ndarray:
@@ -42,8 +43,11 @@ def brackets(theta, d1, kind):
     return lo, hi
 
 
-def stationary(fun, lo, hi, iters: int = 100):
-    """Refine the stationary points of fun bracketed in [lo, hi] (arrays). Returns theta2 arrays."""
+def stationary(fun, lo, hi, iters: int = 100, xtol: float = 0.0):
+    """Refine the stationary points of fun bracketed in [lo, hi] (arrays). Returns theta2 arrays.
+
+    Stops where the Newton step falls below 4 ulp (or xtol, for derivatives that carry noise).
+    """
     lo, hi = np.array(lo, float), np.array(hi, float)
     if lo.size == 0:
         return lo
@@ -55,7 +59,7 @@ def stationary(fun, lo, hi, iters: int = 100):
         g, h = j.d1, j.d2
         with np.errstate(divide="ignore", invalid="ignore"):
             step = g / h
-        done = (g == 0.0) | (np.abs(step) <= eps * np.maximum(1.0, np.abs(x)))
+        done = (g == 0.0) | (np.abs(step) <= np.maximum(xtol, eps * np.maximum(1.0, np.abs(x))))
         if done.all():
             break
         same = np.sign(g) == np.sign(glo)
@@ -87,7 +91,7 @@ def stack(jets, shape) -> np.ndarray:
     return out
 
 
-def extremes_many(fun, specs, n: int = GRID):
+def extremes_many(fun, specs, n: int = GRID, xtol: float = 0.0):
     """Local extremes of several quantities at once, from one grid evaluation and one Newton run.
 
     fun(theta_jet) -> array (Q, 3, m) of the Q quantities' jets; specs: [(q, 'max' | 'min')].
@@ -103,7 +107,7 @@ def extremes_many(fun, specs, n: int = GRID):
     def selected(t):
         return Jet(fun(t)[which, :, np.arange(which.size)].T)
 
-    x = wrap(stationary(selected, lo, hi)) if which.size else lo
+    x = wrap(stationary(selected, lo, hi, xtol=xtol)) if which.size else lo
     vals = jet_of(selected, x).v if which.size else lo
     out, start = [], 0
     for p in parts:
@@ -112,10 +116,26 @@ def extremes_many(fun, specs, n: int = GRID):
     return out, g[:, 0]
 
 
-def extremes(fun, kind, n: int = GRID):
+def extremes(fun, kind, n: int = GRID, xtol: float = 0.0):
     """All local maxima or minima of fun over a turn: (theta2 in [0, 2pi), values)."""
-    (res,), _ = extremes_many(lambda t: stack([fun(t)], np.shape(t.v)), [(0, kind)], n)
+    (res,), _ = extremes_many(lambda t: stack([fun(t)], np.shape(t.v)), [(0, kind)], n, xtol)
     return res
+
+
+def difference_jet(values, h: float = 1e-4):
+    """A function of theta -> values as a jet fun(theta_jet) with central-difference derivatives.
+
+    Used where exact second derivatives are not available (extremes of an acceleration):
+    the derivative error O(h^2) moves a stationary point by O(h^2), its value only by O(h^4).
+    Refine with ``xtol = FD_XTOL``: a location error of 1e-10 changes the extreme value by ~1e-20.
+    """
+
+    def fun(t):
+        th = t.v
+        f0, fp, fm = values(th), values(th + h), values(th - h)
+        return Jet.of(f0, (fp - fm) / (2 * h), (fp - 2 * f0 + fm) / (h * h))
+
+    return fun
 
 
 def minimum(fun, n: int = GRID):

@@ -293,6 +293,66 @@ class Mechanism:
         """Smallest transmission angle over the full turn and every joint, exact (not a grid sample)."""
         return self._gamma_min
 
+    def peak_acceleration(self, omega2: float = 1.0, over: str = "cycle") -> tuple[float, float]:
+        """Largest |slider acceleration| at constant omega2 (rad/s): (value, theta2 in rad).
+
+        ``over="working"`` restricts it to the working (slow) stroke.
+        """
+        self._require_full_turn()
+
+        def acc(th):
+            return self.evaluate(JET, Jet.seed(th, 1.0, 0.0)).x.d2
+
+        cand = []
+        for t, v in self._acceleration_extremes:
+            cand += list(zip(t.tolist(), v.tolist(), strict=True))
+        if over == "working":
+            lo, length = self.working_arc(omega2)
+            inside = [(t, v) for t, v in cand if (t - lo) % cycle.TWO_PI <= length]
+            ends = [lo % cycle.TWO_PI, (lo + length) % cycle.TWO_PI]
+            cand = inside + list(zip(ends, acc(np.array(ends)).tolist(), strict=True))
+        t, v = max(cand, key=lambda tv: abs(tv[1]))
+        return abs(v) * omega2 * omega2, float(t)
+
+    @cached_property
+    def _acceleration_extremes(self):
+        def acc(th):
+            return self.evaluate(JET, Jet.seed(th, 1.0, 0.0)).x.d2
+
+        g = cycle.difference_jet(acc)
+        return [cycle.extremes(g, kind, xtol=cycle.FD_XTOL) for kind in ("max", "min")]
+
+    def working_arc(self, omega2: float = 1.0) -> tuple[float, float]:
+        """The crank interval of the working (slow) stroke as (counter-clockwise start, length), rad."""
+        d = self.dead_centres()
+        a, b = self.stroke_angles()
+        return (d.theta_max, a) if a >= b else (d.theta_min, b)
+
+    def footprint(self) -> float:
+        """Area of the bounding box of every joint's path over a turn (length^2), exact."""
+        self._require_full_turn()
+        names = list(self.evaluate(NUMPY, np.zeros(1)).points)
+
+        def coords(t):
+            lp = self.evaluate(JET, t)
+            return cycle.stack([c for k in names for c in lp.points[k]], np.shape(t.v))
+
+        q = 2 * len(names)
+        specs = [(k, kind) for k in range(q) for kind in ("max", "min")]
+        res, on_grid = cycle.extremes_many(coords, specs)
+        hi = [max(np.max(on_grid[k]), np.max(res[2 * k][1], initial=-np.inf)) for k in range(q)]
+        lo = [min(np.min(on_grid[k]), np.min(res[2 * k + 1][1], initial=np.inf)) for k in range(q)]
+        width = max(hi[0::2]) - min(lo[0::2])
+        height = max(hi[1::2]) - min(lo[1::2])
+        return float(width * height)
+
+    def size(self, measure: str = "sum") -> float:
+        """Size by ``measure``: 'sum' of link lengths (ground included), 'longest' link, or 'footprint'."""
+        if measure == "footprint":
+            return self.footprint()
+        lengths = [self.params[k] for k in self.LENGTHS if k in self.params]
+        return float(sum(lengths) if measure == "sum" else max(lengths))
+
     def assembly_failures(self) -> list[tuple[str, float, float]]:
         """(closure, theta2_from, theta2_to) intervals (rad) where the loop cannot close; [] if it turns fully."""
         lp = self.evaluate(NUMPY, np.zeros(1))

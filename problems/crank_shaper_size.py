@@ -1,0 +1,19 @@
+"""Crank-shaper (yoke) for TR 1.6 and stroke 0.4 m with centres r1 = 0.3 m: the shortest lever.
+
+Oracle: closed form r2 = r1 sin(phi / 2), r4 = stroke r1 / (2 r2) (phi of eq. 7): the lever length
+is fixed by TR and stroke, so ``min_size`` must return it.
+"""
+
+from qropt import Problem
+
+
+def build() -> Problem:
+    return Problem(
+        mechanism="CrankShaper",
+        fixed={"r1": 0.3},
+        free={"r2": (0.01, 0.29), "r4": (0.1, 2.0)},
+        targets={"time_ratio": 1.6, "stroke": 0.4},
+        objective="min_size",
+        size="longest",
+        name="crank_shaper_size",
+    )

@@ -1,0 +1,205 @@
+"""A synthesis problem: what the designer wants, validated and frozen.
+
+Lengths in any consistent unit, angles in radians. Targets are equality
+constraints, conditions inequalities, the objective one of ``OBJECTIVES``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
+
+from qropt.errors import ProblemError
+from qropt.mechanisms import FourBar, FourBarSlider, Mechanism, mechanism_type
+from qropt.mechanisms.base import REQUIRED
+
+OBJECTIVES = (None, "max_gamma_min", "min_size", "min_peak_accel")
+SIZES = ("sum", "longest", "footprint")
+BRANCHES = ("sigma", "sigma_slider")
+
+
+def _frozen(d):
+    return MappingProxyType(dict(d or {}))
+
+
+@dataclass(frozen=True)
+class Problem:
+    """Dimensional synthesis of one mechanism type.
+
+    mechanism: class or type name; fixed: name -> value; free: name -> (lower, upper);
+    targets: 'time_ratio', 'stroke' (sliders) or 'swing' (FourBar, rad);
+    conditions: 'grashof' ('drag-link' | 'crank-rocker'), 'gamma_min' (lower bound, rad),
+    'linear' [(coefficients, lower, upper)], 'ratio' [(numerator, denominator, lower, upper)];
+    objective: 'max_gamma_min', 'min_size' (with ``size``), 'min_peak_accel' (at ``omega2``,
+    over the 'cycle' or the 'working' stroke) or None; branches: name -> allowed signs.
+    """
+
+    mechanism: Any
+    fixed: Any = field(default_factory=dict)
+    free: Any = field(default_factory=dict)
+    targets: Any = field(default_factory=dict)
+    conditions: Any = field(default_factory=dict)
+    objective: str | None = "max_gamma_min"
+    size: str = "sum"
+    omega2: float = 1.0
+    accel_over: str = "cycle"
+    branches: Any = field(default_factory=dict)
+    name: str = ""
+
+    def __post_init__(self):
+        try:
+            cls = mechanism_type(self.mechanism)
+        except Exception as e:
+            raise ProblemError(str(e)) from None
+        set_ = object.__setattr__
+        set_(self, "mechanism", cls)
+        for k in ("fixed", "free", "targets", "conditions", "branches"):
+            set_(self, k, _frozen(getattr(self, k)))
+        set_(self, "free", _frozen({k: (float(lo), float(hi)) for k, (lo, hi) in self._check_free().items()}))
+        set_(self, "branches", _frozen(self._branches()))
+        set_(self, "fixed", _frozen(self._completed_fixed()))
+        self._check_targets()
+        set_(self, "conditions", _frozen(self._check_conditions()))
+        self._check_objective()
+
+    # ---- validation ---------------------------------------------------------
+    def _err(self, msg):
+        return ProblemError(f"{self.name or self.mechanism.__name__}: {msg}")
+
+    @property
+    def names(self) -> list[str]:
+        """Every parameter of this problem's mechanism, in the type's order."""
+        return [k for k in self.mechanism.PARAMS if k in self.fixed or k in self.free]
+
+    def _check_free(self):
+        cls, params = self.mechanism, self.mechanism.PARAMS
+        if not self.free:
+            raise self._err("no free parameter: give free={name: (lower, upper)}")
+        for k in list(self.fixed) + list(self.free):
+            if k not in params or (k in BRANCHES and k in self.free):
+                raise self._err(f"unknown or non-continuous parameter {k!r}; {cls.__name__} takes {list(params)}")
+        both = sorted(set(self.fixed) & set(self.free))
+        if both:
+            raise self._err(f"{both} are both fixed and free")
+        for k, b in self.free.items():
+            try:
+                lo, hi = (float(v) for v in b)
+            except (TypeError, ValueError):
+                raise self._err(f"bounds of {k} must be (lower, upper), got {b!r}") from None
+            if not (math.isfinite(lo) and math.isfinite(hi)):
+                raise self._err(f"bounds of {k} must be finite, got ({lo:g}, {hi:g})")
+            if not lo < hi:
+                raise self._err(f"bounds of {k} are empty or contradictory: ({lo:g}, {hi:g}); fix it instead")
+            if k in cls.LENGTHS and lo <= 0:
+                raise self._err(f"length {k} needs a positive lower bound, got {lo:g}")
+        for k, v in self.fixed.items():
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise self._err(f"fixed {k} must be a finite number, got {v!r}")
+            if k in cls.LENGTHS and v <= 0:
+                raise self._err(f"fixed length {k} must be positive, got {v:g}")
+        missing = [k for k, v in params.items() if v is REQUIRED and k not in self.fixed and k not in self.free]
+        if missing:
+            raise self._err(f"parameters {missing} are neither fixed nor free")
+        return self.free
+
+    def _branches(self):
+        out = {}
+        for k in BRANCHES:
+            if k not in self.mechanism.PARAMS:
+                continue
+            vals = self.branches.get(k, (self.fixed.get(k, self.mechanism.PARAMS[k]),))
+            vals = tuple(float(v) for v in (vals if isinstance(vals, (tuple, list)) else (vals,)))
+            if not vals or any(v not in (-1.0, 1.0) for v in vals):
+                raise self._err(f"branch {k} takes signs from (-1, +1), got {vals}")
+            out[k] = vals
+        for k in self.branches:
+            if k not in out:
+                raise self._err(f"{self.mechanism.__name__} has no branch {k!r}")
+        return out
+
+    def _completed_fixed(self):
+        fixed = {k: float(v) for k, v in self.fixed.items() if k not in BRANCHES}
+        for k, v in self.mechanism.PARAMS.items():
+            if k in BRANCHES or k in fixed or k in self.free or v is None or v is REQUIRED:
+                continue
+            fixed[k] = float(v)
+        rod = "r6" in fixed or "r6" in self.free
+        if self.mechanism.__name__ == "CrankShaper" and rod and "h" not in self.free:
+            fixed.setdefault("h", 0.0)
+        return fixed
+
+    def _check_targets(self):
+        allowed = ("time_ratio", "swing") if self.mechanism is FourBar else ("time_ratio", "stroke")
+        if not self.targets:
+            raise self._err(f"no target: give targets from {allowed}")
+        for k, v in self.targets.items():
+            if k not in allowed:
+                raise self._err(f"unknown target {k!r} for {self.mechanism.__name__}; targets are {allowed}")
+            if not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise self._err(f"target {k} must be a finite number, got {v!r}")
+        tr = self.targets.get("time_ratio")
+        if tr is not None and tr < 1.0:
+            raise self._err(f"time_ratio is slow/fast >= 1 by definition, got {tr:g}")
+        if self.targets.get("stroke", 1.0) <= 0:
+            raise self._err(f"stroke must be positive, got {self.targets['stroke']:g}")
+        if not 0 < self.targets.get("swing", 1.0) < math.pi:
+            raise self._err(f"swing must be in (0, pi) rad, got {self.targets['swing']:g}")
+
+    def _check_conditions(self):
+        c = dict(self.conditions)
+        known = {"grashof", "gamma_min", "linear", "ratio"}
+        for k in c:
+            if k not in known:
+                raise self._err(f"unknown condition {k!r}; conditions are {sorted(known)}")
+        four_bar = issubclass(self.mechanism, (FourBar, FourBarSlider))
+        if four_bar:
+            default = getattr(self.mechanism, "CLASS", "") or "crank-rocker"
+            c.setdefault("grashof", default)
+            if c["grashof"] not in ("drag-link", "crank-rocker"):
+                raise self._err(f"grashof condition is 'drag-link' or 'crank-rocker', got {c['grashof']!r}")
+            need = getattr(self.mechanism, "CLASS", "")
+            if need and c["grashof"] != need:
+                raise self._err(f"{self.mechanism.__name__} is a {need} by definition, not {c['grashof']}")
+        elif "grashof" in c:
+            raise self._err(f"{self.mechanism.__name__} has no four-bar: no grashof condition")
+        g = c.get("gamma_min")
+        if g is not None and not 0 <= g < math.pi / 2:
+            raise self._err(f"gamma_min bound must be in [0, pi/2) rad, got {g!r}")
+        for coeffs, lo, hi in c.get("linear", ()):
+            self._check_names(coeffs)
+            if lo > hi:
+                raise self._err(f"linear condition {coeffs} has lower {lo:g} > upper {hi:g}")
+        for num, den, lo, hi in c.get("ratio", ()):
+            self._check_names({num: 1, den: 1})
+            if den not in self.mechanism.LENGTHS or lo > hi:
+                raise self._err(f"ratio {num}/{den} needs a length denominator and lower <= upper")
+        return c
+
+    def _check_names(self, names):
+        for k in names:
+            if k not in self.fixed and k not in self.free:
+                raise self._err(f"condition names {k!r}, which is not a parameter of this problem")
+
+    def _check_objective(self):
+        if self.objective not in OBJECTIVES:
+            raise self._err(f"unknown objective {self.objective!r}; objectives are {OBJECTIVES}")
+        if self.size not in SIZES:
+            raise self._err(f"unknown size measure {self.size!r}; measures are {SIZES}")
+        if self.accel_over not in ("cycle", "working"):
+            raise self._err(f"accel_over is 'cycle' or 'working', got {self.accel_over!r}")
+        if self.objective == "min_peak_accel" and self.mechanism is FourBar:
+            raise self._err("FourBar has no slider: min_peak_accel does not apply")
+
+    # ---- helpers --------------------------------------------------------------
+    def replace(self, **changes) -> Problem:
+        """A copy with some fields changed (validated again)."""
+        d = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        d["fixed"] = {**self.fixed, **{k: v[0] for k, v in self.branches.items() if len(v) == 1}}
+        d.update(changes)
+        return Problem(**{k: (dict(v) if isinstance(v, MappingProxyType) else v) for k, v in d.items()})
+
+    def build(self, values: dict, branch: dict) -> Mechanism:
+        """The mechanism with the free parameters at ``values`` on ``branch`` (may raise QroptError)."""
+        return self.mechanism(**self.fixed, **values, **branch)

@@ -1,0 +1,319 @@
+"""solve(problem) -> Result: IPOPT from analytic warm starts and a space-filling multi-start,
+an exchange loop for continuous-cycle extremes, and a certificate by exact numeric evaluation."""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+
+import numpy as np
+from scipy.stats import qmc
+
+from qropt import analytic, cycle
+from qropt.errors import AssemblyError, QroptError
+from qropt.mechanisms import FourBar
+from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, TWO_PI, Formulation, slow_interval
+from qropt.problem import Problem
+from qropt.result import Result
+
+_FORMULATIONS: dict = {}
+FEAS_TOL = 1e-8  # largest accepted constraint violation (lengths, radians)
+GAP_TOL = 1e-8  # certified minus NLP epigraph value that ends the exchange loop
+
+
+def _key(problem: Problem, branch, orientation, range_target, sense):
+    c = problem.conditions
+    cond = (c.get("grashof"), c.get("gamma_min") is not None, repr(c.get("linear")), repr(c.get("ratio")))
+    return (problem.mechanism, tuple(problem.free), tuple(problem.fixed), tuple(problem.targets), cond,
+            problem.objective, problem.size, problem.accel_over, tuple(sorted(branch.items())), orientation,
+            range_target, sense, c.get("gamma_min"))  # fmt: skip
+
+
+def formulation(problem, branch, orientation, range_target=None, sense=1) -> Formulation:
+    """The NLP of this problem structure, built once and reused (new targets/fixed values are parameters)."""
+    key = _key(problem, branch, orientation, range_target, sense)
+    f = _FORMULATIONS.get(key)
+    if f is None or f.problem.free != problem.free:
+        f = _FORMULATIONS[key] = Formulation(problem, branch, orientation, range_target, sense)
+    f.problem = problem
+    return f
+
+
+def branches(problem):
+    names = list(problem.branches)
+    return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*problem.branches.values())]
+
+
+def starts(problem, n: int, seed: int, use_analytic: bool) -> list[tuple[str, dict]]:
+    """Analytic starts first, then a scrambled Sobol design over the free bounds (log-spaced for lengths)."""
+    out = [("analytic", s) for s in analytic.warm_starts(problem)] if use_analytic else []
+    if n > 0:
+        names = list(problem.free)
+        points = []
+        for row in qmc.Sobol(len(names), scramble=True, seed=seed).random(8 * n):
+            v = {}
+            for k, x in zip(names, row, strict=True):
+                lo, hi = problem.free[k]
+                v[k] = lo * (hi / lo) ** x if k in problem.mechanism.LENGTHS and lo > 0 else lo + (hi - lo) * x
+            points.append(v)
+        kept = [v for v in points if _assembles(problem, v)][:n]
+        out += [("multistart", v) for v in (kept or points[:n])]
+    return out
+
+
+def _assembles(problem, values) -> bool:
+    try:
+        problem.build(values, branches(problem)[0])
+        return True
+    except QroptError:
+        return False
+
+
+def _angle_gap(a, b):
+    return abs((a - b + math.pi) % TWO_PI - math.pi)
+
+
+def quantities(problem, m) -> dict:
+    """Exact quantities of a mechanism for a Result."""
+    q = {"time_ratio": m.time_ratio(), "gamma_min": m.gamma_min().value}
+    q["swing" if isinstance(m, FourBar) else "stroke"] = m.stroke()
+    q["peak_accel"] = None if isinstance(m, FourBar) else m.peak_acceleration(problem.omega2, problem.accel_over)[0]
+    q["grashof"] = m.grashof().kind if hasattr(m, "grashof") else None
+    q["size"] = m.size(problem.size)
+    q["working_direction"] = m.working_direction(problem.omega2)
+    return q
+
+
+def objective_value(problem, q) -> float | None:
+    return {"max_gamma_min": q["gamma_min"], "min_size": q["size"], "min_peak_accel": q["peak_accel"]}.get(
+        problem.objective
+    )
+
+
+def certify(problem, form, values, branch, th, z, targets):
+    """Exact check of an NLP point. Returns (mechanism or None, info dict, angles to add, fractions to add)."""
+    try:
+        return _certify(problem, form, values, branch, th, z)
+    except AssemblyError as e:
+        mids = [((lo + hi) / 2) % TWO_PI for _, lo, hi in e.failures]
+        return None, {"ok": False, "reason": str(e)}, mids, []
+    except QroptError as e:
+        return None, {"ok": False, "reason": str(e)}, [], []
+
+
+def _certify(problem, form, values, branch, th, z):
+    m = problem.build(values, branch)
+    d = m.dead_centres()
+    if _angle_gap(d.theta_max, th[0]) > 1e-7 or _angle_gap(d.theta_min, th[1]) > 1e-7:
+        return m, {"ok": False, "reason": "the NLP's dead centres are local, not the global extremes"}, [], []
+    if d.reversals != 1:
+        return m, {"ok": False, "reason": f"the slider reverses {d.reversals} times a turn"}, [], []
+    info = {"ok": True, "nlp": None, "certified": None, "gap": 0.0}
+    add, frac = [], []
+    obj = problem.objective if not form.range_target else None
+    g = m.gamma_min()
+    if obj == "max_gamma_min":
+        exact = math.cos(g.value)
+        info.update(nlp=math.acos(min(1.0, z[0])), certified=g.value, gap=exact - z[0])
+        if exact - z[0] > GAP_TOL:
+            add.append(g.theta2)
+    elif obj == "min_peak_accel":
+        peak, t = m.peak_acceleration(1.0, problem.accel_over)
+        w2 = problem.omega2**2
+        info.update(nlp=z[0] * w2, certified=peak * w2, gap=(peak - z[0]) * w2)
+        if peak - z[0] > GAP_TOL:
+            if problem.accel_over == "working":
+                lo, length = m.working_arc()
+                frac.append(((t - lo) % TWO_PI) / length)
+            else:
+                add.append(t)
+    elif obj == "min_size" and problem.size == "footprint":
+        box, angles = m.bounding_box()
+        exact = (box[1] - box[0]) * (box[3] - box[2])
+        nlp = (z[0] + z[1]) * (z[2] + z[3])
+        info.update(nlp=nlp, certified=exact, gap=exact - nlp)
+        if exact - nlp > GAP_TOL * max(1.0, exact):
+            add += angles
+    elif obj == "min_size":
+        info.update(nlp=m.size(problem.size), certified=m.size(problem.size), gap=0.0)
+    bound = problem.conditions.get("gamma_min")
+    if bound is not None and g.value < bound - FEAS_TOL:
+        add.append(g.theta2)
+    return m, info, add, frac
+
+
+def _residuals(problem, form, g, m, targets):
+    res = {k: v for k, v in form.violations(g).items() if not k.startswith("epigraph")}
+    if m is not None:
+        q = {"time_ratio": m.time_ratio(), "stroke": m.stroke(), "swing": m.stroke()}
+        for k, v in targets.items():
+            res[f"{k} (exact)"] = abs(q[k] - v)
+        if "gamma_min" in problem.conditions:
+            res["gamma_min bound (exact)"] = max(0.0, problem.conditions["gamma_min"] - m.gamma_min().value)
+    return res
+
+
+def run_start(problem, values0, branch, targets, max_rounds=12, range_target=None, sense=1):
+    """One local solve with its exchange loop: a dict describing the candidate."""
+    try:
+        m0 = problem.build(values0, branch)
+        d = m0.dead_centres()
+        a, b = m0.stroke_angles()
+        orientation = 1 if a >= b else -1
+        th0 = (d.theta_max, d.theta_max + a)
+    except QroptError:
+        orientation, tr = 1, targets.get("time_ratio", 1.5)
+        th0 = (0.5, 0.5 + slow_interval(tr, 1))
+    if "time_ratio" in targets and range_target != "time_ratio":
+        th0 = (th0[0], th0[0] + slow_interval(targets["time_ratio"], orientation))
+    form = formulation(problem, branch, orientation, range_target, sense)
+    samples, fractions = form.base_samples()
+    used, used_f = BASE_SAMPLES, BASE_SAMPLES
+    p = form.param_vector(targets, samples, fractions)
+    w = form.epigraph_start(form.pack(values0, th0), p)
+    t_ipopt, iters, statuses = 0.0, 0, []
+    for rounds in range(1, max_rounds + 1):
+        w, f, g, st = form.solve(w, p)
+        t_ipopt += st.get("t_wall_total", 0.0)
+        iters += st.get("iter_count", 0)
+        statuses.append(st.get("return_status", "?"))
+        values = dict(zip(form.free, w[: form.nx].tolist(), strict=True))
+        th, z = w[form.nx : form.nx + 2], w[form.nx + 2 :]
+        m, info, add, frac = certify(problem, form, values, branch, th, z, targets)
+        add = add[: max(0, EXTRA_SAMPLES - (used - BASE_SAMPLES))]
+        frac = frac[: max(0, EXTRA_SAMPLES - (used_f - BASE_SAMPLES))]
+        if not add and not frac:
+            break
+        for t in add:
+            samples[used] = t
+            used += 1
+        for t in frac:
+            fractions[used_f] = t
+            used_f += 1
+        p = form.param_vector(targets, samples, fractions)
+        w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
+    res = _residuals(problem, form, g, m, {k: targets[k] for k in form.targets})
+    ok = (
+        bool(info.get("ok"))
+        and st.get("success", False)
+        or (bool(info.get("ok")) and statuses[-1] == "Solved_To_Acceptable_Level")
+    )
+    ok = ok and max(res.values(), default=0.0) <= FEAS_TOL and info.get("gap", 0.0) <= max(GAP_TOL, 1e-6 * 0)
+    return {
+        "ok": ok,
+        "q": quantities(problem, m) if ok else None,
+        "values": values,
+        "branch": branch,
+        "orientation": orientation,
+        "mechanism": m,
+        "info": {**info, "rounds": rounds},
+        "residuals": res,
+        "ipopt": {"statuses": statuses, "iterations": iters, "t_ipopt": t_ipopt},
+        "f": f,
+    }
+
+
+def _distinct(cands):
+    out = []
+    for c in cands:
+        v = np.array([c["values"][k] for k in sorted(c["values"])])
+        if all(
+            c["branch"] != o["branch"]
+            or np.max(np.abs(v - np.array([o["values"][k] for k in sorted(o["values"])])) / np.maximum(1, np.abs(v)))
+            > 1e-6
+            for o in out
+        ):
+            out.append(c)
+    return out
+
+
+def _to_result(problem, c, status, message, stats, local=()):
+    m, q = c["mechanism"], c["q"]
+    params = dict(m.params)
+    return Result(
+        status=status,
+        message=message,
+        params=params,
+        mechanism=m,
+        objective=objective_value(problem, q),
+        quantities=q,
+        residuals=c["residuals"],
+        certificate=c["info"],
+        stats={**stats, **c["ipopt"], "branch": c["branch"], "orientation": c["orientation"]},
+        local_optima=tuple(local),
+    )
+
+
+def solve(problem: Problem, *, starts_n: int = 8, use_analytic: bool = True, seed: int = 0,
+          targets: dict | None = None, max_rounds: int = 12) -> Result:  # fmt: skip
+    """Solve a synthesis problem; returns a Result whatever happens (only invalid input raises).
+
+    starts_n: Sobol multi-start points; use_analytic: start from every closed form as well;
+    targets: override the problem's target values (the NLP is not rebuilt).
+    """
+    t0 = time.perf_counter()
+    targets = dict(problem.targets if targets is None else targets)
+    cands = []
+    for origin, v in starts(problem, starts_n, seed, use_analytic):
+        for br in branches(problem):
+            c = run_start(problem, v, br, targets, max_rounds)
+            c["origin"] = origin
+            cands.append(c)
+    good = [c for c in cands if c["ok"]]
+    stats = {"starts": len(cands), "t_total": None, "formulations": len(_FORMULATIONS)}
+    if good:
+        best_first = sorted(_distinct(good), key=lambda c: objective_value(problem, c["q"]) or 0.0,
+                            reverse=problem.objective == "max_gamma_min")  # fmt: skip
+        stats["t_total"] = time.perf_counter() - t0
+        stats["local_optima"] = len(best_first)
+        local = [_to_result(problem, c, "optimal" if problem.objective else "feasible", "local optimum", stats)
+                 for c in best_first]  # fmt: skip
+        status = "optimal" if problem.objective else "feasible"
+        msg = f"best of {len(best_first)} distinct local optima from {len(cands)} starts, certified"
+        return _to_result(problem, best_first[0], status, msg, stats, local)
+    reasons = sorted({c["info"].get("reason", "") or ", ".join(c["ipopt"]["statuses"][-1:]) for c in cands})
+    infeasible = any("Infeasible" in s for c in cands for s in c["ipopt"]["statuses"]) or any(
+        "Infeasible" not in c["ipopt"]["statuses"][-1] and not c["info"].get("ok") for c in cands
+    )
+    reach, msgs = {}, []
+    for k, v in targets.items():
+        lo, hi = target_range(problem, k, targets, starts_n=starts_n, seed=seed)
+        reach[k] = (lo, hi)
+        msgs.append(_range_message(problem, k, v, lo, hi))
+    stats["t_total"] = time.perf_counter() - t0
+    if infeasible or any(not (lo <= targets[k] <= hi) for k, (lo, hi) in reach.items()):
+        return Result("infeasible", "; ".join(msgs), stats=stats, reachable=reach)
+    return Result("failed", "no start converged to a certified design: " + "; ".join(reasons[:3]), stats=stats,
+                  reachable=reach)  # fmt: skip
+
+
+def _range_message(problem, k, v, lo, hi):
+    bounds = ", ".join(f"{n} in [{a:g}, {b:g}]" for n, (a, b) in problem.free.items())
+    if not math.isfinite(lo):
+        return f"no design meets the conditions for {bounds}"
+    where = "below" if v < lo else "above" if v > hi else "inside"
+    return f"{k} {v:g} is {where} the reachable {lo:.6g}..{hi:.6g} for {bounds}"
+
+
+def target_range(problem, target, targets=None, *, starts_n=8, seed=0):
+    """(low, high) of one target over the free bounds and conditions (other targets dropped); nan if none."""
+    targets = dict(problem.targets if targets is None else targets)
+    others = {}
+    out = []
+    for sense in (1, -1):
+        best = None
+        for _, v in starts(problem, starts_n, seed, True):
+            for br in branches(problem):
+                sub = problem.replace(targets={target: targets[target]})
+                c = run_start(sub, v, br, {**others, target: targets[target]}, 3, target, sense)
+                if not c["info"].get("ok") or max(c["residuals"].get(k, 0.0) for k in c["residuals"]) > 1e-7:
+                    continue
+                m = c["mechanism"]
+                val = m.time_ratio() if target == "time_ratio" else m.stroke()
+                best = val if best is None else (min(best, val) if sense > 0 else max(best, val))
+        out.append(float("nan") if best is None else best)
+    return out[0], out[1]
+
+
+__all__ = ["solve", "target_range", "formulation", "quantities", "cycle"]
