@@ -134,7 +134,7 @@ def _certify(problem, form, values, branch, th, z):
         nlp = (z[0] + z[1]) * (z[2] + z[3])
         info.update(nlp=nlp, certified=exact, gap=exact - nlp)
         if exact - nlp > GAP_TOL * max(1.0, exact):
-            add += angles
+            add += list(angles)
     elif obj == "min_size":
         info.update(nlp=m.size(problem.size), certified=m.size(problem.size), gap=0.0)
     bound = problem.conditions.get("gamma_min")
@@ -172,8 +172,9 @@ def run_start(problem, values0, branch, targets, max_rounds=12, range_target=Non
     used, used_f = BASE_SAMPLES, BASE_SAMPLES
     p = form.param_vector(targets, samples, fractions)
     w = form.epigraph_start(form.pack(values0, th0), p)
-    t_ipopt, iters, statuses = 0.0, 0, []
-    for rounds in range(1, max_rounds + 1):
+    t_ipopt, iters, statuses, rounds = 0.0, 0, [], 0
+    while rounds < max_rounds:
+        rounds += 1
         w, f, g, st = form.solve(w, p)
         t_ipopt += st.get("t_wall_total", 0.0)
         iters += st.get("iter_count", 0)

@@ -328,8 +328,8 @@ class Mechanism:
         a, b = self.stroke_angles()
         return (d.theta_max, a) if a >= b else (d.theta_min, b)
 
-    def footprint(self) -> float:
-        """Area of the bounding box of every joint's path over a turn (length^2), exact."""
+    def bounding_box(self):
+        """((x_min, x_max, y_min, y_max) of every joint's path over a turn, crank angles where they occur)."""
         self._require_full_turn()
         names = list(self.evaluate(NUMPY, np.zeros(1)).points)
 
@@ -338,13 +338,25 @@ class Mechanism:
             return cycle.stack([c for k in names for c in lp.points[k]], np.shape(t.v))
 
         q = 2 * len(names)
-        specs = [(k, kind) for k in range(q) for kind in ("max", "min")]
-        res, on_grid = cycle.extremes_many(coords, specs)
-        hi = [max(np.max(on_grid[k]), np.max(res[2 * k][1], initial=-np.inf)) for k in range(q)]
-        lo = [min(np.min(on_grid[k]), np.min(res[2 * k + 1][1], initial=np.inf)) for k in range(q)]
-        width = max(hi[0::2]) - min(lo[0::2])
-        height = max(hi[1::2]) - min(lo[1::2])
-        return float(width * height)
+        res, on_grid = cycle.extremes_many(coords, [(k, kind) for k in range(q) for kind in ("max", "min")])
+        grid = cycle.grid()
+        box, angles = [], []
+        for axis in (0, 1):
+            for kind, pick in (("min", np.argmin), ("max", np.argmax)):
+                vals, ths = [], []
+                for k in range(axis, q, 2):
+                    t, v = res[2 * k + (kind == "min")]
+                    vals += [*v.tolist(), *on_grid[k].tolist()]
+                    ths += [*t.tolist(), *grid.tolist()]
+                i = int(pick(vals))
+                box.append(float(vals[i]))
+                angles.append(float(ths[i]))
+        return tuple(box), tuple(angles)
+
+    def footprint(self) -> float:
+        """Area of the bounding box of every joint's path over a turn (length^2), exact."""
+        (x0, x1, y0, y1), _ = self.bounding_box()
+        return float((x1 - x0) * (y1 - y0))
 
     def size(self, measure: str = "sum") -> float:
         """Size by ``measure``: 'sum' of link lengths (ground included), 'longest' link, or 'footprint'."""
