@@ -3,8 +3,16 @@
 Oracle: closed form, eqs. (7)-(13).
 """
 
-from problems.paper_drag_link import build as paper
+from qropt import Problem
 
 
-def build():
-    return paper().replace(objective="min_size", size="sum", name="paper_drag_link_min_size")
+def build() -> Problem:
+    return Problem(
+        mechanism="DragLinkSlider",
+        fixed={"r1": 0.1, "r2": 0.225, "r4": 0.275, "r6": 0.3},
+        free={"r3": (0.05, 1.0), "r5": (0.01, 0.5)},
+        targets={"time_ratio": 1.5, "stroke": 0.3},
+        objective="min_size",
+        size="sum",
+        name="paper_drag_link_min_size",
+    )

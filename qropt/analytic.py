@@ -62,25 +62,32 @@ class DragLinkR3(NamedTuple):
 
 
 def drag_link_r3(time_ratio: float, r1: float, r2: float, r4: float) -> list[DragLinkR3]:
-    """Eqs. (7)-(13): every positive r3 giving the time ratio (0, 1 or 2 solutions; Grashof not checked)."""
-    f = tr_deviation(time_ratio)
-    a = (r4 + r1) - (r4 - r1) * math.cos(f)
-    b = (r4 - r1) * math.sin(f)
-    c = 2.0 * r4 * r1 / r2
-    disc = a * a + b * b - c * c
-    if disc < 0:
-        return []
-    roots = {math.atan2(b, a) + s * math.atan2(math.sqrt(disc), c) for s in (1.0, -1.0)}
+    """Eqs. (7)-(13): every positive r3 giving the time ratio (Grashof not checked).
+
+    The slow interval runs from TDC to BDC (theta2b = theta2a + phi, eq. 7); 0, 1 or 2 roots.
+    Roots of eq. (11) whose theta2a or theta2b leaves [0, pi] (the range of eqs. 3a, 3b) are spurious:
+    their r3 gives another TR, so they are dropped.
+    """
     out = []
-    for t in sorted(roots):
-        r3sq = r2**2 + (r4 + r1) ** 2 - 2 * r2 * (r4 + r1) * math.cos(t)
-        if r3sq > 0:
-            out.append(DragLinkR3(math.sqrt(r3sq), t))
+    for phi in (tr_deviation(time_ratio),):
+        a = (r4 + r1) - (r4 - r1) * math.cos(phi)
+        b = (r4 - r1) * math.sin(phi)
+        c = 2.0 * r4 * r1 / r2
+        disc = a * a + b * b - c * c
+        if disc < 0:
+            continue
+        for t in sorted({math.atan2(b, a) + s * math.atan2(math.sqrt(disc), c) for s in (1.0, -1.0)}):
+            r3sq = r2**2 + (r4 + r1) ** 2 - 2 * r2 * (r4 + r1) * math.cos(t)
+            if r3sq > 0 and 0.0 <= t <= math.pi and 0.0 <= t + phi <= math.pi:
+                out.append(DragLinkR3(math.sqrt(r3sq), t))
     return sorted(out)
 
 
 def drag_link_discriminant(time_ratio: float, r1: float, r2: float, r4: float) -> float:
-    """A^2 + B^2 - C^2 of eq. (12): > 0 two r3 solutions, = 0 one (a fold), < 0 none."""
+    """A^2 + B^2 - C^2 of eq. (12): > 0 two r3 solutions, = 0 one (a fold), < 0 none.
+
+    (The mirrored timing, phi -> -phi, has the same discriminant.)
+    """
     f = tr_deviation(time_ratio)
     a = (r4 + r1) - (r4 - r1) * math.cos(f)
     b = (r4 - r1) * math.sin(f)

@@ -189,20 +189,72 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("--csv", help="file for the full-cycle table ('-' for standard output)")
     a.add_argument("--plot", help="PNG file: mechanism at theta2 beside x, v, a over the cycle")
     a.set_defaults(run=cmd_analyze)
-    try:
-        from qropt import cli_synth
-
-        cli_synth.add_commands(sub)
-    except ImportError:  # pragma: no cover - synthesis not installed
-        pass
+    s = sub.add_parser("synth", help="solve a synthesis problem file (build() -> Problem)")
+    s.add_argument("problem", help="a problem file, e.g. problems/paper_drag_link.py")
+    s.add_argument("--objective", choices=["max_gamma_min", "min_size", "min_peak_accel", "none"])
+    s.add_argument("--size", choices=["sum", "longest", "footprint"], help="size measure for min_size")
+    s.add_argument("--starts", type=int, default=8, help="space-filling multi-start points (default 8)")
+    s.add_argument("--json", action="store_true", help="print the Result as JSON")
+    s.add_argument("--plot", help="PNG file: the best design over its cycle")
+    s.set_defaults(run=cmd_synth)
     return p
+
+
+def load_problem(path: str):
+    """The Problem built by a problem file's ``build()``."""
+    import importlib.util
+    from pathlib import Path
+
+    file = Path(path)
+    if not file.is_file():
+        raise CliError(f"no problem file {path!r}")
+    spec = importlib.util.spec_from_file_location(f"qropt_problem_{file.stem}", file)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    if not hasattr(module, "build"):
+        raise CliError(f"{path} has no build() function")
+    return module.build()
+
+
+def cmd_synth(args):
+    from qropt.solve import solve
+
+    problem = load_problem(args.problem)
+    changes = {}
+    if args.objective:
+        changes["objective"] = None if args.objective == "none" else args.objective
+    if args.size:
+        changes["size"] = args.size
+    if changes:
+        problem = problem.replace(**changes)
+    r = solve(problem, starts_n=args.starts)
+    if args.json:
+        json.dump(r.to_dict(), sys.stdout, indent=2, default=str)
+        sys.stdout.write("\n")
+    else:
+        print(f"{problem.name or args.problem}: {problem.mechanism.KIND}, objective {problem.objective}")
+        print(r.summary())
+        for k, (lo, hi) in r.reachable.items():
+            print(f"reachable {k}: {lo:.10g} .. {hi:.10g}")
+        if r.local_optima:
+            print(f"local optima ({len(r.local_optima)}):")
+            for o in r.local_optima:
+                free = ", ".join(f"{k}={o.params[k]:.10g}" for k in problem.free)
+                obj = "" if o.objective is None else f"  objective {o.objective:.10g}"
+                print(f"  {free}  gamma_min {math.degrees(o.quantities['gamma_min']):.6f} deg{obj}")
+        st = r.stats
+        print(f"stats: {st.get('starts')} starts, {st.get('t_total', 0):.3f} s total")
+    if args.plot and r.mechanism is not None:
+        from qropt import plots
+
+        plots.save(plots.cycle_figure(r.mechanism, omega2=problem.omega2), args.plot)
+    return 0 if r.success else 1
 
 
 def main(argv=None) -> int:
     try:
         args = parser().parse_args(argv)
-        args.run(args)
-        return 0
+        return args.run(args) or 0
     except CliError as e:
         print(f"qropt: error: {e}", file=sys.stderr)
         return 2

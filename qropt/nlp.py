@@ -34,7 +34,7 @@ IPOPT = {
     "record_time": True,
     "ipopt.tol": 1e-12,
     "ipopt.acceptable_tol": 1e-9,
-    "ipopt.max_iter": 300,
+    "ipopt.max_iter": 150,
     "ipopt.bound_relax_factor": 0.0,
     "show_eval_warnings": False,
     "calc_lam_p": False,

@@ -47,7 +47,11 @@ def branches(problem):
 
 def starts(problem, n: int, seed: int, use_analytic: bool) -> list[tuple[str, dict]]:
     """Analytic starts first, then a scrambled Sobol design over the free bounds (log-spaced for lengths)."""
-    out = [("analytic", s) for s in analytic.warm_starts(problem)] if use_analytic else []
+
+    def clip(v):
+        return {k: min(max(x, problem.free[k][0]), problem.free[k][1]) for k, x in v.items()}
+
+    out = [("analytic", clip(s)) for s in analytic.warm_starts(problem)] if use_analytic else []
     if n > 0:
         names = list(problem.free)
         points = []
@@ -64,7 +68,7 @@ def starts(problem, n: int, seed: int, use_analytic: bool) -> list[tuple[str, di
 
 def _assembles(problem, values) -> bool:
     try:
-        problem.build(values, branches(problem)[0])
+        problem.build(values, branches(problem)[0]).dead_centres()
         return True
     except QroptError:
         return False
@@ -154,17 +158,30 @@ def _residuals(problem, form, g, m, targets):
     return res
 
 
-def run_start(problem, values0, branch, targets, max_rounds=12, range_target=None, sense=1):
-    """One local solve with its exchange loop: a dict describing the candidate."""
+def start_orientation(problem, values, branch):
+    """+1 if the start's slow interval runs from theta_max to theta_min (counter-clockwise), -1 if not,
+    None if it does not turn fully."""
+    try:
+        a, b = problem.build(values, branch).stroke_angles()
+        return 1 if a >= b else -1
+    except QroptError:
+        return None
+
+
+def run_start(problem, values0, branch, targets, max_rounds=12, range_target=None, sense=1, orientation=None):
+    """One local solve with its exchange loop: a dict describing the candidate.
+
+    orientation: which way the TR equality is met (+1, -1); None takes the start's own.
+    """
     try:
         m0 = problem.build(values0, branch)
         d = m0.dead_centres()
         a, b = m0.stroke_angles()
-        orientation = 1 if a >= b else -1
+        orientation = orientation or (1 if a >= b else -1)
         th0 = (d.theta_max, d.theta_max + a)
     except QroptError:
-        orientation, tr = 1, targets.get("time_ratio", 1.5)
-        th0 = (0.5, 0.5 + slow_interval(tr, 1))
+        orientation, tr = orientation or 1, targets.get("time_ratio", 1.5)
+        th0 = (0.5, 0.5 + slow_interval(tr, orientation))
     if "time_ratio" in targets and range_target != "time_ratio":
         th0 = (th0[0], th0[0] + slow_interval(targets["time_ratio"], orientation))
     form = formulation(problem, branch, orientation, range_target, sense)
@@ -182,6 +199,8 @@ def run_start(problem, values0, branch, targets, max_rounds=12, range_target=Non
         values = dict(zip(form.free, w[: form.nx].tolist(), strict=True))
         th, z = w[form.nx : form.nx + 2], w[form.nx + 2 :]
         m, info, add, frac = certify(problem, form, values, branch, th, z, targets)
+        if not (st.get("success") or statuses[-1] == "Solved_To_Acceptable_Level") and not range_target:
+            break
         add = add[: max(0, EXTRA_SAMPLES - (used - BASE_SAMPLES))]
         frac = frac[: max(0, EXTRA_SAMPLES - (used_f - BASE_SAMPLES))]
         if not add and not frac:
@@ -258,9 +277,12 @@ def solve(problem: Problem, *, starts_n: int = 8, use_analytic: bool = True, see
     cands = []
     for origin, v in starts(problem, starts_n, seed, use_analytic):
         for br in branches(problem):
-            c = run_start(problem, v, br, targets, max_rounds)
-            c["origin"] = origin
-            cands.append(c)
+            own = start_orientation(problem, v, br)
+            ways = [own] if origin == "analytic" and own else [1, -1]
+            for orientation in ways:
+                c = run_start(problem, v, br, targets, max_rounds, orientation=orientation)
+                c["origin"] = origin
+                cands.append(c)
     good = [c for c in cands if c["ok"]]
     stats = {"starts": len(cands), "t_total": None, "formulations": len(_FORMULATIONS)}
     if good:
@@ -274,47 +296,64 @@ def solve(problem: Problem, *, starts_n: int = 8, use_analytic: bool = True, see
         msg = f"best of {len(best_first)} distinct local optima from {len(cands)} starts, certified"
         return _to_result(problem, best_first[0], status, msg, stats, local)
     reasons = sorted({c["info"].get("reason", "") or ", ".join(c["ipopt"]["statuses"][-1:]) for c in cands})
-    infeasible = any("Infeasible" in s for c in cands for s in c["ipopt"]["statuses"]) or any(
-        "Infeasible" not in c["ipopt"]["statuses"][-1] and not c["info"].get("ok") for c in cands
-    )
     reach, msgs = {}, []
     for k, v in targets.items():
         lo, hi = target_range(problem, k, targets, starts_n=starts_n, seed=seed)
         reach[k] = (lo, hi)
         msgs.append(_range_message(problem, k, v, lo, hi))
     stats["t_total"] = time.perf_counter() - t0
-    if infeasible or any(not (lo <= targets[k] <= hi) for k, (lo, hi) in reach.items()):
-        return Result("infeasible", "; ".join(msgs), stats=stats, reachable=reach)
-    return Result("failed", "no start converged to a certified design: " + "; ".join(reasons[:3]), stats=stats,
+    outside = [m for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True) if not lo <= targets[k] <= hi]
+    if outside:
+        return Result("infeasible", "; ".join(outside), stats=stats, reachable=reach)
+    if all(c["ipopt"]["statuses"][-1] == "Infeasible_Problem_Detected" for c in cands):
+        msg = f"every one of {len(cands)} starts ends in IPOPT's local infeasibility: the targets and conditions "
+        msg += "cannot be met together, though each target alone can (" + "; ".join(msgs) + ")"
+        return Result("infeasible", msg, stats=stats, reachable=reach)
+    why = "; ".join(reasons[:3])
+    return Result("failed", f"no start converged to a certified design ({why}); " + "; ".join(msgs), stats=stats,
                   reachable=reach)  # fmt: skip
 
 
 def _range_message(problem, k, v, lo, hi):
     bounds = ", ".join(f"{n} in [{a:g}, {b:g}]" for n, (a, b) in problem.free.items())
     if not math.isfinite(lo):
-        return f"no design meets the conditions for {bounds}"
+        return f"no design turns fully and meets the conditions for {bounds}"
     where = "below" if v < lo else "above" if v > hi else "inside"
     return f"{k} {v:g} is {where} the reachable {lo:.6g}..{hi:.6g} for {bounds}"
 
 
 def target_range(problem, target, targets=None, *, starts_n=8, seed=0):
-    """(low, high) of one target over the free bounds and conditions (other targets dropped); nan if none."""
+    """(low, high) of one target over the free bounds and conditions (other targets dropped).
+
+    Every value is that of a certified design: the optimised extremes and the start designs themselves.
+    (nan, nan) if no design turns fully.
+    """
     targets = dict(problem.targets if targets is None else targets)
-    others = {}
-    out = []
+    sub = problem.replace(targets={target: targets[target]})
+    seen = []
+
+    def value(m):
+        return m.time_ratio() if target == "time_ratio" else m.stroke()
+
+    pts = starts(problem, starts_n, seed, True)
+    for _, v in pts:
+        for br in branches(problem):
+            try:
+                seen.append(value(problem.build(v, br)))
+            except QroptError:
+                pass
     for sense in (1, -1):
-        best = None
-        for _, v in starts(problem, starts_n, seed, True):
-            for br in branches(problem):
-                sub = problem.replace(targets={target: targets[target]})
-                c = run_start(sub, v, br, {**others, target: targets[target]}, 3, target, sense)
-                if not c["info"].get("ok") or max(c["residuals"].get(k, 0.0) for k in c["residuals"]) > 1e-7:
-                    continue
+        for _, v in pts:
+            for br, way in itertools.product(branches(problem), (1, -1)):
+                c = run_start(sub, v, br, {target: targets[target]}, 3, target, sense, way)
                 m = c["mechanism"]
-                val = m.time_ratio() if target == "time_ratio" else m.stroke()
-                best = val if best is None else (min(best, val) if sense > 0 else max(best, val))
-        out.append(float("nan") if best is None else best)
-    return out[0], out[1]
+                internal = ("dead centre", "time_ratio orientation")
+                conditions = [x for k, x in c["residuals"].items() if not k.startswith(internal)]
+                if m is not None and m.dead_centres().reversals == 1 and max(conditions, default=0.0) <= 1e-9:
+                    seen.append(value(m))  # the exact value of a design that meets every condition
+    if not seen:
+        return float("nan"), float("nan")
+    return float(min(seen)), float(max(seen))
 
 
 __all__ = ["solve", "target_range", "formulation", "quantities", "cycle"]
