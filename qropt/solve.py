@@ -3,6 +3,7 @@ an exchange loop for continuous-cycle extremes, and a certificate by exact numer
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import math
 import time
@@ -338,10 +339,8 @@ def target_range(problem, target, targets=None, *, starts_n=8, seed=0):
     pts = starts(problem, starts_n, seed, True)
     for _, v in pts:
         for br in branches(problem):
-            try:
+            with contextlib.suppress(QroptError):
                 seen.append(value(problem.build(v, br)))
-            except QroptError:
-                pass
     for sense in (1, -1):
         for _, v in pts:
             for br, way in itertools.product(branches(problem), (1, -1)):

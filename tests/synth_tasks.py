@@ -105,6 +105,15 @@ def four_bar(rng):
     return prob, {"r3": _best("four-bar", cands)["r3"]}
 
 
+def _rocker_stroke(r1, r5, r6, e):
+    """Slider travel between the rocker limits (slide line y = 0 through O2 and O4)."""
+
+    def slider_x(t4):
+        return r1 + r5 * math.cos(t4) + math.sqrt(r6**2 - (r5 * math.sin(t4)) ** 2)
+
+    return abs(slider_x(e.theta4_extended) - slider_x(e.theta4_folded))
+
+
 def crank_rocker_slider(rng):
     while True:
         r1, r2, r4, r6 = 0.3, rng.uniform(0.05, 0.12), rng.uniform(0.2, 0.4), 0.5
@@ -113,11 +122,8 @@ def crank_rocker_slider(rng):
         for r3 in _crank_rocker_r3_roots(tr, r1, r2, r4):
             e = analytic.crank_rocker_extremes(r1, r2, r3, r4)
 
-            def stroke(r5, e=e):
-                def x(t4):
-                    return r1 + r5 * math.cos(t4) + math.sqrt(r6**2 - (r5 * math.sin(t4)) ** 2)
-
-                return abs(x(e.theta4_extended) - x(e.theta4_folded)) - s
+            def stroke(r5, e=e, r1=r1, r6=r6, s=s):
+                return _rocker_stroke(r1, r5, r6, e) - s
 
             grid = np.linspace(0.01, 0.45, 441)
             vals = np.array([stroke(x) for x in grid])
