@@ -24,7 +24,7 @@ def _frozen(d):
     return MappingProxyType(dict(d or {}))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Problem:
     """Dimensional synthesis of one mechanism type.
 

@@ -4,6 +4,7 @@ an exchange loop for continuous-cycle extremes, and a certificate by exact numer
 from __future__ import annotations
 
 import contextlib
+import functools
 import itertools
 import math
 import time
@@ -41,6 +42,16 @@ def formulation(problem, branch, orientation, range_target=None, sense=1) -> For
     return f
 
 
+@functools.lru_cache(maxsize=256)
+def _build(problem, values: tuple, branch: tuple):
+    return problem.build(dict(values), dict(branch))
+
+
+def build(problem, values: dict, branch: dict):
+    """problem.build, cached (mechanisms are immutable): a start is built once for all its uses."""
+    return _build(problem, tuple(sorted(values.items())), tuple(sorted(branch.items())))
+
+
 def branches(problem):
     names = list(problem.branches)
     return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*problem.branches.values())]
@@ -69,7 +80,7 @@ def starts(problem, n: int, seed: int, use_analytic: bool) -> list[tuple[str, di
 
 def _assembles(problem, values) -> bool:
     try:
-        problem.build(values, branches(problem)[0]).dead_centres()
+        build(problem, values, branches(problem)[0]).dead_centres()
         return True
     except QroptError:
         return False
@@ -163,7 +174,7 @@ def start_orientation(problem, values, branch):
     """+1 if the start's slow interval runs from theta_max to theta_min (counter-clockwise), -1 if not,
     None if it does not turn fully."""
     try:
-        a, b = problem.build(values, branch).stroke_angles()
+        a, b = build(problem, values, branch).stroke_angles()
         return 1 if a >= b else -1
     except QroptError:
         return None
@@ -175,7 +186,7 @@ def run_start(problem, values0, branch, targets, max_rounds=12, range_target=Non
     orientation: which way the TR equality is met (+1, -1); None takes the start's own.
     """
     try:
-        m0 = problem.build(values0, branch)
+        m0 = build(problem, values0, branch)
         d = m0.dead_centres()
         a, b = m0.stroke_angles()
         orientation = orientation or (1 if a >= b else -1)

@@ -31,7 +31,8 @@ def crank_shaper(rng):
     r1, tr = rng.uniform(0.2, 1.0), rng.uniform(1.1, 3.0)
     s = rng.uniform(0.2, 2.0) * r1
     k = analytic.crank_shaper_ratio(tr)
-    prob = Problem("CrankShaper", fixed={"r1": r1}, free={"r2": (0.01 * r1, 0.99 * r1), "r4": (0.05 * r1, 10 * r1)},
+    bounds = {"r2": (0.01 * r1, 0.99 * r1), "r4": (0.05 * r1, max(10 * r1, s / k))}
+    prob = Problem("CrankShaper", fixed={"r1": r1}, free=bounds,
                    targets={"time_ratio": tr, "stroke": s}, objective=None)  # fmt: skip
     ans = {"r2": k * r1, "r4": s / (2 * k)}
     assert np.allclose(_tr("crank-shaper", {"r1": r1, **ans}), (tr, s), rtol=1e-10)
@@ -52,7 +53,8 @@ def slider_crank(rng):
     r2, tr = rng.uniform(0.05, 0.3), rng.uniform(1.05, 1.6)
     s = r2 * rng.uniform(2.05, 3.5)
     d = analytic.slider_crank_design(tr, s, r2)[0]
-    prob = Problem("SliderCrank", fixed={"r2": r2}, free={"r3": (1.001 * r2, 20 * r2), "e": (0.0, 10 * r2)},
+    bounds = {"r3": (1.001 * r2, max(20 * r2, 2 * d.r3)), "e": (0.0, max(10 * r2, 2 * d.e))}
+    prob = Problem("SliderCrank", fixed={"r2": r2}, free=bounds,
                    targets={"time_ratio": tr, "stroke": s}, objective=None)  # fmt: skip
     assert np.allclose(_tr("slider-crank", {"r2": r2, "r3": d.r3, "e": d.e, "sigma_slider": 1.0}), (tr, s), rtol=1e-10)
     return prob, {"r3": d.r3, "e": d.e}

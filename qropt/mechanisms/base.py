@@ -316,11 +316,22 @@ class Mechanism:
 
     @cached_property
     def _acceleration_extremes(self):
+        """Local maxima and minima of d2x/dtheta2 over a turn: [(theta2, values), (theta2, values)]."""
+
         def acc(th):
             return self.evaluate(JET, Jet.seed(th, 1.0, 0.0)).x.d2
 
-        g = cycle.difference_jet(acc)
-        return [cycle.extremes(g, kind, xtol=cycle.FD_XTOL) for kind in ("max", "min")]
+        th = cycle.grid()
+        a = acc(th)
+        step = th[1] - th[0]
+        prev, nxt = np.roll(a, 1), np.roll(a, -1)
+        kinds = [(a >= prev) & (a > nxt), (a <= prev) & (a < nxt)]
+        idx = [np.flatnonzero(k) for k in kinds]
+        both = np.concatenate(idx)
+        t = cycle.wrap(cycle.stationary(cycle.difference_jet(acc), th[both] - step, th[both] + step, xtol=cycle.FD_XTOL))
+        v = acc(t)
+        n = idx[0].size
+        return [(t[:n], v[:n]), (t[n:], v[n:])]
 
     def working_arc(self, omega2: float = 1.0) -> tuple[float, float]:
         """The crank interval of the working (slow) stroke as (counter-clockwise start, length), rad."""
