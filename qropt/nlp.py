@@ -151,6 +151,10 @@ class Formulation:
         p = casadi.vertcat(PF, PT, S, W)
         g = casadi.vertcat(*[r.expr for r in rows])
         self.solver = casadi.nlpsol("qropt", "ipopt", {"x": w, "p": p, "f": f, "g": g}, IPOPT)
+        # the same NLP as plain functions with exact derivatives, for other solvers (benchmarks)
+        self.functions = casadi.Function(
+            "fg", [w, p], [f, g, casadi.gradient(f, w), casadi.jacobian(g, w)], ["w", "p"], ["f", "g", "df", "dg"]
+        )
         self.epi_fun = casadi.Function("epi", [w, p], [casadi.vertcat(*[e for _, e in epi], 0)])
         self.epi_index = np.array([zi for zi, _ in epi], int)
         self.lbg = np.array([r.lb for r in rows], float)
