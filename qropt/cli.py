@@ -36,21 +36,14 @@ def angle(text: str) -> float:
         raise argparse.ArgumentTypeError(f"not an angle: {text!r} (use e.g. 60deg or 1.05rad)") from None
 
 
-def paper_example() -> Mechanism:
-    """The paper's project mechanism: TR 1.5, stroke 0.3 m, r3 from eqs. (7)-(13) (larger root)."""
-    from qropt import analytic
-    from qropt.mechanisms import DragLinkSlider
-
-    r3 = analytic.drag_link_r3(1.5, 0.1, 0.225, 0.275)[-1].r3
-    return DragLinkSlider(r1=0.1, r2=0.225, r3=r3, r4=0.275, r5=0.15, r6=0.3)
-
-
 def build_mechanism(args) -> Mechanism:
     given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
     if args.type is None:
         if given:
             raise CliError("give the mechanism TYPE before its parameters (types: " + ", ".join(sorted(REGISTRY)) + ")")
-        return paper_example()
+        from qropt.examples import paper_mechanism
+
+        return paper_mechanism()
     return mechanism_type(args.type)(**given)
 
 
@@ -190,7 +183,7 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("--plot", help="PNG file: mechanism at theta2 beside x, v, a over the cycle")
     a.set_defaults(run=cmd_analyze)
     s = sub.add_parser("synth", help="solve a synthesis problem file (build() -> Problem)")
-    s.add_argument("problem", help="a problem file, e.g. problems/paper_drag_link.py")
+    s.add_argument("problem", nargs="?", help="a problem file (default: the paper's design task, built in)")
     s.add_argument("--objective", choices=["max_gamma_min", "min_size", "min_peak_accel", "none"])
     s.add_argument("--size", choices=["sum", "longest", "footprint"], help="size measure for min_size")
     s.add_argument("--starts", type=int, default=8, help="space-filling multi-start points (default 8)")
@@ -219,7 +212,12 @@ def load_problem(path: str):
 def cmd_synth(args):
     from qropt.solve import solve
 
-    problem = load_problem(args.problem)
+    if args.problem is None:
+        from qropt.examples import paper_problem
+
+        problem = paper_problem()
+    else:
+        problem = load_problem(args.problem)
     changes = {}
     if args.objective:
         changes["objective"] = None if args.objective == "none" else args.objective

@@ -150,6 +150,7 @@ class Formulation:
         w = casadi.vertcat(X, TH, Z)
         p = casadi.vertcat(PF, PT, S, W)
         g = casadi.vertcat(*[r.expr for r in rows])
+        self.w_sym, self.p_sym, self.g_sym = w, p, g
         self.solver = casadi.nlpsol("qropt", "ipopt", {"x": w, "p": p, "f": f, "g": g}, IPOPT)
         # the same NLP as plain functions with exact derivatives, for other solvers (benchmarks)
         self.functions = casadi.Function(

@@ -278,19 +278,21 @@ def _to_result(problem, c, status, message, stats, local=()):
 
 
 def solve(problem: Problem, *, starts_n: int = 8, use_analytic: bool = True, seed: int = 0,
-          targets: dict | None = None, max_rounds: int = 12) -> Result:  # fmt: skip
+          targets: dict | None = None, max_rounds: int = 12, extra_starts=()) -> Result:  # fmt: skip
     """Solve a synthesis problem; returns a Result whatever happens (only invalid input raises).
 
     starts_n: Sobol multi-start points; use_analytic: start from every closed form as well;
-    targets: override the problem's target values (the NLP is not rebuilt).
+    targets: override the problem's target values (the NLP is not rebuilt);
+    extra_starts: more starting points (free-parameter dicts), tried first.
     """
     t0 = time.perf_counter()
     targets = dict(problem.targets if targets is None else targets)
     cands = []
-    for origin, v in starts(problem, starts_n, seed, use_analytic):
+    given = [("given", {k: v[k] for k in problem.free}) for v in extra_starts]
+    for origin, v in given + starts(problem, starts_n, seed, use_analytic):
         for br in branches(problem):
             own = start_orientation(problem, v, br)
-            ways = [own] if origin == "analytic" and own else [1, -1]
+            ways = [own] if origin in ("analytic", "given") and own else [1, -1]
             for orientation in ways:
                 c = run_start(problem, v, br, targets, max_rounds, orientation=orientation)
                 c["origin"] = origin
