@@ -190,7 +190,122 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="print the Result as JSON")
     s.add_argument("--plot", help="PNG file: the best design over its cycle")
     s.set_defaults(run=cmd_synth)
+    f = sub.add_parser("family", help="trace the one-parameter family of a problem file")
+    f.add_argument("problem", help="a problem file with one more free parameter than targets")
+    f.add_argument("--along", help="the parameter in which folds are counted (default: the first free one)")
+    f.add_argument("--csv", help="file for every traced point with its quantities")
+    f.add_argument("--plot", help="PNG file: the family coloured by gamma_min, folds, ends and the best design")
+    f.add_argument("--json", action="store_true", help="print branches' ends, folds and the best design as JSON")
+    f.set_defaults(run=cmd_family)
+    r = sub.add_parser("reachable", help="TR range, solution counts and adjustable-link travel of one parameter")
+    r.add_argument("type", nargs="?", help="mechanism type (default: the paper's mechanism)")
+    for k in PARAM_NAMES:
+        r.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
+    r.add_argument("--free", default="r3", help="the adjustable parameter (default r3)")
+    r.add_argument("--bounds", nargs=2, type=float, metavar=("LOW", "HIGH"), help="its interval")
+    r.add_argument("--tr", type=float, action="append", default=[], help="count the designs for this TR")
+    r.add_argument("--json", action="store_true", help="print JSON")
+    r.add_argument("--plot", help="PNG file: TR against the parameter (the paper's Fig. 5)")
+    r.set_defaults(run=cmd_reachable)
     return p
+
+
+class _Progress:
+    """A one-line progress count on standard error."""
+
+    def __init__(self, what):
+        self.what, self.n = what, 0
+
+    def __call__(self, k=1):
+        self.n += k
+        if self.n % 50 == 0:
+            sys.stderr.write(f"\r{self.what}: {self.n} points")
+            sys.stderr.flush()
+
+    def done(self):
+        sys.stderr.write(f"\r{self.what}: {self.n} points\n")
+
+
+def cmd_family(args):
+    from qropt.family import family
+
+    problem = load_problem(args.problem)
+    bar = _Progress("tracing")
+    fam = family(problem, along=args.along, progress=bar)
+    bar.done()
+    best = fam.best(problem.objective or "max_gamma_min")
+    if args.json:
+        out = {
+            "branches": [len(b) for b in fam.branches],
+            "ends": [{"branch": e.branch, "side": e.side, "reason": e.reason, "params": e.params} for e in fam.ends],
+            "folds": fam.folds,
+            "best": best.to_dict(),
+        }
+        json.dump(out, sys.stdout, indent=2, default=str)
+        sys.stdout.write("\n")
+    else:
+        free = list(problem.free)
+        print(f"{problem.name or args.problem}: {len(fam.branches)} branch(es), {sum(map(len, fam.branches))} points")
+        for e in fam.ends:
+            at = ", ".join(f"{k}={e.params[k]:.10g}" for k in free)
+            print(f"  branch {e.branch + 1} {'start' if e.side == 0 else 'end'}: {at}  ({e.reason})")
+        for fold in fam.folds:
+            print("  fold: " + ", ".join(f"{k}={fold[k]:.12g}" for k in free))
+        print("best " + (problem.objective or "max_gamma_min") + ":")
+        print("  " + best.summary().replace("\n", "\n  "))
+    if args.csv:
+        with open(args.csv, "w", newline="") as fh:
+            w = csv.writer(fh)
+            head = ["branch", "arclength", *problem.free, "theta_max_deg", "theta_min_deg", "time_ratio", "stroke",
+                    "gamma_min_deg", "peak_accel", "grashof"]  # fmt: skip
+            w.writerow(head)
+            for b, pts in enumerate(fam.branches):
+                for p in pts:
+                    q = p.quantities
+                    w.writerow([b + 1, f"{p.arclength:.12g}", *(f"{p.params[k]:.15g}" for k in problem.free),
+                                *(f"{math.degrees(t):.12g}" for t in p.theta), q.get("time_ratio"),
+                                q.get("stroke", q.get("swing")), math.degrees(q["gamma_min"]) if q else None,
+                                q.get("peak_accel"), q.get("grashof")])  # fmt: skip
+    if args.plot:
+        from qropt import plots
+
+        plots.save(plots.family_figure(fam, best=best), args.plot)
+
+
+def cmd_reachable(args):
+    from qropt.reachable import reachable
+
+    given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
+    if args.type is None and not given:
+        from qropt.examples import paper_mechanism
+
+        m = paper_mechanism()
+    elif args.type is None:
+        raise CliError("give the mechanism TYPE before its parameters")
+    else:
+        m = mechanism_type(args.type)(**given)
+    r = reachable(m, args.free, tuple(args.bounds) if args.bounds else None)
+    tmin, xmin, tmax, xmax = r.time_ratio_range
+    adj = r.adjustable(tmin, tmax)
+    counts = {t: r.solutions(t) for t in args.tr}
+    if args.json:
+        out = {"free": args.free, "intervals": r.intervals, "time_ratio_range": r.time_ratio_range,
+               "stroke_range": r.stroke_range, "solutions": {str(k): v for k, v in counts.items()},
+               "adjustable": {"interval": adj.interval, "explanation": adj.explanation}}  # fmt: skip
+        json.dump(out, sys.stdout, indent=2, default=float)
+        sys.stdout.write("\n")
+    else:
+        print(f"{type(m).__name__}: {args.free} varies, the rest as given")
+        print("  feasible " + " and ".join(f"{args.free} in [{a:.10g}, {b:.10g}]" for a, b in r.intervals))
+        print(f"  time ratio {tmin:.10g} (at {args.free} = {xmin:.10g}) .. {tmax:.10g} (at {args.free} = {xmax:.10g})")
+        print(f"  stroke {r.stroke_range[0]:.10g} .. {r.stroke_range[1]:.10g}")
+        for t, xs in counts.items():
+            print(f"  TR {t:g}: {len(xs)} design(s)" + (": " + ", ".join(f"{x:.10g}" for x in xs) if xs else ""))
+        print(f"  adjustable {args.free}: {adj.explanation}")
+    if args.plot:
+        from qropt import plots
+
+        plots.save(plots.reachable_figure(r, args.tr), args.plot)
 
 
 def load_problem(path: str):

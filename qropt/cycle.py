@@ -14,6 +14,7 @@ from qropt.ops import Jet
 
 TWO_PI = 2.0 * np.pi
 GRID = 720
+MARGIN_TOL = 1e-12  # an assembly margin this far below zero is rounding (a change point), not a failure
 FD_XTOL = 1e-10
 
 
@@ -149,13 +150,13 @@ def minimum(fun, n: int = GRID):
 
 
 def negative_intervals(margin, n: int = 3600):
-    """Crank-angle intervals (radians, lo < hi, possibly past 2pi) where the numpy function margin < 0."""
+    """Crank-angle intervals (radians, lo < hi, possibly past 2pi) where the numpy function margin < -MARGIN_TOL."""
     from scipy.optimize import brentq
 
     theta = grid(n)
     with np.errstate(invalid="ignore"):
         m = margin(theta)
-    bad = m < 0
+    bad = m < -MARGIN_TOL
     if not bad.any():
         return []
     if bad.all():
@@ -174,7 +175,7 @@ def negative_intervals(margin, n: int = 3600):
 
             def f(t):
                 with np.errstate(invalid="ignore"):
-                    return float(margin(np.array([t]))[0])
+                    return float(margin(np.array([t]))[0]) + MARGIN_TOL
 
             lo = brentq(f, prev, t0, xtol=1e-14) if np.isfinite(f(prev)) else t0
             hi = brentq(f, t1, nxt, xtol=1e-14) if np.isfinite(f(nxt)) else t1

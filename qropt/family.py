@@ -27,12 +27,14 @@ NEWTON_TOL = 1e-12
 
 @dataclass(frozen=True)
 class FamilyPoint:
-    """A design on a family: params (all), dead-centre crank angles (rad), arclength; quantities on demand."""
+    """A design on a family: params (all), dead-centre crank angles (rad), arclength, the largest equation
+    residual |F| (dead-centre velocities, TR, stroke); quantities on demand."""
 
     problem: Problem = field(repr=False)
     params: dict
     theta: tuple
     arclength: float
+    residual: float = 0.0
 
     @cached_property
     def mechanism(self):
@@ -88,7 +90,9 @@ class Family:
 
         top = sorted(chosen, key=score, reverse=True)[:3]
         free = list(self.problem.free)
-        return solve(problem, starts_n=0, use_analytic=False, extra_starts=[{k: p.params[k] for k in free} for p in top])
+        return solve(
+            problem, starts_n=0, use_analytic=False, extra_starts=[{k: p.params[k] for k in free} for p in top]
+        )
 
 
 class _Curve:
@@ -103,6 +107,7 @@ class _Curve:
         f = form.g_sym[eq.tolist()] - casadi.DM(form.lbg[eq])
         g = form.g_sym[ineq.tolist()]
         self.fun = casadi.Function("F", [u, form.p_sym], [f, casadi.jacobian(f, u), g])
+        self.fj = casadi.Function("FJ", [u, form.p_sym], [f, casadi.jacobian(f, u)])
         self.ineq_rows = [form.rows[i] for i in ineq]
         self.glo, self.ghi = form.lbg[ineq], form.ubg[ineq]
         self.n = n
@@ -113,8 +118,14 @@ class _Curve:
         self.free = form.free
 
     def eval(self, u):
+        """(F, dF/du, inequality rows) at u."""
         f, j, g = self.fun(u, self.p)
         return np.array(f).ravel(), np.array(j), np.array(g).ravel()
+
+    def eval_fj(self, u):
+        """(F, dF/du) at u: what a Newton step needs."""
+        f, j = self.fj(u, self.p)
+        return np.array(f).ravel(), np.array(j)
 
     def violation(self, g):
         """(largest violation, row index) of the inequality rows."""
@@ -132,7 +143,11 @@ class _Curve:
     def correct(self, u, t, pred, extra=None, iters=12):
         """Newton on F = 0 and t.(u - pred) = 0 (or an extra scalar equation): (u, iterations) or None."""
         for k in range(iters):
-            f, j, g = self.eval(u)
+            if extra is None:
+                f, j = self.eval_fj(u)
+                g = None
+            else:
+                f, j, g = self.eval(u)
             if extra is None:
                 r = np.append(f, t @ (u - pred))
                 a = np.vstack([j, t])
@@ -147,7 +162,14 @@ class _Curve:
                 return None
             u = u + du
             if np.max(np.abs(du)) <= NEWTON_TOL * max(1.0, np.max(np.abs(u))) and np.max(np.abs(f)) < 1e-9:
-                f, j, g = self.eval(u)
+                f, j, g = self.eval(u)  # one more step: the residual falls to rounding level
+                r = np.append(f, 0.0) if extra is None else np.append(f, extra(u, g, j)[0])
+                a = np.vstack([j, t]) if extra is None else np.vstack([j, extra(u, g, j)[1]])
+                with np.errstate(all="ignore"):
+                    u2 = u + np.linalg.solve(a, -r)
+                f2 = self.eval_fj(u2)[0]
+                if np.all(np.isfinite(f2)) and np.max(np.abs(f2)) <= np.max(np.abs(f)):
+                    u, f = u2, f2
                 return (u, k + 1) if np.max(np.abs(f)) <= 1e-10 else None
         return None
 
@@ -166,7 +188,7 @@ class _Curve:
 
 
 def family(problem: Problem, along: str | None = None, *, ds: float | None = None, max_points: int = 5000,
-           starts_n: int = 16, seed: int = 0, progress=None) -> Family:  # fmt: skip
+           starts_n: int = 8, seed: int = 0, progress=None) -> Family:  # fmt: skip
     """Trace every branch of a one-parameter family of designs.
 
     along: the parameter in which folds are counted (default: the first free one); ds: the largest
@@ -206,7 +228,9 @@ def family(problem: Problem, along: str | None = None, *, ds: float | None = Non
     out = []
     for curve, br, us in traced:
         s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(np.array(us), axis=0), axis=1))])
-        out.append([FamilyPoint(problem, _params(problem, curve, u, br), (u[-2], u[-1]), float(a)) for u, a in zip(us, s, strict=True)])
+        res = [float(np.max(np.abs(curve.eval(u)[0]))) for u in us]
+        out.append([FamilyPoint(problem, _params(problem, curve, u, br), (u[-2], u[-1]), float(a), r)
+                    for u, a, r in zip(us, s, res, strict=True)])  # fmt: skip
     fold_params = [_params(problem, c, u, br) for c, br, u in folds]
     return Family(problem, along, out, ends, fold_params, {"points": n_points, "branches": len(out)})
 
@@ -227,8 +251,10 @@ def _seed(problem, curve, values, br, way):
         th = (d.theta_max, d.theta_max + a)
     u = np.array([values[k] for k in curve.free] + list(th), float)
     u = curve.project(u)
-    if u is None or np.any(u[: len(curve.free)] < curve.lo[: len(curve.free)]) or np.any(
-        u[: len(curve.free)] > curve.hi[: len(curve.free)]
+    if (
+        u is None
+        or np.any(u[: len(curve.free)] < curve.lo[: len(curve.free)])
+        or np.any(u[: len(curve.free)] > curve.hi[: len(curve.free)])
     ):
         return None
     _, _, g = curve.eval(u)
@@ -275,6 +301,7 @@ def _trace(curve, u0, direction, ds_max, max_points, ia, progress):
             name = curve.ineq_rows[row].name
             lo_b, hi_b = curve.glo[row], curve.ghi[row]
             target = lo_b if gn[row] < lo_b else hi_b
+
             def edge(x, g, jj, row=row, target=target):
                 val = g[row] - target
                 eps = 1e-7

@@ -90,3 +90,75 @@ def _shade(ax, t_max, t_min, a, b, omega2):
 def save(fig, path):
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def reachable_figure(r, time_ratios=()):
+    """TR against the free parameter over its feasible interval (the paper's Fig. 5, recomputed),
+    with the TR extremes and, for each requested TR, its solutions and their count."""
+    fig, ax = plt.subplots(figsize=(8, 5))
+    ok = np.isfinite(r.tr)
+    ax.plot(r.grid[ok], r.tr[ok], color="tab:blue", label="TR")
+    for lo, hi in r.intervals:
+        ax.axvspan(lo, hi, color="tab:green", alpha=0.07)
+    tmin, xmin, tmax, xmax = r.time_ratio_range
+    ax.plot([xmin, xmax], [tmin, tmax], "kv", ms=7, label=f"TR range {tmin:.4f}..{tmax:.4f}")
+    for k, t in enumerate(time_ratios):
+        xs = r.solutions(t)
+        ax.axhline(t, color="tab:red", lw=0.8, ls="--")
+        ax.plot(xs, [t] * len(xs), "o", color="tab:red")
+        at, ha = (r.grid[0], "left") if k % 2 == 0 else (r.grid[-1], "right")
+        ax.annotate(f"TR {t:g}: {len(xs)} solution(s)", (at, t), textcoords="offset points", xytext=(4, 4), ha=ha)
+    ax.set_xlabel(f"{r.free}")
+    ax.set_ylabel("time ratio")
+    ax.set_title(f"TR over the feasible {r.free} of {type(r.base).__name__} (shaded)")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper center")
+    fig.tight_layout()
+    return fig
+
+
+def family_figure(f, x=None, y=None, best=None, max_points=400):
+    """A family in the plane of two free parameters, coloured by gamma_min, with folds, ends and the best."""
+    free = list(f.problem.free)
+    x = x or f.along
+    y = y or next(k for k in free if k != x)
+    fig, ax = plt.subplots(figsize=(8, 6))
+    pts = f.points()
+    step = max(1, len(pts) // max_points)
+    for b in f.branches:
+        ax.plot([p.params[x] for p in b], [p.params[y] for p in b], color="0.6", lw=1)
+    shown = pts[::step]
+    g = [math.degrees(p.quantities.get("gamma_min", float("nan"))) for p in shown]
+    sc = ax.scatter([p.params[x] for p in shown], [p.params[y] for p in shown], c=g, cmap="viridis", s=12)
+    fig.colorbar(sc, ax=ax, label="gamma_min [deg]")
+    for fold in f.folds:
+        ax.plot(fold[x], fold[y], "rx", ms=10, mew=2)
+    for k, e in enumerate(f.ends):
+        ax.plot(e.params[x], e.params[y], "ks", ms=6)
+        ax.annotate(f"end {k + 1}", (e.params[x], e.params[y]), textcoords="offset points", xytext=(5, -10), fontsize=8)
+    if best is not None and best.success:
+        ax.plot(best.params[x], best.params[y], "*", color="tab:red", ms=16, label="best gamma_min")
+        ax.legend()
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+    n = sum(len(b) for b in f.branches)
+    ax.set_title(f"{f.problem.mechanism.__name__} family ({n} points, {len(f.folds)} fold(s))")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def family_mechanisms(f, count=4):
+    """The mechanism drawn at ``count`` points spread along the family."""
+    pts = f.points()
+    picks = [pts[i] for i in np.linspace(0, len(pts) - 1, count).astype(int)]
+    fig, axes = plt.subplots(1, count, figsize=(4 * count, 4))
+    for ax, p in zip(np.atleast_1d(axes), picks, strict=True):
+        try:
+            draw_mechanism(ax, p.mechanism, 0.0)
+        except Exception as e:  # noqa: BLE001 - a point that does not build is shown as such
+            ax.text(0.5, 0.5, type(e).__name__, transform=ax.transAxes, ha="center")
+        free = ", ".join(f"{k}={p.params[k]:.4g}" for k in f.problem.free)
+        ax.set_title(free, fontsize=9)
+    fig.tight_layout()
+    return fig

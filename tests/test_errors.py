@@ -118,7 +118,7 @@ def test_cli_one_line_nonzero(name, kw, err, fragment, cli_extra, capsys):
         (["analyze", "whitworth", "--r1", "x"], "invalid float value"),
         (["frobnicate"], "invalid choice"),
         (["analyze", "four-bar", "--r1", "3.5", "--r2", "1.6", "--r3", "2.14", "--r4", "2.06"], "104.6361, 255.3639"),
-        (["analyze", "four-bar", "--r1", "0.1", "--r2", "0.3", "--r3", "0.3", "--r4", "0.3"], "no extremes"),
+        (["analyze", "four-bar", "--r1", "0.1", "--r2", "0.3", "--r3", "0.3", "--r4", "0.3"], "no regular extremes"),
     ],
 )
 def test_cli_usage_errors(argv, fragment, capsys):

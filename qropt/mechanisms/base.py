@@ -245,7 +245,10 @@ class Mechanism:
         self._require_full_turn()
         (tmax, xmax), (tmin, xmin) = self._cycle["max"], self._cycle["min"]
         if tmax.size == 0 or tmin.size == 0:
-            raise NoDeadCentres(f"{self!r}: the output has no extremes over a crank turn (it turns fully)")
+            raise NoDeadCentres(
+                f"{self!r}: the output has no regular extremes over a crank turn (it turns fully, "
+                "or a dead centre falls on a singular position such as a change point)"
+            )
         i, j = int(np.argmax(xmax)), int(np.argmin(xmin))
         return DeadCentres(float(tmax[i]), float(tmin[j]), float(xmax[i]), float(xmin[j]), int(tmax.size))
 
@@ -328,7 +331,9 @@ class Mechanism:
         kinds = [(a >= prev) & (a > nxt), (a <= prev) & (a < nxt)]
         idx = [np.flatnonzero(k) for k in kinds]
         both = np.concatenate(idx)
-        t = cycle.wrap(cycle.stationary(cycle.difference_jet(acc), th[both] - step, th[both] + step, xtol=cycle.FD_XTOL))
+        t = cycle.wrap(
+            cycle.stationary(cycle.difference_jet(acc), th[both] - step, th[both] + step, xtol=cycle.FD_XTOL)
+        )
         v = acc(t)
         n = idx[0].size
         return [(t[:n], v[:n]), (t[n:], v[n:])]
@@ -380,7 +385,7 @@ class Mechanism:
         """(closure, theta2_from, theta2_to) intervals (rad) where the loop cannot close; [] if it turns fully."""
         lp = self.evaluate(NUMPY, np.zeros(1))
         for k, (what, _) in enumerate(lp.margins):
-            if not self._cycle["margins"][k] < 0:
+            if not self._cycle["margins"][k] < -cycle.MARGIN_TOL:
                 continue
 
             def margin(t, k=k):
