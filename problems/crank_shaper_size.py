@@ -4,7 +4,10 @@ Oracle: closed form r2 = r1 sin(phi / 2), r4 = stroke r1 / (2 r2) (phi of eq. 7)
 is fixed by TR and stroke, so ``min_size`` must return it.
 """
 
-from qropt import Problem
+from problems import _oracle
+from qropt import Problem, analytic
+
+ORACLE = {"kind": "closed form", "tolerance": 1e-9}
 
 
 def build() -> Problem:
@@ -17,3 +20,9 @@ def build() -> Problem:
         size="longest",
         name="crank_shaper_size",
     )
+
+
+def oracle() -> dict:
+    """The reference optimum: {'objective', 'params'}."""
+    k = analytic.crank_shaper_ratio(1.6)
+    return _oracle.best_of(build(), [{"r2": 0.3 * k, "r4": 0.4 / (2 * k)}])

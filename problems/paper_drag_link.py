@@ -6,8 +6,10 @@ Oracle: closed form, eqs. (7)-(13): r3 = 0.2504281 m (gamma_min 27.008 deg) or 0
 (9.095 deg), r5 = 0.15 m.
 """
 
-from qropt import analytic
+from problems import _oracle
 from qropt.examples import paper_problem
+
+ORACLE = {"kind": "closed form", "tolerance": 1e-9}
 
 
 def build():
@@ -15,5 +17,6 @@ def build():
 
 
 def oracle() -> dict:
-    """Every solution (closed form): r3, r5."""
-    return {"solutions": [{"r3": s.r3, "r5": 0.15} for s in analytic.drag_link_r3(1.5, 0.1, 0.225, 0.275)]}
+    """The reference optimum: {'objective', 'params'} (the best of eqs. 7-13's roots)."""
+    p = build()
+    return _oracle.best_of(p, _oracle.drag_link(p, 0.1, 0.225, 0.275, 0.3))

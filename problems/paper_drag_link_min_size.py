@@ -1,9 +1,11 @@
 """The paper's task (1) with the smallest sum of link lengths: the shorter coupler, r3 = 0.1543445 m.
 
-Oracle: closed form, eqs. (7)-(13).
-"""
+Oracle: closed form, eqs. (7)-(13): the best of its roots."""
 
+from problems import _oracle
 from qropt import Problem
+
+ORACLE = {"kind": "closed form", "tolerance": 1e-09}
 
 
 def build() -> Problem:
@@ -16,3 +18,9 @@ def build() -> Problem:
         size="sum",
         name="paper_drag_link_min_size",
     )
+
+
+def oracle() -> dict:
+    """The reference optimum: {'objective', 'params'}."""
+    p = build()
+    return _oracle.best_of(p, _oracle.drag_link(p, 0.1, 0.225, 0.275, 0.3))

@@ -1,10 +1,11 @@
 """Offset slider-crank for TR 1.3 and stroke 0.3 m with the best transmission angle (r2, r3, e free).
 
-Oracle: the closed-form family ``analytic.slider_crank_design`` swept densely over r2 (reference
-computed at test time).
-"""
+Oracle: grid along the closed-form family (r2 -> r3, e from the stroke triangle), refined."""
 
+from problems import _oracle
 from qropt import Problem
+
+ORACLE = {"kind": "grid", "tolerance": 1e-07}
 
 
 def build() -> Problem:
@@ -15,3 +16,9 @@ def build() -> Problem:
         objective="max_gamma_min",
         name="slider_crank_gamma",
     )
+
+
+def oracle() -> dict:
+    """The reference optimum: {'objective', 'params'}."""
+    p = build()
+    return _oracle.along(p, _oracle.slider_crank_family(1.3, 0.3), 0.0501, 0.14999)

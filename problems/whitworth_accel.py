@@ -2,10 +2,13 @@
 at omega2 = 10 rad/s; the rod r6 is free.
 
 Oracle: r2 = r1 / sin(phi / 2) = 0.2 m and r5 = 0.15 m are forced; the peak acceleration falls as
-the rod lengthens, so the optimum is r6 at its upper bound (reference: dense scan of r6 at test time).
+the rod lengthens, so the optimum is r6 at its upper bound (reference: grid over r6, refined).
 """
 
-from qropt import Problem
+from problems import _oracle
+from qropt import Problem, analytic
+
+ORACLE = {"kind": "grid", "tolerance": 1e-6}
 
 
 def build() -> Problem:
@@ -18,3 +21,9 @@ def build() -> Problem:
         omega2=10.0,
         name="whitworth_accel",
     )
+
+
+def oracle() -> dict:
+    """The reference optimum: {'objective', 'params'}."""
+    r2 = 0.1 / analytic.whitworth_ratio(2.0)
+    return _oracle.along(build(), lambda r6: {"r2": r2, "r5": 0.15, "r6": r6}, 0.2, 0.6)

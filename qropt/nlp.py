@@ -26,7 +26,8 @@ from qropt.ops import CASADI
 
 TWO_PI = 2.0 * math.pi
 BASE_SAMPLES = 24
-EXTRA_SAMPLES = 16
+LIFTED = 2  # lifted acceleration extremes for min_peak_accel
+EXTRA_SAMPLES = 24
 IPOPT = {
     "ipopt.print_level": 0,
     "ipopt.sb": "yes",
@@ -88,12 +89,13 @@ class Formulation:
         margins = [m for what, m in lp.margins if not (four_bar and "four-bar" in what)]
         dx = casadi.jacobian(lp.x, t)
         ddx = casadi.jacobian(dx, t)
+        dddx = casadi.jacobian(ddx, t)
         cos_all = [transmission_cos(CASADI, lp.transmission[j]) for j in self.exact_joints + self.sampled_joints]
         coords = [c for pt in lp.points.values() for c in pt]
         kin = casadi.Function(
             "kin",
             [t, X, PF],
-            [lp.x, dx, ddx, casadi.vertcat(*cos_all, 0), casadi.vertcat(*margins, 0), casadi.vertcat(*coords)],
+            [lp.x, dx, ddx, casadi.vertcat(*cos_all, 0), casadi.vertcat(*margins, 0), casadi.vertcat(*coords), dddx],
         )
         self.kin = kin
         n_exact = len(self.exact_joints)
@@ -130,6 +132,15 @@ class Formulation:
         exact = [at(a) for a in (0.0, math.pi)]
         self.z_names, epi = self._objective(problem, params, sampled, exact, n_exact, at, start, length, working)
         Z = casadi.SX.sym("z", len(self.z_names))
+        # peak acceleration: the largest extremes are lifted like the dead centres (d3x/dtheta3 = 0 there)
+        self.n_lift = LIFTED if problem.objective == "min_peak_accel" and not range_target else 0
+        PHI = casadi.SX.sym("phi", self.n_lift)
+        for k in range(self.n_lift):
+            out = at(PHI[k])
+            rows.append(Row("lifted acceleration extreme: stationary", out[6], 0.0, 0.0))
+            epi += [(0, out[2]), (0, -out[2])]
+            if working:
+                rows.append(Row("lifted acceleration extreme: in the working stroke", (PHI[k] - start) / length, 0, 1))
         for zi, e in epi:
             rows.append(Row(f"epigraph {self.z_names[zi]}", e - Z[zi], -casadi.inf, 0.0))
         g_min = problem.conditions.get("gamma_min")
@@ -147,7 +158,7 @@ class Formulation:
                     rows.append(Row(f"gamma_min >= bound at joint {name}", out[3][j], -cos_lb, cos_lb))
         f = self._objective_value(problem, params, Z, travel, span)
         self.rows = rows
-        w = casadi.vertcat(X, TH, Z)
+        w = casadi.vertcat(X, TH, Z, PHI)
         p = casadi.vertcat(PF, PT, S, W)
         g = casadi.vertcat(*[r.expr for r in rows])
         self.w_sym, self.p_sym, self.g_sym = w, p, g
@@ -244,9 +255,11 @@ class Formulation:
         pad = np.zeros(EXTRA_SAMPLES)
         return np.concatenate([angles, pad]), np.concatenate([fractions, pad])
 
-    def pack(self, values: dict, th, z=None):
-        x = [values[k] for k in self.free] + list(th)
-        return np.array(x + list(z if z is not None else np.zeros(self.nz)), float)
+    def pack(self, values: dict, th, z=None, phi=None):
+        x = [values[k] for k in self.free] + list(th) + list(z if z is not None else np.zeros(self.nz))
+        phi = list(phi if phi is not None else np.linspace(0.0, math.pi, self.n_lift))[: self.n_lift]
+        phi += [0.0] * (self.n_lift - len(phi))
+        return np.array(x + phi, float)
 
     def param_vector(self, targets: dict, samples, fractions, fixed=None):
         fixed = self.problem.fixed if fixed is None else fixed
@@ -263,14 +276,15 @@ class Formulation:
         np.fmax.at(z, self.epi_index, e)
         z = np.where(np.isfinite(z), z, 0.0)
         w = w0.copy()
-        w[self.nx + 2 :] = z + 1e-9 * np.maximum(1.0, np.abs(z))
+        w[self.nx + 2 : self.nx + 2 + self.nz] = z + 1e-9 * np.maximum(1.0, np.abs(z))
         return w
 
     def bounds(self):
         lo = [self.problem.free[k][0] for k in self.free] + [-2 * TWO_PI, -2 * TWO_PI]
         hi = [self.problem.free[k][1] for k in self.free] + [2 * TWO_PI, 3 * TWO_PI]
-        zl = [-np.inf] * self.nz
-        return np.array(lo + zl, float), np.array(hi + [np.inf] * self.nz, float)
+        lo += [-np.inf] * self.nz + [-2 * TWO_PI] * self.n_lift
+        hi += [np.inf] * self.nz + [3 * TWO_PI] * self.n_lift
+        return np.array(lo, float), np.array(hi, float)
 
     def solve(self, w0, p):
         """One IPOPT run: (w, objective, constraint values, stats)."""

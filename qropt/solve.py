@@ -132,18 +132,23 @@ def _certify(problem, form, values, branch, th, z):
     if obj == "max_gamma_min":
         exact = math.cos(g.value)
         info.update(nlp=math.acos(min(1.0, z[0])), certified=g.value, gap=exact - z[0])
-        if exact - z[0] > GAP_TOL:
-            add.append(g.theta2)
+        if exact - z[0] > GAP_TOL:  # every local minimum of every joint below the NLP's value
+            for t, v in m.transmission_minima():
+                add += [float(a) for a, b in sorted(zip(t, v, strict=True), key=lambda q: q[1]) if math.cos(b) > z[0]]
     elif obj == "min_peak_accel":
         peak, t = m.peak_acceleration(1.0, problem.accel_over)
         w2 = problem.omega2**2
         info.update(nlp=z[0] * w2, certified=peak * w2, gap=(peak - z[0]) * w2)
-        if peak - z[0] > GAP_TOL:
+        if peak - z[0] > GAP_TOL:  # every local extreme of the acceleration above the NLP's bound
+            ts, vs = (np.concatenate(x) for x in zip(*m._acceleration_extremes, strict=True))
+            worst = [float(a) for a, b in sorted(zip(ts, vs, strict=True), key=lambda q: -abs(q[1])) if abs(b) > z[0]]
             if problem.accel_over == "working":
                 lo, length = m.working_arc()
-                frac.append(((t - lo) % TWO_PI) / length)
+                frac += [((a - lo) % TWO_PI) / length for a in worst if (a - lo) % TWO_PI <= length] or [
+                    ((t - lo) % TWO_PI) / length
+                ]
             else:
-                add.append(t)
+                add += worst or [t]
     elif obj == "min_size" and problem.size == "footprint":
         box, angles = m.bounding_box()
         exact = (box[1] - box[0]) * (box[3] - box[2])
@@ -170,6 +175,24 @@ def _residuals(problem, form, g, m, targets):
     return res
 
 
+def _peaks(problem, values, branch, th0, orientation):
+    """Initial lifted acceleration extremes: the start design's largest |d2x/dtheta2| (in the working
+    stroke when asked), else spread over the turn."""
+    if problem.objective != "min_peak_accel":
+        return None
+    try:
+        m = build(problem, values, branch)
+        ts, vs = (np.concatenate(x) for x in zip(*m._acceleration_extremes, strict=True))
+    except QroptError:
+        return None
+    order = np.argsort(-np.abs(vs))
+    if problem.accel_over == "working":
+        lo, length = m.working_arc()
+        order = [i for i in order if (ts[i] - lo) % TWO_PI <= length]
+        return [lo + (ts[i] - lo) % TWO_PI for i in order] or None
+    return [float(ts[i]) for i in order]
+
+
 def start_orientation(problem, values, branch):
     """+1 if the start's slow interval runs from theta_max to theta_min (counter-clockwise), -1 if not,
     None if it does not turn fully."""
@@ -180,7 +203,24 @@ def start_orientation(problem, values, branch):
         return None
 
 
-def run_start(problem, values0, branch, targets, max_rounds=12, range_target=None, sense=1, orientation=None):
+def _place(slots, used, new, period, near):
+    """Put new sample angles into the extra slots: an angle close to an extra sample moves it there (the
+    worst angle drifts as the design changes), others take free slots. Returns the slots in use."""
+    for t in new:
+        extra = np.arange(BASE_SAMPLES, used)
+        if extra.size:
+            d = np.abs((slots[extra] - t + period / 2) % period - period / 2)
+            k = int(np.argmin(d))
+            if d[k] < near:
+                slots[extra[k]] = t
+                continue
+        if used < BASE_SAMPLES + EXTRA_SAMPLES:
+            slots[used] = t
+            used += 1
+    return used
+
+
+def run_start(problem, values0, branch, targets, max_rounds=30, range_target=None, sense=1, orientation=None):
     """One local solve with its exchange loop: a dict describing the candidate.
 
     orientation: which way the TR equality is met (+1, -1); None takes the start's own.
@@ -200,7 +240,7 @@ def run_start(problem, values0, branch, targets, max_rounds=12, range_target=Non
     samples, fractions = form.base_samples()
     used, used_f = BASE_SAMPLES, BASE_SAMPLES
     p = form.param_vector(targets, samples, fractions)
-    w = form.epigraph_start(form.pack(values0, th0), p)
+    w = form.epigraph_start(form.pack(values0, th0, phi=_peaks(problem, values0, branch, th0, orientation)), p)
     t_ipopt, iters, statuses, rounds = 0.0, 0, [], 0
     while rounds < max_rounds:
         rounds += 1
@@ -209,20 +249,14 @@ def run_start(problem, values0, branch, targets, max_rounds=12, range_target=Non
         iters += st.get("iter_count", 0)
         statuses.append(st.get("return_status", "?"))
         values = dict(zip(form.free, w[: form.nx].tolist(), strict=True))
-        th, z = w[form.nx : form.nx + 2], w[form.nx + 2 :]
+        th, z = w[form.nx : form.nx + 2], w[form.nx + 2 : form.nx + 2 + form.nz]
         m, info, add, frac = certify(problem, form, values, branch, th, z, targets)
         if not (st.get("success") or statuses[-1] == "Solved_To_Acceptable_Level") and not range_target:
             break
-        add = add[: max(0, EXTRA_SAMPLES - (used - BASE_SAMPLES))]
-        frac = frac[: max(0, EXTRA_SAMPLES - (used_f - BASE_SAMPLES))]
         if not add and not frac:
             break
-        for t in add:
-            samples[used] = t
-            used += 1
-        for t in frac:
-            fractions[used_f] = t
-            used_f += 1
+        used = _place(samples, used, add, TWO_PI, 0.05)
+        used_f = _place(fractions, used_f, frac, 1.0, 0.01)
         p = form.param_vector(targets, samples, fractions)
         w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
     res = _residuals(problem, form, g, m, {k: targets[k] for k in form.targets})
@@ -278,7 +312,7 @@ def _to_result(problem, c, status, message, stats, local=()):
 
 
 def solve(problem: Problem, *, starts_n: int = 8, use_analytic: bool = True, seed: int = 0,
-          targets: dict | None = None, max_rounds: int = 12, extra_starts=()) -> Result:  # fmt: skip
+          targets: dict | None = None, max_rounds: int = 30, extra_starts=()) -> Result:  # fmt: skip
     """Solve a synthesis problem; returns a Result whatever happens (only invalid input raises).
 
     starts_n: Sobol multi-start points; use_analytic: start from every closed form as well;

@@ -292,6 +292,11 @@ class Mechanism:
                     best = GammaMin(float(v[k]), float(t[k]), joint)
         return best
 
+    def transmission_minima(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Every local minimum of every varying joint's transmission angle: [(theta2, value)] per joint (rad)."""
+        self._require_full_turn()
+        return [tv for j, tv in self._cycle["gamma"].items() if tv[0].size]
+
     def gamma_min(self) -> GammaMin:
         """Smallest transmission angle over the full turn and every joint, exact (not a grid sample)."""
         return self._gamma_min
