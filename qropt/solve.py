@@ -3,6 +3,7 @@ an exchange loop for continuous-cycle extremes, and a certificate by exact numer
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import functools
 import itertools
@@ -353,9 +354,11 @@ def solve(problem: Problem, *, starts_n: int = 8, use_analytic: bool = True, see
     outside = [m for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True) if not lo <= targets[k] <= hi]
     if outside:
         return Result("infeasible", "; ".join(outside), stats=stats, reachable=reach)
-    if all(c["ipopt"]["statuses"][-1] == "Infeasible_Problem_Detected" for c in cands):
-        msg = f"every one of {len(cands)} starts ends in IPOPT's local infeasibility: the targets and conditions "
-        msg += "cannot be met together, though each target alone can (" + "; ".join(msgs) + ")"
+    if all(max(c["residuals"].values(), default=0.0) > FEAS_TOL or c["mechanism"] is None for c in cands):
+        ends = collections.Counter(c["ipopt"]["statuses"][-1] for c in cands)
+        how = ", ".join(f"{n} {k}" for k, n in ends.most_common())
+        msg = f"none of {len(cands)} starts reaches a design meeting the targets and conditions together (IPOPT: "
+        msg += f"{how}), though each target alone can be met (" + "; ".join(msgs) + ")"
         return Result("infeasible", msg, stats=stats, reachable=reach)
     why = "; ".join(reasons[:3])
     return Result("failed", f"no start converged to a certified design ({why}); " + "; ".join(msgs), stats=stats,
