@@ -30,8 +30,13 @@ def main(points: int = 1000):
     pts = f.points()
     residual = max(p.residual for p in pts)
     r1 = np.linspace(min(p.params["r1"] for p in pts), max(p.params["r1"] for p in pts), points)
-    sweep = Problem("DragLinkSlider", fixed={**problem.fixed, "r1": float(r1[0])}, free={"r3": problem.free["r3"]},
-                    targets=dict(problem.targets), objective=None)  # fmt: skip
+    sweep = Problem(
+        "DragLinkSlider",
+        fixed={**problem.fixed, "r1": float(r1[0])},
+        free={"r3": problem.free["r3"]},
+        targets=dict(problem.targets),
+        objective=None,
+    )
     solve(sweep, starts_n=0)
     t = time.perf_counter()
     found = 0
@@ -40,10 +45,14 @@ def main(points: int = 1000):
         found += len(r.local_optima)
     t_sweep = time.perf_counter() - t
     per = 1e3 * t_trace / len(pts)
-    print(f"paper family (r1, r3 free, TR 1.5): {len(pts)} traced points in {t_trace:.3f} s ({per:.3f} ms a point), "
-          f"largest residual {residual:.1e}, {len(f.folds)} fold")  # fmt: skip
-    print(f"naive sweep: solve() at {points} values of r1: {t_sweep:.2f} s "
-          f"({1e3 * t_sweep / points:.2f} ms a value), {found} designs")  # fmt: skip
+    print(
+        f"paper family (r1, r3 free, TR 1.5): {len(pts)} traced points in {t_trace:.3f} s ({per:.3f} ms a point), "
+        f"largest residual {residual:.1e}, {len(f.folds)} fold"
+    )
+    print(
+        f"naive sweep: solve() at {points} values of r1: {t_sweep:.2f} s "
+        f"({1e3 * t_sweep / points:.2f} ms a value), {found} designs"
+    )
     print(f"trace / sweep: {t_sweep / t_trace:.1f}x faster")
     out = {
         "date": date.today().isoformat(),

@@ -78,18 +78,28 @@ def slsqp(problem):
                 return np.array(out[1]).ravel(), casadi.DM(out[3]).full()
 
             cons = [
-                {"type": "eq", "fun": lambda w, m=eq, f=form: g_all(w)[0][m] - f.lbg[m],
-                 "jac": lambda w, m=eq: g_all(w)[1][m]},
-                {"type": "ineq", "fun": lambda w, m=lo, f=form: g_all(w)[0][m] - f.lbg[m],
-                 "jac": lambda w, m=lo: g_all(w)[1][m]},
-                {"type": "ineq", "fun": lambda w, m=hi, f=form: f.ubg[m] - g_all(w)[0][m],
-                 "jac": lambda w, m=hi: -g_all(w)[1][m]},
-            ]  # fmt: skip
+                {
+                    "type": "eq",
+                    "fun": lambda w, m=eq, f=form: g_all(w)[0][m] - f.lbg[m],
+                    "jac": lambda w, m=eq: g_all(w)[1][m],
+                },
+                {
+                    "type": "ineq",
+                    "fun": lambda w, m=lo, f=form: g_all(w)[0][m] - f.lbg[m],
+                    "jac": lambda w, m=lo: g_all(w)[1][m],
+                },
+                {
+                    "type": "ineq",
+                    "fun": lambda w, m=hi, f=form: f.ubg[m] - g_all(w)[0][m],
+                    "jac": lambda w, m=hi: -g_all(w)[1][m],
+                },
+            ]
             bounds = list(
                 zip(np.where(np.isfinite(lbx), lbx, None), np.where(np.isfinite(ubx), ubx, None), strict=True)
             )
-            r = minimize(f, w0, jac=df, bounds=bounds, constraints=cons, method="SLSQP",
-                         options={"ftol": 1e-12, "maxiter": 300})  # fmt: skip
+            r = minimize(
+                f, w0, jac=df, bounds=bounds, constraints=cons, method="SLSQP", options={"ftol": 1e-12, "maxiter": 300}
+            )
             if r.success and (best is None or r.fun < best.fun):
                 best = r
     return best
@@ -110,12 +120,14 @@ def main(repeat: int = 15):
         ("closed form (eqs. 7-13 + exact gamma_min)", t_floor, m_floor.params["r3"], math.degrees(g_floor)),
         ("qropt solve(), NLP built once", t_solve, res.params["r3"], math.degrees(res.objective)),
         ("scipy SLSQP, same formulation (no certificate)", t_slsqp, r3_slsqp, math.degrees(g_slsqp)),
-    ]  # fmt: skip
+    ]
     print(f"paper design task: TR 1.5, stroke 0.3 m, max gamma_min (median of {repeat}, ms)")
     for name, t, r3, g in rows:
         print(f"  {name:48s} {t:9.2f} ms  {t / t_floor:7.1f}x floor  r3 = {r3:.10f}  gamma_min {g:.6f} deg")
-    print(f"  solve(): {len(res.local_optima)} local optima, certificate gap {res.certificate['gap']:.1e}, "
-          f"IPOPT {1e3 * res.stats['t_ipopt']:.2f} ms of it")  # fmt: skip
+    print(
+        f"  solve(): {len(res.local_optima)} local optima, certificate gap {res.certificate['gap']:.1e}, "
+        f"IPOPT {1e3 * res.stats['t_ipopt']:.2f} ms of it"
+    )
     print(f"  SLSQP / solve(): {t_slsqp / t_solve:.2f}x")
     out = {
         "date": date.today().isoformat(),
@@ -126,7 +138,7 @@ def main(repeat: int = 15):
             "casadi": casadi.__version__,
             "numpy": np.__version__,
             "scipy": scipy.__version__,
-        },  # fmt: skip
+        },
         "median_ms": {"closed_form": t_floor, "solve": t_solve, "slsqp": t_slsqp},
         "r3": {"closed_form": m_floor.params["r3"], "solve": res.params["r3"], "slsqp": r3_slsqp},
     }

@@ -207,7 +207,20 @@ def parser() -> argparse.ArgumentParser:
     r.add_argument("--json", action="store_true", help="print JSON")
     r.add_argument("--plot", help="PNG file: TR against the parameter (the paper's Fig. 5)")
     r.set_defaults(run=cmd_reachable)
+    sub.add_parser("bench", help="the benchmark suite, from the repository root (options: qropt bench --help)")
     return p
+
+
+def cmd_bench(argv):
+    """Hand over to benchmarks/suite.py of the repository in the current directory."""
+    from pathlib import Path
+
+    if not (Path.cwd() / "benchmarks" / "suite.py").is_file():
+        raise CliError("qropt bench runs from the qropt repository root (benchmarks/ and problems/ are not installed)")
+    sys.path.insert(0, str(Path.cwd()))
+    from benchmarks.suite import main as bench_main
+
+    return bench_main(argv)
 
 
 class _Progress:
@@ -365,7 +378,10 @@ def cmd_synth(args):
 
 
 def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     try:
+        if argv[:1] == ["bench"]:
+            return cmd_bench(argv[1:])
         args = parser().parse_args(argv)
         return args.run(args) or 0
     except CliError as e:

@@ -333,7 +333,8 @@ def solve(problem: Problem, *, starts_n: int = 8, use_analytic: bool = True, see
                 c["origin"] = origin
                 cands.append(c)
     good = [c for c in cands if c["ok"]]
-    stats = {"starts": len(cands), "t_total": None, "formulations": len(_FORMULATIONS)}
+    stats = {"starts": len(cands), "t_total": None, "formulations": len(_FORMULATIONS),
+             "iterations_total": sum(c["ipopt"]["iterations"] for c in cands)}  # fmt: skip
     if good:
         best_first = sorted(_distinct(good), key=lambda c: objective_value(problem, c["q"]) or 0.0,
                             reverse=problem.objective == "max_gamma_min")  # fmt: skip

@@ -1,0 +1,202 @@
+"""The methods the benchmark compares, each a function (problem, seed) -> dict with the free-parameter
+values it returns (or None), its function evaluations and a message. All start from the same points."""
+
+from __future__ import annotations
+
+import importlib
+import math
+
+import numpy as np
+from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
+
+from qropt import QroptError, solve
+from qropt.nlp import slow_interval
+from qropt.solve import branches, build, formulation, start_orientation, starts
+
+STARTS = 8  # Sobol starts for every multi-start method, as qropt's default
+FEASIBLE = 1e-6  # a local method's design counts only if it meets the targets this well
+
+
+def qropt_warm(problem, seed):
+    r = solve(problem, starts_n=STARTS, seed=seed)
+    return _from_result(problem, r)
+
+
+def qropt_cold(problem, seed):
+    r = solve(problem, starts_n=STARTS, seed=seed, use_analytic=False)
+    return _from_result(problem, r)
+
+
+def _from_result(problem, r):
+    values = {k: r.params[k] for k in problem.free} if r.success else None
+    return {
+        "values": values,
+        "nfev": r.stats.get("iterations_total"),
+        "message": r.status,
+        "branch": r.stats.get("branch"),
+    }
+
+
+def _scipy_local(problem, seed, method):
+    """A local scipy method on qropt's NLP functions (exact CasADi derivatives) from qropt's starts, both TR
+    orientations for the space-filling starts; no exchange loop. The best design by exact evaluation."""
+    from problems import _oracle
+
+    best, nfev = None, 0
+    for origin, v in starts(problem, STARTS, seed, True):
+        for br in branches(problem):
+            own = start_orientation(problem, v, br)
+            for way in [own] if origin == "analytic" and own else [1, -1]:
+                form = formulation(problem, br, way)
+                samples, fractions = form.base_samples()
+                p = form.param_vector(dict(problem.targets), samples, fractions)
+                tr = problem.targets.get("time_ratio")
+                try:
+                    d = build(problem, v, br).dead_centres()
+                    t0 = d.theta_max
+                except QroptError:
+                    t0 = 0.5
+                th0 = (t0, t0 + (slow_interval(tr, way) if tr else math.pi))
+                w0 = form.epigraph_start(form.pack(v, th0), p)
+                x, n = _local(form, w0, p, method)
+                nfev += n
+                if x is None:
+                    continue
+                values = dict(zip(form.free, x[: form.nx].tolist(), strict=True))
+                s = _oracle.score(problem, values)
+                feasible = s is not None and violation(problem, s[1]) <= FEASIBLE
+                if feasible and _oracle._better(problem, s[0], best[0] if best else None):
+                    best = (s[0], values, br)
+    return {
+        "values": best[1] if best else None,
+        "nfev": nfev,
+        "message": "best converged start" if best else "none",
+        "branch": best[2] if best else None,
+    }
+
+
+def _local(form, w0, p, method):
+    fn = form.functions
+    lbx, ubx = form.bounds()
+    w0 = np.clip(w0, lbx, ubx)
+    calls = [0]
+
+    def f(w):
+        calls[0] += 1
+        return float(fn(w, p)[0])
+
+    def df(w):
+        return np.array(fn(w, p)[2]).ravel()
+
+    def g(w):
+        return np.array(fn(w, p)[1]).ravel()
+
+    def dg(w):
+        return np.array(fn(w, p)[3])
+
+    bounds = list(zip(np.where(np.isfinite(lbx), lbx, None), np.where(np.isfinite(ubx), ubx, None), strict=True))
+    with np.errstate(all="ignore"):
+        try:
+            if method == "SLSQP":
+                eq = form.lbg == form.ubg
+                lo = ~eq & np.isfinite(form.lbg)
+                hi = ~eq & np.isfinite(form.ubg)
+                cons = [
+                    {"type": "eq", "fun": lambda w: g(w)[eq] - form.lbg[eq], "jac": lambda w: dg(w)[eq]},
+                    {"type": "ineq", "fun": lambda w: g(w)[lo] - form.lbg[lo], "jac": lambda w: dg(w)[lo]},
+                    {"type": "ineq", "fun": lambda w: form.ubg[hi] - g(w)[hi], "jac": lambda w: -dg(w)[hi]},
+                ]
+                r = minimize(
+                    f,
+                    w0,
+                    jac=df,
+                    bounds=bounds,
+                    constraints=cons,
+                    method="SLSQP",
+                    options={"ftol": 1e-12, "maxiter": 300},
+                )
+            else:
+                con = NonlinearConstraint(g, form.lbg, form.ubg, jac=dg)
+                r = minimize(
+                    f,
+                    w0,
+                    jac=df,
+                    bounds=bounds,
+                    constraints=[con],
+                    method="trust-constr",
+                    options={"gtol": 1e-10, "xtol": 1e-12, "maxiter": 200},
+                )
+        except (ValueError, np.linalg.LinAlgError):
+            return None, calls[0]
+    return (r.x if np.all(np.isfinite(r.x)) else None), calls[0]
+
+
+def scipy_slsqp(problem, seed):
+    return _scipy_local(problem, seed, "SLSQP")
+
+
+def scipy_trust_constr(problem, seed):
+    return _scipy_local(problem, seed, "trust-constr")
+
+
+def scipy_de(problem, seed):
+    """differential_evolution over the free parameters: exact objective plus a penalty on target and
+    condition violations (a design that does not work scores 1e6)."""
+    from problems import _oracle
+
+    names = list(problem.free)
+    sign = -1.0 if problem.objective == "max_gamma_min" else 1.0
+    calls = [0]
+
+    def f(x):
+        calls[0] += 1
+        values = dict(zip(names, x.tolist(), strict=True))
+        s = _oracle.score(problem, values)
+        if s is None:
+            return 1e6
+        obj, q = s
+        return sign * (obj or 0.0) + 1e3 * violation(problem, q)
+
+    r = differential_evolution(
+        f, [problem.free[k] for k in names], seed=seed, popsize=10, maxiter=40, tol=1e-12, polish=False, init="sobol"
+    )
+    ok = r.fun < 1e5
+    return {
+        "values": dict(zip(names, r.x.tolist(), strict=True)) if ok else None,
+        "nfev": calls[0],
+        "message": r.message,
+        "branch": None,
+    }
+
+
+def violation(problem, q) -> float:
+    """Largest violation of a design's targets (relative for lengths) and gamma_min bound."""
+    v = 0.0
+    for k, t in problem.targets.items():
+        got = q.get(k, q.get("swing") if k == "swing" else None)
+        v = max(v, abs(got - t) / (abs(t) if k == "stroke" else 1.0))
+    bound = problem.conditions.get("gamma_min")
+    if bound is not None:
+        v = max(v, bound - q["gamma_min"])
+    return v
+
+
+def pylinkage_pso(problem, seed):
+    """pylinkage's own particle swarm on a linkage built in pylinkage (four-bars and slider-cranks)."""
+    try:
+        pl = importlib.import_module("pylinkage")
+    except ImportError:
+        return {"values": None, "nfev": None, "message": "not installed", "branch": None}
+    from benchmarks import pylinkage_adapter
+
+    return pylinkage_adapter.run(pl, problem, seed)
+
+
+METHODS = {
+    "qropt": qropt_warm,
+    "qropt-cold": qropt_cold,
+    "scipy-slsqp": scipy_slsqp,
+    "scipy-trust-constr": scipy_trust_constr,
+    "scipy-de": scipy_de,
+    "pylinkage": pylinkage_pso,
+}
