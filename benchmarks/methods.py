@@ -158,7 +158,7 @@ def scipy_de(problem, seed):
         return sign * (obj or 0.0) + 1e3 * violation(problem, q)
 
     r = differential_evolution(
-        f, [problem.free[k] for k in names], seed=seed, popsize=10, maxiter=40, tol=1e-12, polish=False, init="sobol"
+        f, [problem.free[k] for k in names], seed=seed, popsize=10, maxiter=25, tol=1e-12, polish=False, init="sobol"
     )
     ok = r.fun < 1e5
     return {

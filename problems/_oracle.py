@@ -65,7 +65,8 @@ def along(problem, design, lo, hi, n=400, boundary=None):
     i = int(np.argmin(vals))
     if math.isfinite(vals[i]):
         a, b = ts[max(i - 1, 0)], ts[min(i + 1, n - 1)]
-        r = minimize_scalar(f, bounds=(a, b), method="bounded", options={"xatol": 1e-13})
+        with np.errstate(invalid="ignore"):  # a neighbour may not work (score inf): Brent copes
+            r = minimize_scalar(f, bounds=(a, b), method="bounded", options={"xatol": 1e-13})
         cands.append((r.fun, r.x))
     if boundary is not None:
         m = np.array([boundary(t) for t in ts])

@@ -1,0 +1,50 @@
+"""The benchmark suite on a small subset: the tables' structure, and qropt meets every oracle there."""
+
+from __future__ import annotations
+
+import csv
+import importlib
+import json
+
+from benchmarks import suite
+from benchmarks.methods import METHODS
+
+
+def test_suite_subset(tmp_path, capsys):
+    rc = suite.main(["--problems", "seed001_redesign", "--methods", "qropt", "scipy-slsqp", "pylinkage",
+                     "--out", str(tmp_path)])  # fmt: skip
+    assert rc == 0
+    data = json.loads((tmp_path / "results.json").read_text())
+    assert {"meta", "summary", "oracles", "rows"} <= set(data)
+    assert {"date", "machine", "python", "versions", "repeat", "seed"} <= set(data["meta"])
+    rows = data["rows"]
+    assert [r["method"] for r in rows] == ["qropt", "scipy-slsqp", "pylinkage"]
+    q = rows[0]
+    assert q["status"] == "meets oracle" and q["success"] and q["error"] <= 1e-9 and q["violation"] <= 1e-9
+    # pylinkage does not model crank-shapers (or is not installed): the column says which
+    assert rows[2]["status"] in ("not applicable", "not installed") and rows[2]["success"] is None
+    with open(tmp_path / "results.csv") as fh:
+        table = list(csv.DictReader(fh))
+    assert len(table) == 3 and {"problem", "method", "status", "objective", "oracle", "error", "violation",
+                                "seconds", "nfev"} <= set(table[0])  # fmt: skip
+    md = (tmp_path / "results.md").read_text()
+    assert "| method | problems | meets oracle | median time [s] | median time / qropt |" in md
+    assert "| qropt | 1 | 100% |" in md
+
+
+def test_every_problem_declares_an_oracle():
+    names = suite.problem_names()
+    assert len(names) >= 20
+    kinds = set()
+    for n in names:
+        mod = importlib.import_module(f"problems.{n}")
+        assert mod.ORACLE["kind"] in ("closed form", "grid") and 0 < mod.ORACLE["tolerance"] <= 1e-6
+        p = mod.build()
+        kinds.add((p.mechanism.__name__, p.objective))
+    types = {k for k, _ in kinds}
+    assert types == {"SliderCrank", "CrankShaper", "Whitworth", "CrankRockerSlider", "DragLinkSlider", "FourBar"}
+    for t in types:  # every type by every objective that applies to it
+        objectives = {o for k, o in kinds if k == t}
+        need = {"max_gamma_min", "min_size"} | (set() if t == "FourBar" else {"min_peak_accel"})
+        assert need <= objectives, (t, objectives)
+    assert set(METHODS) == {"qropt", "qropt-cold", "scipy-slsqp", "scipy-trust-constr", "scipy-de", "pylinkage"}
