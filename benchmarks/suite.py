@@ -68,7 +68,10 @@ def run(names, methods, repeat=1, seed=0, progress=True):
             times, out = [], None
             for _ in range(repeat):
                 t = time.perf_counter()
-                out = METHODS[method](problem, seed)
+                try:
+                    out = METHODS[method](problem, seed)
+                except Exception as e:  # noqa: BLE001 - a method that crashes is a result, reported as such
+                    out = {"values": None, "nfev": None, "message": f"error: {type(e).__name__}: {e}"[:120]}
                 times.append(time.perf_counter() - t)
             done += 1
             if progress:

@@ -1,6 +1,14 @@
 """qropt: optimisation-based dimensional synthesis of quick-return mechanisms."""
 
-from qropt.errors import AssemblyError, GrashofError, InvalidParameter, NoDeadCentres, ProblemError, QroptError
+from qropt.errors import (
+    AssemblyError,
+    DegenerateMechanism,
+    GrashofError,
+    InvalidParameter,
+    NoDeadCentres,
+    ProblemError,
+    QroptError,
+)
 from qropt.mechanisms import (
     CrankRockerSlider,
     CrankShaper,
@@ -35,5 +43,6 @@ __all__ = [
     "GrashofError",
     "AssemblyError",
     "NoDeadCentres",
+    "DegenerateMechanism",
     "ProblemError",
 ]

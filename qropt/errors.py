@@ -42,5 +42,9 @@ class NoDeadCentres(QroptError):
     """The output has no extremes over a crank turn (for example a drag-link follower)."""
 
 
+class DegenerateMechanism(QroptError):
+    """A quantity is undefined because the mechanism sits on a singular configuration over its whole turn."""
+
+
 class ProblemError(QroptError):
     """A synthesis problem is malformed: unknown names, empty or contradictory bounds, no free parameter."""

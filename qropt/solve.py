@@ -13,7 +13,7 @@ import time
 import numpy as np
 from scipy.stats import qmc
 
-from qropt import analytic, cycle
+from qropt import analytic
 from qropt.errors import AssemblyError, QroptError
 from qropt.mechanisms import FourBar
 from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, TWO_PI, Formulation, slow_interval
@@ -176,7 +176,7 @@ def _residuals(problem, form, g, m, targets):
     return res
 
 
-def _peaks(problem, values, branch, th0, orientation):
+def _peaks(problem, values, branch):
     """Initial lifted acceleration extremes: the start design's largest |d2x/dtheta2| (in the working
     stroke when asked), else spread over the turn."""
     if problem.objective != "min_peak_accel":
@@ -241,7 +241,7 @@ def run_start(problem, values0, branch, targets, max_rounds=30, range_target=Non
     samples, fractions = form.base_samples()
     used, used_f = BASE_SAMPLES, BASE_SAMPLES
     p = form.param_vector(targets, samples, fractions)
-    w = form.epigraph_start(form.pack(values0, th0, phi=_peaks(problem, values0, branch, th0, orientation)), p)
+    w = form.epigraph_start(form.pack(values0, th0, phi=_peaks(problem, values0, branch)), p)
     t_ipopt, iters, statuses, rounds = 0.0, 0, [], 0
     while rounds < max_rounds:
         rounds += 1
@@ -406,4 +406,4 @@ def target_range(problem, target, targets=None, *, starts_n=8, seed=0):
     return float(min(seen)), float(max(seen))
 
 
-__all__ = ["solve", "target_range", "formulation", "quantities", "cycle"]
+__all__ = ["solve", "target_range", "formulation", "quantities"]

@@ -18,7 +18,7 @@ import numpy as np
 
 from qropt import cycle
 from qropt.closures import RIGHT_ANGLE, transmission_angle
-from qropt.errors import AssemblyError, InvalidParameter, NoDeadCentres
+from qropt.errors import AssemblyError, DegenerateMechanism, InvalidParameter, NoDeadCentres
 from qropt.ops import JET, NUMPY, Jet
 
 REQUIRED = object()
@@ -290,6 +290,15 @@ class Mechanism:
                 k = ok[np.argmin(v[ok])]
                 if best is None or v[k] < best.value:
                     best = GammaMin(float(v[k]), float(t[k]), joint)
+        if best is None:  # no finite refined minimum: a singular configuration; fall back to the grid
+            th = cycle.grid()
+            for joint, g in self.transmission_angles(th).items():
+                if np.isfinite(g).any():
+                    k = int(np.nanargmin(g))
+                    if best is None or g[k] < best.value:
+                        best = GammaMin(float(g[k]), float(th[k]), joint)
+        if best is None:
+            raise DegenerateMechanism(f"{self!r}: no transmission angle is defined over the turn")
         return best
 
     def transmission_minima(self) -> list[tuple[np.ndarray, np.ndarray]]:
