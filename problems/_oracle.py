@@ -78,6 +78,11 @@ def along(problem, design, lo, hi, n=400, boundary=None):
     return {"objective": sign * v if math.isfinite(v) else None, "params": design(t)}
 
 
+def paper(problem):
+    """The best closed-form design of the paper's linkage (r1, r2, r4 = 0.1, 0.225, 0.275 m) for a problem."""
+    return best_of(problem, drag_link(problem, 0.1, 0.225, 0.275, problem.targets["stroke"]))
+
+
 def drag_link(problem, r1, r2, r4, stroke):
     """Closed-form designs of the drag-link slider (h = 0): every root of eqs. (7)-(13), r5 = stroke / 2."""
     tr = problem.targets["time_ratio"]

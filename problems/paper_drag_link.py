@@ -18,5 +18,4 @@ def build():
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'} (the best of eqs. 7-13's roots)."""
-    p = build()
-    return _oracle.best_of(p, _oracle.drag_link(p, 0.1, 0.225, 0.275, 0.3))
+    return _oracle.paper(build())

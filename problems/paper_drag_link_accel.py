@@ -3,24 +3,15 @@
 Oracle: closed form, eqs. (7)-(13): the best of its roots (peak acceleration evaluated exactly)."""
 
 from problems import _oracle
-from qropt import Problem
+from qropt.examples import paper_problem
 
-ORACLE = {"kind": "closed form", "tolerance": 1e-08}
+ORACLE = {"kind": "closed form", "tolerance": 1e-8}
 
 
-def build() -> Problem:
-    return Problem(
-        mechanism="DragLinkSlider",
-        fixed={"r1": 0.1, "r2": 0.225, "r4": 0.275, "r6": 0.3},
-        free={"r3": (0.05, 1.0), "r5": (0.01, 0.5)},
-        targets={"time_ratio": 1.5, "stroke": 0.3},
-        objective="min_peak_accel",
-        omega2=10.0,
-        name="paper_drag_link_accel",
-    )
+def build():
+    return paper_problem().replace(objective="min_peak_accel", omega2=10.0, name="paper_drag_link_accel")
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    p = build()
-    return _oracle.best_of(p, _oracle.drag_link(p, 0.1, 0.225, 0.275, 0.3))
+    return _oracle.paper(build())
