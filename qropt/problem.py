@@ -68,11 +68,6 @@ class Problem:
     def _err(self, msg):
         return ProblemError(f"{self.name or self.mechanism.__name__}: {msg}")
 
-    @property
-    def names(self) -> list[str]:
-        """Every parameter of this problem's mechanism, in the type's order."""
-        return [k for k in self.mechanism.PARAMS if k in self.fixed or k in self.free]
-
     def _check_free(self):
         cls, params = self.mechanism, self.mechanism.PARAMS
         if not self.free:
