@@ -2,23 +2,15 @@
 
 Oracle: grid along the closed-form family, refined."""
 
-from problems import _oracle
-from qropt import Problem
+from problems import _bases
 
-ORACLE = {"kind": "grid", "tolerance": 1e-06}
+ORACLE = {"kind": "grid", "tolerance": 1e-6}
 
 
-def build() -> Problem:
-    return Problem(
-        mechanism="SliderCrank",
-        free={"r2": (0.05, 0.3), "r3": (0.1, 1.5), "e": (0.0, 0.6)},
-        targets={"time_ratio": 1.3, "stroke": 0.3},
-        objective="min_peak_accel",
-        name="slider_crank_accel",
-    )
+def build():
+    return _bases.slider_crank(objective="min_peak_accel", name="slider_crank_accel")
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    p = build()
-    return _oracle.along(p, _oracle.slider_crank_family(1.3, 0.3), 0.0501, 0.14999)
+    return _bases.slider_crank_oracle(build())

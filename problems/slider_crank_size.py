@@ -4,30 +4,19 @@ Oracle: grid along the closed-form family; the gamma_min boundary located by bre
 
 import math
 
-from problems import _oracle
-from qropt import Problem
+from problems import _bases, _oracle
 
-ORACLE = {"kind": "grid", "tolerance": 1e-07}
+ORACLE = {"kind": "grid", "tolerance": 1e-7}
 
 
-def build() -> Problem:
-    return Problem(
-        mechanism="SliderCrank",
-        free={"r2": (0.05, 0.3), "r3": (0.1, 1.5), "e": (0.0, 0.6)},
-        targets={"time_ratio": 1.3, "stroke": 0.3},
-        conditions={"gamma_min": math.radians(30)},
-        objective="min_size",
-        name="slider_crank_size",
+def build():
+    return _bases.slider_crank(
+        conditions={"gamma_min": math.radians(30)}, objective="min_size", name="slider_crank_size"
     )
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
     p = build()
-    design = _oracle.slider_crank_family(1.3, 0.3)
-
-    def margin(r2):
-        s = _oracle.score(p.replace(conditions={}), design(r2))
-        return -1.0 if s is None else s[1]["gamma_min"] - math.radians(30)
-
-    return _oracle.along(p, design, 0.0501, 0.14999, boundary=margin)
+    margin = _bases.gamma_margin(p, _oracle.slider_crank_family(1.3, 0.3), math.radians(30))
+    return _bases.slider_crank_oracle(p, boundary=margin)
