@@ -9,14 +9,11 @@ Run: ``python -m benchmarks.family``.
 from __future__ import annotations
 
 import importlib
-import json
-import platform
 import time
-from datetime import date
-from pathlib import Path
 
 import numpy as np
 
+from benchmarks.report import save
 from qropt import Problem, solve
 from qropt.family import family
 
@@ -54,16 +51,14 @@ def main(points: int = 1000):
         f"({1e3 * t_sweep / points:.2f} ms a value), {found} designs"
     )
     print(f"trace / sweep: {t_sweep / t_trace:.1f}x faster")
-    out = {
-        "date": date.today().isoformat(),
-        "machine": platform.platform(),
-        "trace": {"points": len(pts), "seconds": t_trace, "max_residual": residual, "folds": len(f.folds)},
-        "sweep": {"values": points, "seconds": t_sweep, "designs": found},
-        "speedup": t_sweep / t_trace,
-    }
-    path = Path(__file__).parent / "results" / "family.json"
-    path.parent.mkdir(exist_ok=True)
-    path.write_text(json.dumps(out, indent=2) + "\n")
+    save(
+        "family.json",
+        {
+            "trace": {"points": len(pts), "seconds": t_trace, "max_residual": residual, "folds": len(f.folds)},
+            "sweep": {"values": points, "seconds": t_sweep, "designs": found},
+            "speedup": t_sweep / t_trace,
+        },
+    )
 
 
 if __name__ == "__main__":

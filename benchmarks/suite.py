@@ -13,19 +13,13 @@ import fnmatch
 import importlib
 import json
 import math
-import platform
 import statistics
 import sys
 import time
-from datetime import date
 from pathlib import Path
 
-import casadi
-import numpy as np
-import scipy
-
-import qropt
 from benchmarks.methods import METHODS, violation
+from benchmarks.report import environment
 
 ROOT = Path(__file__).resolve().parent.parent
 FEASIBLE = 1e-6  # largest accepted violation of a target (relative for lengths) or condition
@@ -201,25 +195,7 @@ def main(argv=None):
     t0 = time.perf_counter()
     rows, oracles = run(names, args.methods, args.repeat, args.seed)
     summ = summary(rows, args.methods)
-    try:
-        pyl = importlib.import_module("pylinkage").__version__
-    except ImportError:
-        pyl = "not installed"
-    meta = {
-        "date": date.today().isoformat(),
-        "machine": f"{platform.platform()} ({platform.machine()})",
-        "python": platform.python_version(),
-        "repeat": args.repeat,
-        "seed": args.seed,
-        "seconds": time.perf_counter() - t0,
-        "versions": {
-            "qropt": qropt.__version__,
-            "casadi": casadi.__version__,
-            "scipy": scipy.__version__,
-            "numpy": np.__version__,
-            "pylinkage": pyl,
-        },
-    }
+    meta = {**environment(), "repeat": args.repeat, "seed": args.seed, "seconds": time.perf_counter() - t0}
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "results.md").write_text(markdown(rows, summ, meta))

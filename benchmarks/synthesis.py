@@ -10,20 +10,16 @@ Run: ``python -m benchmarks.synthesis``.
 from __future__ import annotations
 
 import importlib
-import json
 import math
-import platform
 import statistics
 import time
-from datetime import date
-from pathlib import Path
 
 import casadi
 import numpy as np
-import scipy
 from scipy.optimize import minimize
 
 import qropt
+from benchmarks.report import save
 from qropt import DragLinkSlider, analytic
 from qropt.solve import branches, formulation, start_orientation, starts
 
@@ -129,22 +125,13 @@ def main(repeat: int = 15):
         f"IPOPT {1e3 * res.stats['t_ipopt']:.2f} ms of it"
     )
     print(f"  SLSQP / solve(): {t_slsqp / t_solve:.2f}x")
-    out = {
-        "date": date.today().isoformat(),
-        "machine": platform.platform(),
-        "python": platform.python_version(),
-        "versions": {
-            "qropt": qropt.__version__,
-            "casadi": casadi.__version__,
-            "numpy": np.__version__,
-            "scipy": scipy.__version__,
+    save(
+        "synthesis.json",
+        {
+            "median_ms": {"closed_form": t_floor, "solve": t_solve, "slsqp": t_slsqp},
+            "r3": {"closed_form": m_floor.params["r3"], "solve": res.params["r3"], "slsqp": r3_slsqp},
         },
-        "median_ms": {"closed_form": t_floor, "solve": t_solve, "slsqp": t_slsqp},
-        "r3": {"closed_form": m_floor.params["r3"], "solve": res.params["r3"], "slsqp": r3_slsqp},
-    }
-    path = Path(__file__).parent / "results" / "synthesis.json"
-    path.parent.mkdir(exist_ok=True)
-    path.write_text(json.dumps(out, indent=2) + "\n")
+    )
 
 
 if __name__ == "__main__":
