@@ -79,7 +79,6 @@ class Formulation:
         params = {k: X[i] for i, k in enumerate(self.free)}
         params.update({k: PF[i] for i, k in enumerate(self.fixed)})
         params.update(self.branch)
-        self.params = params
         t = casadi.SX.sym("t")
         lp = cls.loop(CASADI, t, params)
         four_bar = issubclass(cls, (FourBar, FourBarSlider))

@@ -144,9 +144,7 @@ class Jet:
     def __pow__(self, n):
         if n == 2:
             return self * self
-        if n == 0.5:
-            return _jsqrt(self)
-        raise ValueError("Jet supports only the powers 2 and 0.5")
+        raise ValueError("Jet supports only the power 2 (use the namespace's sqrt)")
 
     def __lt__(self, o):
         return self.v < _val(o)

@@ -155,3 +155,11 @@ def test_unknown_type_and_grashof_error_attributes():
 def test_drag_link_four_bar_has_no_swing():
     with pytest.raises(qropt.NoDeadCentres):
         qropt.FourBar(r1=0.1, r2=0.225, r3=0.25, r4=0.275).swing()
+
+
+def test_mechanisms_are_immutable_and_keep_their_cached_results():
+    m = qropt.DragLinkSlider(**PAPER)
+    tr = m.time_ratio()
+    with pytest.raises(AttributeError, match="immutable"):
+        m.params = {}
+    assert m.time_ratio() == tr and m.params["r3"] == 0.2504

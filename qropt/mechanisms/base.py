@@ -132,9 +132,7 @@ class Mechanism:
                 raise AssemblyError(name, self.params, failures)
 
     def __setattr__(self, k, v):
-        if k in type(self).__dict__ and isinstance(type(self).__dict__[k], cached_property):
-            object.__setattr__(self, k, v)
-            return
+        # cached properties write to __dict__ directly, so only user assignments arrive here
         raise AttributeError(f"{type(self).__name__} is immutable")
 
     def __repr__(self):
