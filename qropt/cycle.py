@@ -117,12 +117,6 @@ def extremes_many(fun, specs, n: int = GRID, xtol: float = 0.0):
     return out, g[:, 0]
 
 
-def extremes(fun, kind, n: int = GRID, xtol: float = 0.0):
-    """All local maxima or minima of fun over a turn: (theta2 in [0, 2pi), values)."""
-    (res,), _ = extremes_many(lambda t: stack([fun(t)], np.shape(t.v)), [(0, kind)], n, xtol)
-    return res
-
-
 def difference_jet(values, h: float = 1e-4):
     """A function of theta -> values as a jet fun(theta_jet) with central-difference derivatives.
 
@@ -137,16 +131,6 @@ def difference_jet(values, h: float = 1e-4):
         return Jet.of(f0, (fp - fm) / (2 * h), (fp - 2 * f0 + fm) / (h * h))
 
     return fun
-
-
-def minimum(fun, n: int = GRID):
-    """The global minimum of fun over a turn: (theta2, value); nan, nan if fun has no minimum."""
-    t, v = extremes(fun, "min", n)
-    ok = np.isfinite(v)
-    if not ok.any():
-        return float("nan"), float("nan")
-    k = np.flatnonzero(ok)[np.argmin(v[ok])]
-    return float(t[k]), float(v[k])
 
 
 def negative_intervals(margin, n: int = 3600):

@@ -20,7 +20,7 @@ import numpy as np
 
 from qropt.errors import ProblemError, QroptError
 from qropt.problem import Problem
-from qropt.solve import branches, formulation, quantities, solve, start_orientation, starts
+from qropt.solve import branches, build, formulation, quantities, solve, starts
 
 NEWTON_TOL = 1e-12
 
@@ -145,13 +145,9 @@ class _Curve:
         for k in range(iters):
             if extra is None:
                 f, j = self.eval_fj(u)
-                g = None
+                r, a = np.append(f, t @ (u - pred)), np.vstack([j, t])
             else:
                 f, j, g = self.eval(u)
-            if extra is None:
-                r = np.append(f, t @ (u - pred))
-                a = np.vstack([j, t])
-            else:
                 e, de = extra(u, g, j)
                 r, a = np.append(f, e), np.vstack([j, de])
             if not np.all(np.isfinite(r)) or not np.all(np.isfinite(a)):
@@ -163,8 +159,8 @@ class _Curve:
             u = u + du
             if np.max(np.abs(du)) <= NEWTON_TOL * max(1.0, np.max(np.abs(u))) and np.max(np.abs(f)) < 1e-9:
                 f, j, g = self.eval(u)  # one more step: the residual falls to rounding level
-                r = np.append(f, 0.0) if extra is None else np.append(f, extra(u, g, j)[0])
-                a = np.vstack([j, t]) if extra is None else np.vstack([j, extra(u, g, j)[1]])
+                e, de = (0.0, t) if extra is None else extra(u, g, j)
+                r, a = np.append(f, e), np.vstack([j, de])
                 with np.errstate(all="ignore"):
                     u2 = u + np.linalg.solve(a, -r)
                 f2 = self.eval_fj(u2)[0]
@@ -176,13 +172,13 @@ class _Curve:
     def project(self, u, iters=30):
         """Gauss-Newton onto F = 0 (minimal-norm steps): the nearest curve point, or None."""
         for _ in range(iters):
-            f, j, g = self.eval(u)
+            f, j = self.eval_fj(u)
             if not np.all(np.isfinite(f)) or not np.all(np.isfinite(j)):
                 return None
             du = -np.linalg.lstsq(j, f, rcond=None)[0]
             u = u + du
             if np.max(np.abs(du)) <= NEWTON_TOL * max(1.0, np.max(np.abs(u))):
-                f, _, _ = self.eval(u)
+                f, _ = self.eval_fj(u)
                 return u if np.max(np.abs(f)) <= 1e-10 else None
         return None
 
@@ -215,7 +211,7 @@ def family(problem: Problem, along: str | None = None, *, ds: float | None = Non
             for direction in (1.0, -1.0):
                 pts, end, fl = _trace(curve, u0, direction, ds_max, max_points, ia, progress)
                 halves.append((pts, end))
-                folds += [(c, br, u) for c, _, u in fl]
+                folds += [(curve, br, u) for u in fl]
             (back, end0), (fwd, end1) = halves[1], halves[0]
             us = back[::-1] + fwd[1:]
             if len(us) < 2:
@@ -228,7 +224,7 @@ def family(problem: Problem, along: str | None = None, *, ds: float | None = Non
     out = []
     for curve, br, us in traced:
         s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(np.array(us), axis=0), axis=1))])
-        res = [float(np.max(np.abs(curve.eval(u)[0]))) for u in us]
+        res = [float(np.max(np.abs(curve.eval_fj(u)[0]))) for u in us]
         out.append([FamilyPoint(problem, _params(problem, curve, u, br), (u[-2], u[-1]), float(a), r)
                     for u, a, r in zip(us, s, res, strict=True)])  # fmt: skip
     fold_params = [_params(problem, c, u, br) for c, br, u in folds]
@@ -241,14 +237,11 @@ def _params(problem, curve, u, br):
 
 def _seed(problem, curve, values, br, way):
     try:
-        m = problem.build(values, br)
+        m = build(problem, values, br)
         d = m.dead_centres()
-        a, b = m.stroke_angles()
-        th = (d.theta_max, d.theta_max + (a if way > 0 else a))
+        th = (d.theta_max, d.theta_max + m.stroke_angles()[0])
     except QroptError:
         return None
-    if start_orientation(problem, values, br) != way:
-        th = (d.theta_max, d.theta_max + a)
     u = np.array([values[k] for k in curve.free] + list(th), float)
     u = curve.project(u)
     if (
@@ -270,7 +263,7 @@ def _on_traced(u, traced, ds_max):
 
 
 def _trace(curve, u0, direction, ds_max, max_points, ia, progress):
-    """Follow the curve from u0 one way: (points, end reason, folds)."""
+    """Follow the curve from u0 one way: (points, end reason, fold points)."""
     f, j, g = curve.eval(u0)
     t = curve.tangent(j, np.eye(curve.n)[ia] * direction + 1e-3)
     t = t * np.sign(t[ia] * direction) if t[ia] != 0 else t
@@ -316,7 +309,7 @@ def _trace(curve, u0, direction, ds_max, max_points, ia, progress):
         if np.sign(tn[ia]) != np.sign(t[ia]) and t[ia] != 0:
             fold = _fold(curve, u, t, ds, ia)
             if fold is not None:
-                folds.append((curve, None, fold))
+                folds.append(fold)
         if len(pts) > 10 and np.linalg.norm(un[:nf] - pts[0][:nf]) < 0.5 * ds and np.dot(tn[:nf], t[:nf]) > 0:
             pts.append(pts[0])
             return pts, "closed loop", folds

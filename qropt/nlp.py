@@ -14,6 +14,7 @@ Fixed parameters and targets are CasADi parameters too.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -96,7 +97,6 @@ class Formulation:
             [t, X, PF],
             [lp.x, dx, ddx, casadi.vertcat(*cos_all, 0), casadi.vertcat(*margins, 0), casadi.vertcat(*coords), dddx],
         )
-        self.kin = kin
         n_exact = len(self.exact_joints)
 
         def at(theta):
@@ -162,15 +162,20 @@ class Formulation:
         g = casadi.vertcat(*[r.expr for r in rows])
         self.w_sym, self.p_sym, self.g_sym = w, p, g
         self.solver = casadi.nlpsol("qropt", "ipopt", {"x": w, "p": p, "f": f, "g": g}, IPOPT)
-        # the same NLP as plain functions with exact derivatives, for other solvers (benchmarks)
-        self.functions = casadi.Function(
-            "fg", [w, p], [f, g, casadi.gradient(f, w), casadi.jacobian(g, w)], ["w", "p"], ["f", "g", "df", "dg"]
-        )
+        self._f = f
         self.epi_fun = casadi.Function("epi", [w, p], [casadi.vertcat(*[e for _, e in epi], 0)])
         self.epi_index = np.array([zi for zi, _ in epi], int)
         self.lbg = np.array([r.lb for r in rows], float)
         self.ubg = np.array([r.ub for r in rows], float)
         self.nx, self.nz = len(self.free), len(self.z_names)
+
+    @functools.cached_property
+    def functions(self):
+        """The same NLP as plain functions (f, g, df, dg) with exact derivatives, for other solvers."""
+        w, p, f, g = self.w_sym, self.p_sym, self._f, self.g_sym
+        return casadi.Function(
+            "fg", [w, p], [f, g, casadi.gradient(f, w), casadi.jacobian(g, w)], ["w", "p"], ["f", "g", "df", "dg"]
+        )
 
     # ---- pieces --------------------------------------------------------------
     @staticmethod

@@ -27,17 +27,18 @@ GAP_TOL = 1e-8  # certified minus NLP epigraph value that ends the exchange loop
 
 def _key(problem: Problem, branch, orientation, range_target, sense):
     c = problem.conditions
-    cond = (c.get("grashof"), c.get("gamma_min") is not None, repr(c.get("linear")), repr(c.get("ratio")))
+    cond = (c.get("grashof"), c.get("gamma_min"), repr(c.get("linear")), repr(c.get("ratio")))
     return (problem.mechanism, tuple(problem.free), tuple(problem.fixed), tuple(problem.targets), cond,
             problem.objective, problem.size, problem.accel_over, tuple(sorted(branch.items())), orientation,
-            range_target, sense, c.get("gamma_min"))  # fmt: skip
+            range_target, sense)  # fmt: skip
 
 
 def formulation(problem, branch, orientation, range_target=None, sense=1) -> Formulation:
-    """The NLP of this problem structure, built once and reused (new targets/fixed values are parameters)."""
+    """The NLP of this problem structure, built once and reused: fixed values, targets and samples are CasADi
+    parameters, and the free bounds are read from the problem at solve time."""
     key = _key(problem, branch, orientation, range_target, sense)
     f = _FORMULATIONS.get(key)
-    if f is None or f.problem.free != problem.free:
+    if f is None:
         f = _FORMULATIONS[key] = Formulation(problem, branch, orientation, range_target, sense)
     f.problem = problem
     return f
@@ -221,6 +222,11 @@ def _place(slots, used, new, period, near):
     return used
 
 
+def _converged(stats) -> bool:
+    """IPOPT solved the NLP (to its tolerance, or to its acceptable level)."""
+    return bool(stats.get("success")) or stats.get("return_status") == "Solved_To_Acceptable_Level"
+
+
 def run_start(problem, values0, branch, targets, max_rounds=30, range_target=None, sense=1, orientation=None):
     """One local solve with its exchange loop: a dict describing the candidate.
 
@@ -252,7 +258,7 @@ def run_start(problem, values0, branch, targets, max_rounds=30, range_target=Non
         values = dict(zip(form.free, w[: form.nx].tolist(), strict=True))
         th, z = w[form.nx : form.nx + 2], w[form.nx + 2 : form.nx + 2 + form.nz]
         m, info, add, frac = certify(problem, form, values, branch, th, z, targets)
-        if not (st.get("success") or statuses[-1] == "Solved_To_Acceptable_Level") and not range_target:
+        if not _converged(st) and not range_target:
             break
         if not add and not frac:
             break
@@ -261,12 +267,8 @@ def run_start(problem, values0, branch, targets, max_rounds=30, range_target=Non
         p = form.param_vector(targets, samples, fractions)
         w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
     res = _residuals(problem, form, g, m, {k: targets[k] for k in form.targets})
-    ok = (
-        bool(info.get("ok"))
-        and st.get("success", False)
-        or (bool(info.get("ok")) and statuses[-1] == "Solved_To_Acceptable_Level")
-    )
-    ok = ok and max(res.values(), default=0.0) <= FEAS_TOL and info.get("gap", 0.0) <= max(GAP_TOL, 1e-6 * 0)
+    ok = bool(info.get("ok")) and _converged(st)
+    ok = ok and max(res.values(), default=0.0) <= FEAS_TOL and info.get("gap", 0.0) <= GAP_TOL
     return {
         "ok": ok,
         "q": quantities(problem, m) if ok else None,

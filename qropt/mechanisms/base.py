@@ -229,7 +229,9 @@ class Mechanism:
             grid_min = (
                 np.nanmin(on_grid[1 + len(varying) + k]) if np.isfinite(on_grid[1 + len(varying) + k]).any() else 0.0
             )
-            margins.append(min(grid_min, np.nanmin(v, initial=np.inf)))
+            k_min = int(np.nanargmin(v)) if np.isfinite(v).any() else None
+            refined = v[k_min] if k_min is not None else np.inf
+            margins.append((min(grid_min, refined), float(t[k_min]) if k_min is not None else 0.0))
         return {"max": res[0], "min": res[1], "gamma": gammas, "margins": margins}
 
     def _require_full_turn(self):
@@ -397,21 +399,15 @@ class Mechanism:
         """(closure, theta2_from, theta2_to) intervals (rad) where the loop cannot close; [] if it turns fully."""
         lp = self.evaluate(NUMPY, np.zeros(1))
         for k, (what, _) in enumerate(lp.margins):
-            if not self._cycle["margins"][k] < -cycle.MARGIN_TOL:
+            least, at = self._cycle["margins"][k]
+            if not least < -cycle.MARGIN_TOL:
                 continue
 
             def margin(t, k=k):
                 return np.asarray(self.evaluate(NUMPY, t).margins[k][1], float) + 0 * t
 
             found = cycle.negative_intervals(margin)
-            if not found:  # a failure narrower than the check grid: around the refined minimum
-                t, v = self._cycle_margin_argmin(k)
-                found = [(t, t)]
+            if not found:  # a failure narrower than the check grid: at the refined minimum
+                found = [(at, at)]
             return [(what, lo, hi) for lo, hi in found]
         return []
-
-    def _cycle_margin_argmin(self, k):
-        def margin(t):
-            return self.evaluate(JET, t).margins[k][1]
-
-        return cycle.minimum(margin)
