@@ -1,5 +1,6 @@
 """qropt: optimisation-based dimensional synthesis of quick-return mechanisms."""
 
+from qropt.certify import Certificate
 from qropt.errors import (
     AssemblyError,
     DegenerateMechanism,
@@ -9,6 +10,7 @@ from qropt.errors import (
     ProblemError,
     QroptError,
 )
+from qropt.family import Family, family
 from qropt.mechanisms import (
     CrankRockerSlider,
     CrankShaper,
@@ -20,8 +22,9 @@ from qropt.mechanisms import (
     mechanism_type,
 )
 from qropt.problem import Problem
-from qropt.result import Result
-from qropt.solve import solve, target_range
+from qropt.reachable import Reachable, reachable
+from qropt.result import STATUSES, Result
+from qropt.solve import Solver, solve, target_range
 
 __version__ = "0.1.0"
 
@@ -35,7 +38,14 @@ __all__ = [
     "grashof",
     "Problem",
     "Result",
+    "STATUSES",
+    "Certificate",
+    "Solver",
     "solve",
+    "family",
+    "Family",
+    "reachable",
+    "Reachable",
     "target_range",
     "mechanism_type",
     "QroptError",

@@ -250,8 +250,24 @@ def crank_rocker_design(time_ratio: float, swing: float, r1: float, position: fl
 
 
 # ---- warm starts ----------------------------------------------------------------------------------
-def warm_starts(problem) -> list[dict]:
-    """Free-parameter values from every closed form that applies to a problem (others at mid-bounds).
+class WarmStarts(NamedTuple):
+    """Free-parameter values from the closed forms that apply to a problem.
+
+    kind: 'enumeration' (the points are every solution of the targets within the problem's structure),
+    'family' (points along a closed-form one-parameter family that holds every solution, in order),
+    'partial' (starting points only) or 'none'; how: which closed form, in words.
+    """
+
+    points: list
+    kind: str
+    how: str
+
+
+FAMILY_POINTS = 17  # closed-form family points scanned when a family holds every solution
+
+
+def warm_starts(problem) -> WarmStarts:
+    """Starts from every closed form that applies to a problem (other free parameters at mid-bounds).
 
     Each start is verified later by the solver; a start that does not build is dropped there.
     """
@@ -260,6 +276,7 @@ def warm_starts(problem) -> list[dict]:
     cls, fixed, free, tg = problem.mechanism, problem.fixed, problem.free, problem.targets
     val = {**fixed, **{k: 0.5 * (lo + hi) for k, (lo, hi) in free.items()}}
     tr, stroke = tg.get("time_ratio"), tg.get("stroke")
+    square = len(free) == len(tg)
     out = []
 
     def emit(**set_):
@@ -267,10 +284,15 @@ def warm_starts(problem) -> list[dict]:
             v = {**val, **set_}
             out.append({k: v[k] for k in free})
 
+    def result(kind, how):
+        return WarmStarts(out, kind if out else "none", how if out else "no closed form applies")
+
     if cls is DragLinkSlider and tr is not None and "r3" in free and fixed.get("h", 0.0) == 0.0:
         r5 = {"r5": stroke / 2} if stroke is not None and "r5" in free else {}
         for s in drag_link_r3(tr, val["r1"], val["r2"], val["r4"]):
             emit(r3=s.r3, **r5)
+        exact = square and set(free) <= {"r3", "r5"} and ("r5" not in free or fixed.get("r6", 0.0) > stroke / 2)
+        return result("enumeration" if exact else "partial", "eqs. (7)-(13) give every r3 for the TR; r5 = stroke/2")
     if cls is CrankShaper and tr is not None:
         ratio = crank_shaper_ratio(tr)
         lever = {"r4": stroke / (2 * ratio)} if stroke is not None and "r4" in free else {}
@@ -280,23 +302,43 @@ def warm_starts(problem) -> list[dict]:
             emit(r1=val["r2"] / ratio, **lever)
         elif stroke is not None and "r4" in free:
             emit(r4=stroke * val["r1"] / (2 * val["r2"]))
+        exact = square and "r6" not in fixed and "r6" not in free
+        return result("enumeration" if exact else "partial", "sin(beta) = r2/r1 fixes the TR; stroke = 2 r4 r2/r1")
     if cls is Whitworth and tr is not None and fixed.get("h", 0.0) == 0.0:
         ratio = whitworth_ratio(tr)
         r5 = {"r5": stroke / 2} if stroke is not None and "r5" in free else {}
-        if "r2" in free:
-            emit(r2=val["r1"] / ratio, **r5)
-        elif "r1" in free:
-            emit(r1=ratio * val["r2"], **r5)
-        elif r5:
-            emit(**r5)
+        rod = "r6" in free and "r5" in free and not square
+        sweep = list(np.geomspace(*free["r6"], FAMILY_POINTS)) if rod else [val.get("r6")]
+        for r6 in sweep:
+            extra = {"r6": r6} if rod else {}
+            if "r2" in free:
+                emit(r2=val["r1"] / ratio, **r5, **extra)
+            elif "r1" in free:
+                emit(r1=ratio * val["r2"], **r5, **extra)
+            elif r5:
+                emit(**r5, **extra)
+        how = "sin(beta) = r1/r2 fixes the TR; stroke = 2 r5 (rod longer than r5)"
+        if square and stroke is not None and fixed.get("r6", 0.0) > stroke / 2:
+            return result("enumeration", how)
+        if rod and len(free) == len(tg) + 1 and stroke is not None:
+            return result("family", how + "; the rod r6 walks the family")
+        return result("partial", how)
     if cls is SliderCrank and tr is not None and stroke is not None:
-        crank = [val["r2"]] if "r2" not in free else list(np.linspace(*free["r2"], 7)[1:-1])
+        family = "r2" in free and len(free) == 3
+        crank = [val["r2"]] if "r2" not in free else list(np.geomspace(*free["r2"], FAMILY_POINTS if family else 7))
         for r2 in crank:
             for d in slider_crank_design(tr, stroke, r2):
                 emit(**{k: getattr(d, k) for k in ("r2", "r3", "e") if k in free})
+        how = "the stroke triangle (sides r3 + r2, r3 - r2, angle phi of eq. 7) gives r3 and e for each r2"
+        if square and set(free) == {"r3", "e"}:
+            return result("enumeration", how)
+        return result("family" if family else "partial", how + "; r2 walks the family")
     if cls is FourBar and tr is not None and "swing" in tg:
-        for pos in np.linspace(0.04, 0.46, 7):
+        family = set(free) == {"r2", "r3", "r4"}
+        for pos in np.linspace(0.01, 0.49, FAMILY_POINTS) if family else np.linspace(0.04, 0.46, 7):
             d = crank_rocker_design(tr, tg["swing"], val["r1"], float(pos))
             if d is not None:
                 emit(**{k: getattr(d, k) for k in ("r2", "r3", "r4") if k in free})
-    return out
+        how = "the classical crank-rocker construction (O2 on the circle that sees the rocker chord under phi)"
+        return result("family" if family else "partial", how)
+    return result("none", "")

@@ -80,3 +80,12 @@ def transmission_cos(xp, lines):
         return 0.0
     (ux, uy), (wx, wy) = lines
     return (ux * wx + uy * wy) / xp.sqrt((ux * ux + uy * uy) * (wx * wx + wy * wy))
+
+
+def transmission_cos2(xp, lines):
+    """Squared cosine of the angle between a joint's lines (smooth; 0 for RIGHT_ANGLE): gamma = acos(sqrt(.))."""
+    if lines is None:
+        return 0.0
+    (ux, uy), (wx, wy) = lines
+    d = ux * wx + uy * wy
+    return d * d / ((ux * ux + uy * uy) * (wx * wx + wy * wy))

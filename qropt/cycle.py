@@ -8,19 +8,29 @@ safeguarded by false position inside the bracket.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from qropt.ops import Jet
 
 TWO_PI = 2.0 * np.pi
 GRID = 720
+GRIDS = (180, 720, 2880)  # grids tried in turn for the compiled analysis (the first that resolves)
 MARGIN_TOL = 1e-12  # an assembly margin this far below zero is rounding (a change point), not a failure
 FD_XTOL = 1e-10
 
 
+@functools.lru_cache(maxsize=16)
+def _grid(n: int) -> np.ndarray:
+    g = TWO_PI * np.arange(n) / n
+    g.flags.writeable = False
+    return g
+
+
 def grid(n: int = GRID) -> np.ndarray:
-    """n crank angles 0, 2pi/n, ... (radians), including 0 and pi for even n."""
-    return TWO_PI * np.arange(n) / n
+    """n crank angles 0, 2pi/n, ... (radians), including 0 and pi for even n (a read-only array)."""
+    return _grid(n)
 
 
 def jet_of(fun, theta):

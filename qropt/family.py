@@ -18,9 +18,11 @@ from functools import cached_property
 import casadi
 import numpy as np
 
+from qropt import starts as starts_
+from qropt.certify import quantities
 from qropt.errors import ProblemError, QroptError
 from qropt.problem import Problem
-from qropt.solve import branches, build, formulation, quantities, solve, starts
+from qropt.solve import DEFAULT, Solver
 
 NEWTON_TOL = 1e-12
 
@@ -90,7 +92,7 @@ class Family:
 
         top = sorted(chosen, key=score, reverse=True)[:3]
         free = list(self.problem.free)
-        return solve(
+        return DEFAULT.solve(
             problem, starts_n=0, use_analytic=False, extra_starts=[{k: p.params[k] for k in free} for p in top]
         )
 
@@ -98,8 +100,8 @@ class Family:
 class _Curve:
     """F, its Jacobian and the inequality rows of one problem structure, as fast CasADi functions."""
 
-    def __init__(self, problem, branch, orientation):
-        self.form = form = formulation(problem.replace(objective=None), branch, orientation)
+    def __init__(self, problem, branch, orientation, solver):
+        self.form = form = solver.formulation(problem.replace(objective=None), branch, orientation)
         n = form.nx + 2
         u = form.w_sym[:n]
         eq = np.flatnonzero(form.lbg == form.ubg)
@@ -184,12 +186,22 @@ class _Curve:
 
 
 def family(problem: Problem, along: str | None = None, *, ds: float | None = None, max_points: int = 5000,
-           starts_n: int = 8, seed: int = 0, progress=None) -> Family:  # fmt: skip
+           starts_n: int = 8, seed: int = 0, progress=None, solver: Solver | None = None) -> Family:  # fmt: skip
     """Trace every branch of a one-parameter family of designs.
 
     along: the parameter in which folds are counted (default: the first free one); ds: the largest
-    arclength step (default 1/200 of the free box's diagonal); progress: callable(points traced).
+    arclength step (default 1/200 of the free box's diagonal); progress: callable(points traced);
+    solver: whose formulations to use (default ``qropt.solve.DEFAULT``).
     """
+    if not isinstance(problem, Problem):
+        raise ProblemError(f"family takes a qropt.Problem, got {type(problem).__name__}")
+    if ds is not None and not (isinstance(ds, (int, float)) and not isinstance(ds, bool) and 0 < ds < math.inf):
+        raise ProblemError(f"ds is the largest arclength step, a positive number; got {ds!r}")
+    if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
+        raise ProblemError(f"max_points must be an integer >= 2, got {max_points!r}")
+    if progress is not None and not callable(progress):
+        raise ProblemError("progress must be a callable(points traced) or None")
+    solver = solver or DEFAULT
     n_free, n_targets = len(problem.free), len(problem.targets)
     if n_free != n_targets + 1:
         raise ProblemError(f"a family needs one more free parameter than targets: {n_free} free, {n_targets} targets")
@@ -199,11 +211,11 @@ def family(problem: Problem, along: str | None = None, *, ds: float | None = Non
     box = np.array([hi - lo for lo, hi in problem.free.values()])
     ds_max = ds or float(np.linalg.norm(box)) / 200
     traced, ends, folds, n_points = [], [], [], 0
-    seeds = starts(problem, starts_n, seed, True)
-    for br, way in itertools.product(branches(problem), (1, -1)):
-        curve = _Curve(problem, br, way)
+    seeds = list(starts_.plan(problem).analytic) + starts_.sobol(problem, starts_n, seed)
+    for br, way in itertools.product(starts_.branches(problem), (1, -1)):
+        curve = _Curve(problem, br, way, solver)
         ia = curve.free.index(along)
-        for _, v in seeds:
+        for v in seeds:
             u0 = _seed(problem, curve, v, br, way)
             if u0 is None or _on_traced(u0, traced, ds_max):
                 continue
@@ -237,7 +249,7 @@ def _params(problem, curve, u, br):
 
 def _seed(problem, curve, values, br, way):
     try:
-        m = build(problem, values, br)
+        m = problem.build(values, br)
         d = m.dead_centres()
         th = (d.theta_max, d.theta_max + m.stroke_angles()[0])
     except QroptError:

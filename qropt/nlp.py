@@ -26,9 +26,9 @@ from qropt.mechanisms import CrankShaper, FourBar, FourBarSlider, SliderCrank, W
 from qropt.ops import CASADI
 
 TWO_PI = 2.0 * math.pi
-BASE_SAMPLES = 24
+BASE_SAMPLES = 8  # uniform sample angles of the epigraphs; the exchange loop adds what binds
 LIFTED = 2  # lifted acceleration extremes for min_peak_accel
-EXTRA_SAMPLES = 24
+EXTRA_SAMPLES = 8  # slots for the exchange loop's angles
 IPOPT = {
     "ipopt.print_level": 0,
     "ipopt.sb": "yes",
@@ -36,7 +36,8 @@ IPOPT = {
     "record_time": True,
     "ipopt.tol": 1e-12,
     "ipopt.acceptable_tol": 1e-9,
-    "ipopt.max_iter": 150,
+    "ipopt.max_iter": 60,
+    "ipopt.mu_strategy": "adaptive",
     "ipopt.bound_relax_factor": 0.0,
     "show_eval_warnings": False,
     "calc_lam_p": False,
@@ -63,13 +64,16 @@ class Formulation:
     minimises, -1 maximises); used for reachable ranges.
     """
 
-    def __init__(self, problem, branch: dict, orientation: int, range_target: str | None = None, sense: int = 1):
+    def __init__(self, problem, branch: dict, orientation: int, range_target: str | None = None, sense: int = 1,
+                 base_samples: int = BASE_SAMPLES, extra_samples: int = EXTRA_SAMPLES,
+                 ipopt: dict | None = None):  # fmt: skip
         self.problem, self.branch, self.orientation = problem, dict(branch), orientation
         self.range_target, self.sense = range_target, sense
         cls = problem.mechanism
         self.free, self.fixed = list(problem.free), list(problem.fixed)
         self.targets = [k for k in problem.targets if k != range_target]
-        self.n_samples = BASE_SAMPLES + EXTRA_SAMPLES
+        self.n_base, self.n_extra = base_samples, extra_samples
+        self.n_samples = base_samples + extra_samples
         X = casadi.SX.sym("x", len(self.free))
         TH = casadi.SX.sym("th", 2)
         PF = casadi.SX.sym("pf", len(self.fixed))
@@ -161,7 +165,7 @@ class Formulation:
         p = casadi.vertcat(PF, PT, S, W)
         g = casadi.vertcat(*[r.expr for r in rows])
         self.w_sym, self.p_sym, self.g_sym = w, p, g
-        self.solver = casadi.nlpsol("qropt", "ipopt", {"x": w, "p": p, "f": f, "g": g}, IPOPT)
+        self.solver = casadi.nlpsol("qropt", "ipopt", {"x": w, "p": p, "f": f, "g": g}, {**IPOPT, **(ipopt or {})})
         self._f = f
         self.epi_fun = casadi.Function("epi", [w, p], [casadi.vertcat(*[e for _, e in epi], 0)])
         self.epi_index = np.array([zi for zi, _ in epi], int)
@@ -251,12 +255,11 @@ class Formulation:
         return casadi.SX(0)
 
     # ---- numbers -------------------------------------------------------------
-    @staticmethod
-    def base_samples():
+    def base_samples(self):
         """(angles, working-arc fractions): uniform in the base slots; the extra slots repeat the first."""
-        angles = TWO_PI * np.arange(BASE_SAMPLES) / BASE_SAMPLES
-        fractions = np.linspace(0.0, 1.0, BASE_SAMPLES)
-        pad = np.zeros(EXTRA_SAMPLES)
+        angles = TWO_PI * np.arange(self.n_base) / self.n_base
+        fractions = np.linspace(0.0, 1.0, self.n_base)
+        pad = np.zeros(self.n_extra)
         return np.concatenate([angles, pad]), np.concatenate([fractions, pad])
 
     def pack(self, values: dict, th, z=None, phi=None):
@@ -297,6 +300,13 @@ class Formulation:
         r = self.solver(x0=w0, p=p, lbx=lbx, ubx=ubx, lbg=self.lbg, ubg=self.ubg)
         st = self.solver.stats()
         return np.array(r["x"]).ravel(), float(r["f"]), np.array(r["g"]).ravel(), st
+
+    @functools.cached_property
+    def square_rows(self) -> np.ndarray | None:
+        """Indices of the equality rows in the free parameters and dead centres (targets, zero velocity), if
+        they are as many as those unknowns: the system a closed-form enumeration is polished on."""
+        rows = [i for i, r in enumerate(self.rows) if r.lb == r.ub and not r.name.startswith("lifted")]
+        return np.array(rows, int) if len(rows) == self.nx + 2 else None
 
     def violations(self, g):
         """Named constraint violations (>= 0) of constraint values g."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
@@ -53,6 +54,15 @@ class Adjustable:
     alternatives: list = field(default_factory=list)
 
 
+class Range(NamedTuple):
+    """The smallest and largest value of a quantity and the parameter values where they occur."""
+
+    low: float
+    low_at: float
+    high: float
+    high_at: float
+
+
 @dataclass
 class Reachable:
     """TR and stroke over one free parameter (the others from a mechanism)."""
@@ -63,8 +73,8 @@ class Reachable:
     grid: np.ndarray
     tr: np.ndarray
     stroke: np.ndarray
-    time_ratio_range: tuple  # (min, at, max, at)
-    stroke_range: tuple
+    time_ratio_range: Range | tuple
+    stroke_range: Range | tuple
 
     def _tr_at(self, x):
         return _evaluate(self.base, self.free, x)[0]
@@ -181,14 +191,23 @@ def reachable(mechanism: Mechanism, free: str = "r3", bounds: tuple | None = Non
     bounds: the parameter's interval; without it a four-bar link's interval follows from the type's
     Grashof class. TR extremes are refined (bounded Brent) and interval ends located by bisection.
     """
-    if free not in mechanism.params or free.startswith("sigma"):
+    if not isinstance(mechanism, Mechanism):
+        raise InvalidParameter(
+            f"reachable takes a mechanism (e.g. qropt.examples.paper_mechanism()), got {type(mechanism).__name__}"
+        )
+    if not isinstance(free, str) or free not in mechanism.params or free.startswith("sigma"):
         raise InvalidParameter(f"{type(mechanism).__name__} has no continuous parameter {free!r}")
+    if isinstance(n, bool) or not isinstance(n, int) or not 3 <= n <= 100_000:
+        raise InvalidParameter(f"n (scan points) must be an integer in [3, 100000], got {n!r}")
     if bounds is None:
         if not (isinstance(mechanism, (FourBar, FourBarSlider)) and free in LINKS):
             raise InvalidParameter(f"give bounds for {free}: only a four-bar link's interval follows from Grashof")
         bounds = _grashof_interval(mechanism, free)
-    lo, hi = (float(b) for b in bounds)
-    if not lo < hi:
+    try:
+        lo, hi = (float(b) for b in bounds)
+    except (TypeError, ValueError):
+        raise InvalidParameter(f"bounds of {free} must be two numbers (low, high), got {bounds!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
         raise InvalidParameter(f"empty interval for {free}: ({lo:g}, {hi:g})")
     grid = np.linspace(lo, hi, n)
     vals = np.array([_evaluate(mechanism, free, x) for x in grid])
@@ -220,7 +239,8 @@ def reachable(mechanism: Mechanism, free: str = "r3", bounds: tuple | None = Non
     if not ext:
         raise InvalidParameter(f"no value of {free} in ({lo:g}, {hi:g}) gives a working {type(mechanism).__name__}")
     (tmin, xmin), (tmax, xmax) = min(ext), max(ext)
-    r.time_ratio_range = (tmin, xmin, tmax, xmax)
-    s = stroke[np.isfinite(stroke)]
-    r.stroke_range = (float(s.min()), float(s.max()))
+    r.time_ratio_range = Range(tmin, xmin, tmax, xmax)
+    ok = np.flatnonzero(np.isfinite(stroke))
+    i, j = ok[np.argmin(stroke[ok])], ok[np.argmax(stroke[ok])]
+    r.stroke_range = Range(float(stroke[i]), float(grid[i]), float(stroke[j]), float(grid[j]))
     return r

@@ -1,239 +1,392 @@
-"""solve(problem) -> Result: IPOPT from analytic warm starts and a space-filling multi-start,
-an exchange loop for continuous-cycle extremes, and a certificate by exact numeric evaluation."""
+"""The Solver: a synthesis problem -> a certified Result. ``qropt.solve`` is its documented default instance.
+
+A solve walks down once: starts (closed forms first: a complete enumeration replaces the multi-start,
+a closed-form family is scanned and only its best points refined; otherwise a Sobol multi-start), a
+local solve per start (IPOPT on the problem's Formulation, with an exchange loop that adds the crank
+angles where the exact analysis disagrees with the NLP's samples), a certificate by exact evaluation,
+and a Result with every distinct local optimum, best first.
+"""
 
 from __future__ import annotations
 
-import collections
 import contextlib
-import functools
-import itertools
 import math
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.stats import qmc
 
-from qropt import analytic
-from qropt.errors import AssemblyError, QroptError
-from qropt.mechanisms import FourBar
+from qropt import starts as starts_
+from qropt.certify import Certificate, better, certify, objective_of, objective_value, quantities, residuals
+from qropt.errors import ProblemError, QroptError
 from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, TWO_PI, Formulation, slow_interval
 from qropt.problem import Problem
 from qropt.result import Result
 
-_FORMULATIONS: dict = {}
-FEAS_TOL = 1e-8  # largest accepted constraint violation (lengths, radians)
-GAP_TOL = 1e-8  # certified minus NLP epigraph value that ends the exchange loop
+TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
+ACCEPTABLE = "Solved_To_Acceptable_Level"
 
 
-def _key(problem: Problem, branch, orientation, range_target, sense):
-    c = problem.conditions
-    cond = (c.get("grashof"), c.get("gamma_min"), repr(c.get("linear")), repr(c.get("ratio")))
-    return (problem.mechanism, tuple(problem.free), tuple(problem.fixed), tuple(problem.targets), cond,
-            problem.objective, problem.size, problem.accel_over, tuple(sorted(branch.items())), orientation,
-            range_target, sense)  # fmt: skip
+@dataclass
+class Candidate:
+    """One local solve's outcome (internal): the design, its certificate data and IPOPT's statistics."""
+
+    ok: bool
+    values: dict
+    branch: dict
+    orientation: int
+    mechanism: object = None
+    info: dict = field(default_factory=dict)
+    residuals: dict = field(default_factory=dict)
+    statuses: list = field(default_factory=list)
+    iterations: int = 0
+    t_ipopt: float = 0.0
+    rounds: int = 0
+    origin: str = ""
+    q: dict | None = None
 
 
-def formulation(problem, branch, orientation, range_target=None, sense=1) -> Formulation:
-    """The NLP of this problem structure, built once and reused: fixed values, targets and samples are CasADi
-    parameters, and the free bounds are read from the problem at solve time."""
-    key = _key(problem, branch, orientation, range_target, sense)
-    f = _FORMULATIONS.get(key)
-    if f is None:
-        f = _FORMULATIONS[key] = Formulation(problem, branch, orientation, range_target, sense)
-    f.problem = problem
-    return f
+class Solver:
+    """Owns the NLP formulations (built once per problem structure) and the options of every solve.
 
+    tolerances: {'feasibility': largest accepted violation, 'gap': certified minus NLP epigraph value that
+    ends the exchange loop}; ipopt_options: merged into IPOPT's (names as CasADi takes them, 'ipopt.tol');
+    samples: uniform epigraph sample angles per formulation (the exchange loop adds up to ``extra`` more);
+    starts_n, seed: the Sobol multi-start used where no closed form enumerates the solutions.
+    Results do not depend on what the Solver solved before: formulations take every value as a parameter.
+    """
 
-@functools.lru_cache(maxsize=256)
-def _build(problem, values: tuple, branch: tuple):
-    return problem.build(dict(values), dict(branch))
+    def __init__(self, *, tolerances: dict | None = None, ipopt_options: dict | None = None, samples: int = BASE_SAMPLES,
+                 extra: int = EXTRA_SAMPLES, starts_n: int = 8, seed: int = 0, max_rounds: int = 30):  # fmt: skip
+        tol = {**TOLERANCES, **(tolerances or {})}
+        if set(tol) != set(TOLERANCES) or not all(_positive(v) for v in tol.values()):
+            raise ProblemError(f"tolerances are positive numbers for {sorted(TOLERANCES)}, got {tolerances!r}")
+        for name, v, lo in (("samples", samples, 2), ("extra", extra, 1), ("starts_n", starts_n, 0),
+                            ("max_rounds", max_rounds, 1)):  # fmt: skip
+            if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+                raise ProblemError(f"Solver: {name} must be an integer >= {lo}, got {v!r}")
+        if ipopt_options is not None and not isinstance(ipopt_options, dict):
+            raise ProblemError(f"Solver: ipopt_options must be a dict, got {ipopt_options!r}")
+        self.tolerances, self.ipopt_options = tol, dict(ipopt_options or {})
+        self.samples, self.extra, self.starts_n, self.seed, self.max_rounds = samples, extra, starts_n, seed, max_rounds
+        self._formulations: dict = {}
 
+    def __repr__(self):
+        return (f"Solver(tolerances={self.tolerances}, samples={self.samples}, extra={self.extra}, "
+                f"starts_n={self.starts_n}, formulations built={len(self._formulations)})")  # fmt: skip
 
-def build(problem, values: dict, branch: dict):
-    """problem.build, cached (mechanisms are immutable): a start is built once for all its uses."""
-    return _build(problem, tuple(sorted(values.items())), tuple(sorted(branch.items())))
+    # ---- formulations ----------------------------------------------------------------------------
+    def formulation(self, problem: Problem, branch: dict, orientation: int, range_target=None, sense=1) -> Formulation:
+        """The NLP of this problem structure, built once: fixed values, targets and samples are CasADi
+        parameters, and the free bounds are read from the problem at solve time."""
+        c = problem.conditions
+        cond = (c.get("grashof"), c.get("gamma_min"), repr(c.get("linear")), repr(c.get("ratio")))
+        key = (problem.mechanism, tuple(problem.free), tuple(problem.fixed), tuple(problem.targets), cond,
+               problem.objective, problem.size, problem.accel_over, tuple(sorted(branch.items())), orientation,
+               range_target, sense)  # fmt: skip
+        f = self._formulations.get(key)
+        if f is None:
+            f = self._formulations[key] = Formulation(problem, branch, orientation, range_target, sense,
+                                                      self.samples, self.extra, self.ipopt_options)  # fmt: skip
+        f.problem = problem
+        return f
 
+    @property
+    def formulations(self) -> int:
+        """How many NLPs this Solver has built."""
+        return len(self._formulations)
 
-def branches(problem):
-    names = list(problem.branches)
-    return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*problem.branches.values())]
+    # ---- one local solve -------------------------------------------------------------------------
+    def local(self, problem, values0, branch, targets, *, orientation=None, max_rounds=None, range_target=None,
+              sense=1) -> Candidate:  # fmt: skip
+        """IPOPT from values0 with the exchange loop; orientation: which way the TR equality is met (+1, -1),
+        None for the start's own."""
+        max_rounds = self.max_rounds if max_rounds is None else max_rounds
+        th0, orientation = _dead_centre_start(problem, values0, branch, targets, orientation, range_target)
+        form = self.formulation(problem, branch, orientation, range_target, sense)
+        samples, fractions = form.base_samples()
+        used = used_f = form.n_base
+        p = form.param_vector(targets, samples, fractions)
+        w = form.epigraph_start(form.pack(values0, th0, phi=_peaks(problem, values0, branch)), p)
+        c = Candidate(False, dict(values0), branch, orientation)
+        gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
+        st, g, info, m = {}, None, {}, None
+        while c.rounds < max_rounds:
+            c.rounds += 1
+            w, f, g, st = form.solve(w, p)
+            c.t_ipopt += st.get("t_wall_total", 0.0)
+            c.iterations += st.get("iter_count", 0)
+            c.statuses.append(st.get("return_status", "?"))
+            c.values = dict(zip(form.free, w[: form.nx].tolist(), strict=True))
+            th, z = w[form.nx : form.nx + 2], w[form.nx + 2 : form.nx + 2 + form.nz]
+            m, info, add, frac = certify(problem, range_target, c.values, branch, th, z, f, gap_tol, feas_tol)
+            if not _converged(st) and not range_target:
+                break
+            if not add and not frac:
+                break
+            used = _place(samples, used, add, TWO_PI, 0.05, form.n_base)
+            used_f = _place(fractions, used_f, frac, 1.0, 0.01, form.n_base)
+            p = form.param_vector(targets, samples, fractions)
+            w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
+        c.mechanism, c.info = m, info
+        c.residuals = residuals(problem, form.violations(g), m, {k: targets[k] for k in form.targets})
+        c.ok = bool(info.get("ok")) and _converged(st) and _within(c, self.tolerances)
+        return c
 
+    def polish(self, problem, values0, branch, targets) -> Candidate:
+        """Newton on the target and dead-centre equations from a closed-form point of a square problem (as many
+        free parameters as targets): the point of the finite solution set that the closed form names."""
+        th0, orientation = _dead_centre_start(problem, values0, branch, targets, None, None)
+        form = self.formulation(problem, branch, orientation)
+        rows = form.square_rows
+        if rows is None:
+            return self.local(problem, values0, branch, targets, orientation=orientation)
+        p = form.param_vector(targets, *form.base_samples())
+        w = form.pack(values0, th0)
+        n = form.nx + 2
+        c = Candidate(False, dict(values0), branch, orientation, origin="enumeration")
+        for _ in range(30):
+            out = form.functions(w, p)
+            r = np.array(out[1]).ravel()[rows] - form.lbg[rows]
+            jac = np.array(out[3])[np.ix_(rows, np.arange(n))]
+            try:
+                step = np.linalg.solve(jac, r)
+            except np.linalg.LinAlgError:
+                break
+            w[:n] -= step
+            c.iterations += 1
+            if np.max(np.abs(step)) <= 1e-14 * max(1.0, np.max(np.abs(w[:n]))):
+                break
+        c.values = dict(zip(form.free, w[: form.nx].tolist(), strict=True))
+        w = form.epigraph_start(w, p)
+        g = np.array(form.functions(w, p)[1]).ravel()
+        tol = self.tolerances
+        m, info, _, _ = certify(problem, None, c.values, branch, w[form.nx : n], None, None, tol["gap"],
+                                tol["feasibility"])  # fmt: skip
+        c.mechanism, c.info, c.statuses = m, info, ["enumerated point (Newton)"]
+        c.residuals = residuals(problem, form.violations(g), m, {k: targets[k] for k in form.targets})
+        inside = all(lo - 1e-12 <= c.values[k] <= hi + 1e-12 for k, (lo, hi) in problem.free.items())
+        c.ok = bool(info.get("ok")) and inside and _within(c, tol)
+        return c
 
-def starts(problem, n: int, seed: int, use_analytic: bool) -> list[tuple[str, dict]]:
-    """Analytic starts first, then a scrambled Sobol design over the free bounds (log-spaced for lengths)."""
+    # ---- the solve ---------------------------------------------------------------------------------
+    def solve(self, problem: Problem, *, starts_n: int | None = None, use_analytic: bool = True,
+              seed: int | None = None, targets: dict | None = None, max_rounds: int | None = None,
+              extra_starts=()) -> Result:  # fmt: skip
+        """Solve a synthesis problem; returns a Result whatever happens (only invalid input raises).
 
-    def clip(v):
-        return {k: min(max(x, problem.free[k][0]), problem.free[k][1]) for k, x in v.items()}
+        starts_n: Sobol points where no closed form enumerates the solutions (default the Solver's);
+        use_analytic: use the closed forms; targets: new values for some targets (the NLP is not rebuilt);
+        extra_starts: more starting points (free-parameter dicts), tried first.
+        """
+        t0 = time.perf_counter()
+        problem, targets, extra, starts_n, seed, max_rounds = self._check(
+            problem, targets, extra_starts, starts_n, seed, max_rounds
+        )
+        plan = starts_.plan(problem, use_analytic)
+        runs = [("given", v) for v in extra]
+        cands: list[Candidate] = []
+        claim = ""
+        if plan.kind == "enumeration" and not extra:
+            for v in plan.analytic:
+                for br in starts_.branches(problem):
+                    cands.append(self.polish(problem, v, br, targets))
+            claim = f"by enumeration: {plan.how}"
+        elif plan.kind == "family" and not extra:
+            runs += self._family_starts(problem, plan)
+            claim = (
+                f"best along a closed-form family that holds every solution ({plan.how}; {len(plan.analytic)} points)"
+            )
+        else:
+            runs += [("analytic", v) for v in plan.analytic] + [("multistart", v) for v in
+                                                                 starts_.sobol(problem, starts_n, seed)]  # fmt: skip
+        for origin, v, *br in runs:
+            for b in br or starts_.branches(problem):
+                own = starts_.orientation(problem, v, b)
+                ways = [own] if origin != "multistart" and own else [1, -1]
+                for way in ways:
+                    c = self.local(problem, v, b, targets, orientation=way, max_rounds=max_rounds)
+                    c.origin = origin
+                    cands.append(c)
+        good = [c for c in cands if c.ok]
+        if plan.kind == "enumeration" and not extra and not good:  # the closed form missed: search instead
+            return self.solve(problem, starts_n=starts_n, use_analytic=False, seed=seed, targets=targets,
+                              max_rounds=max_rounds)  # fmt: skip
+        stats = {"starts": len(cands), "plan": plan.kind, "formulations": self.formulations,
+                 "ipopt_runs": sum(len(c.statuses) for c in cands if c.origin != "enumeration"),
+                 "iterations_total": sum(c.iterations for c in cands),
+                 "t_ipopt": sum(c.t_ipopt for c in cands)}  # fmt: skip
+        if good:
+            for c in good:
+                c.q = quantities(problem, c.mechanism)
+            best_first = sorted(_distinct(good), key=lambda c: objective_value(problem, c.q) or 0.0,
+                                reverse=problem.objective == "max_gamma_min")  # fmt: skip
+            k = len(best_first)
+            claim = claim or f"best of {k} distinct local optima from {len(cands)} starts"
+            stats.update(t_total=time.perf_counter() - t0, local_optima=k)
+            local = [self._result(problem, c, "local_optimum" if i else None, claim, stats)
+                     for i, c in enumerate(best_first)]  # fmt: skip
+            return self._result(problem, best_first[0], None, claim, stats, local)
+        return self._diagnose(problem, cands, targets, starts_n, seed, stats, t0)
 
-    out = [("analytic", clip(s)) for s in analytic.warm_starts(problem)] if use_analytic else []
-    if n > 0:
-        names = list(problem.free)
-        points = []
-        for row in qmc.Sobol(len(names), scramble=True, seed=seed).random(8 * n):
-            v = {}
-            for k, x in zip(names, row, strict=True):
-                lo, hi = problem.free[k]
-                v[k] = lo * (hi / lo) ** x if k in problem.mechanism.LENGTHS and lo > 0 else lo + (hi - lo) * x
-            points.append(v)
-        kept = [v for v in points if _assembles(problem, v)][:n]
-        out += [("multistart", v) for v in (kept or points[:n])]
-    return out
+    def _family_starts(self, problem, plan):
+        """The best local optima of the objective along the closed-form family (exact evaluation), per branch."""
+        out = []
+        for br in starts_.branches(problem):
+            scores = [_score(problem, v, br) for v in plan.analytic]
+            out += [("family", plan.analytic[i], br) for i in starts_.local_best(scores, problem.objective
+                                                                                == "max_gamma_min")]  # fmt: skip
+        return out
 
+    def _check(self, problem, targets, extra_starts, starts_n, seed, max_rounds):
+        if not isinstance(problem, Problem):
+            raise ProblemError(f"solve takes a qropt.Problem, got {type(problem).__name__}")
+        if targets is not None:
+            if not isinstance(targets, dict):
+                raise ProblemError(f"targets must be a dict of target values, got {targets!r}")
+            unknown = sorted(set(targets) - set(problem.targets))
+            if unknown:
+                raise ProblemError(f"targets {unknown} are not targets of this problem ({sorted(problem.targets)})")
+            problem = problem.replace(targets={**problem.targets, **targets})
+        extra = []
+        for v in extra_starts:
+            if not isinstance(v, dict) or set(problem.free) - set(v):
+                raise ProblemError(f"each extra start gives every free parameter {sorted(problem.free)}, got {v!r}")
+            extra.append({k: _real(f"extra start {k}", v[k]) for k in problem.free})
+        starts_n = self.starts_n if starts_n is None else starts_n
+        max_rounds = self.max_rounds if max_rounds is None else max_rounds
+        seed = self.seed if seed is None else seed
+        for name, v, lo in (("starts_n", starts_n, 0), ("max_rounds", max_rounds, 1), ("seed", seed, 0)):
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+                raise ProblemError(f"{name} must be an integer >= {lo}, got {v!r}")
+        return problem, dict(problem.targets), extra, int(starts_n), int(seed), int(max_rounds)
 
-def _assembles(problem, values) -> bool:
-    try:
-        build(problem, values, branches(problem)[0]).dead_centres()
-        return True
-    except QroptError:
-        return False
+    def _result(self, problem, c, status, claim, stats, local=()):
+        converged_to = c.statuses[-1] if c.statuses else ""
+        if status is None:
+            status = "acceptable" if converged_to == ACCEPTABLE else "optimal" if problem.objective else "feasible"
+        info = c.info
+        cert = Certificate(
+            exact=info.get("gap", 0.0) <= self.tolerances["gap"],
+            nlp=info.get("nlp"),
+            certified=info.get("certified"),
+            gap=float(info.get("gap", 0.0)),
+            rounds=c.rounds,
+            local=converged_to,
+            global_claim=claim,
+        )
+        msg = {"optimal": "certified optimum", "feasible": "certified design (no objective)",
+               "acceptable": "certified design; IPOPT stopped at its acceptable tolerance",
+               "local_optimum": "another certified local optimum"}[status]  # fmt: skip
+        return Result(
+            status=status,
+            message=f"{msg}; global: {claim}",
+            params=dict(c.mechanism.params),
+            mechanism=c.mechanism,
+            objective=objective_value(problem, c.q),
+            quantities=c.q,
+            residuals=c.residuals,
+            certificate=cert,
+            stats={
+                **stats,
+                "statuses": list(c.statuses),
+                "iterations": c.iterations,
+                "t_ipopt_design": c.t_ipopt,
+                "branch": dict(c.branch),
+                "orientation": c.orientation,
+                "origin": c.origin,
+            },  # fmt: skip
+            local_optima=tuple(local),
+        )
 
-
-def _angle_gap(a, b):
-    return abs((a - b + math.pi) % TWO_PI - math.pi)
-
-
-def quantities(problem, m) -> dict:
-    """Exact quantities of a mechanism for a Result."""
-    q = {"time_ratio": m.time_ratio(), "gamma_min": m.gamma_min().value}
-    q["swing" if isinstance(m, FourBar) else "stroke"] = m.stroke()
-    q["peak_accel"] = None if isinstance(m, FourBar) else m.peak_acceleration(problem.omega2, problem.accel_over)[0]
-    q["grashof"] = m.grashof().kind if hasattr(m, "grashof") else None
-    q["size"] = m.size(problem.size)
-    q["working_direction"] = m.working_direction(problem.omega2)
-    return q
-
-
-def objective_value(problem, q) -> float | None:
-    return {"max_gamma_min": q["gamma_min"], "min_size": q["size"], "min_peak_accel": q["peak_accel"]}.get(
-        problem.objective
-    )
-
-
-def certify(problem, form, values, branch, th, z, targets):
-    """Exact check of an NLP point. Returns (mechanism or None, info dict, angles to add, fractions to add)."""
-    try:
-        return _certify(problem, form, values, branch, th, z)
-    except AssemblyError as e:
-        mids = [((lo + hi) / 2) % TWO_PI for _, lo, hi in e.failures]
-        return None, {"ok": False, "reason": str(e)}, mids, []
-    except QroptError as e:
-        return None, {"ok": False, "reason": str(e)}, [], []
-
-
-def _certify(problem, form, values, branch, th, z):
-    m = problem.build(values, branch)
-    d = m.dead_centres()
-    if _angle_gap(d.theta_max, th[0]) > 1e-7 or _angle_gap(d.theta_min, th[1]) > 1e-7:
-        return m, {"ok": False, "reason": "the NLP's dead centres are local, not the global extremes"}, [], []
-    if d.reversals != 1:
-        return m, {"ok": False, "reason": f"the slider reverses {d.reversals} times a turn"}, [], []
-    info = {"ok": True, "nlp": None, "certified": None, "gap": 0.0}
-    add, frac = [], []
-    obj = problem.objective if not form.range_target else None
-    g = m.gamma_min()
-    if obj == "max_gamma_min":
-        exact = math.cos(g.value)
-        info.update(nlp=math.acos(min(1.0, z[0])), certified=g.value, gap=exact - z[0])
-        if exact - z[0] > GAP_TOL:  # every local minimum of every joint below the NLP's value
-            for t, v in m.transmission_minima():
-                add += [float(a) for a, b in sorted(zip(t, v, strict=True), key=lambda q: q[1]) if math.cos(b) > z[0]]
-    elif obj == "min_peak_accel":
-        peak, t = m.peak_acceleration(1.0, problem.accel_over)
-        w2 = problem.omega2**2
-        info.update(nlp=z[0] * w2, certified=peak * w2, gap=(peak - z[0]) * w2)
-        if peak - z[0] > GAP_TOL:  # every local extreme of the acceleration above the NLP's bound
-            ts, vs = (np.concatenate(x) for x in zip(*m._acceleration_extremes, strict=True))
-            worst = [float(a) for a, b in sorted(zip(ts, vs, strict=True), key=lambda q: -abs(q[1])) if abs(b) > z[0]]
-            if problem.accel_over == "working":
-                lo, length = m.working_arc()
-                frac += [((a - lo) % TWO_PI) / length for a in worst if (a - lo) % TWO_PI <= length] or [
-                    ((t - lo) % TWO_PI) / length
-                ]
-            else:
-                add += worst or [t]
-    elif obj == "min_size" and problem.size == "footprint":
-        box, angles = m.bounding_box()
-        exact = (box[1] - box[0]) * (box[3] - box[2])
-        nlp = (z[0] + z[1]) * (z[2] + z[3])
-        info.update(nlp=nlp, certified=exact, gap=exact - nlp)
-        if exact - nlp > GAP_TOL * max(1.0, exact):
-            add += list(angles)
-    elif obj == "min_size":
-        info.update(nlp=m.size(problem.size), certified=m.size(problem.size), gap=0.0)
-    bound = problem.conditions.get("gamma_min")
-    if bound is not None and g.value < bound - FEAS_TOL:
-        add.append(g.theta2)
-    return m, info, add, frac
-
-
-def _residuals(problem, form, g, m, targets):
-    res = {k: v for k, v in form.violations(g).items() if not k.startswith("epigraph")}
-    if m is not None:
-        q = {"time_ratio": m.time_ratio(), "stroke": m.stroke(), "swing": m.stroke()}
+    def _diagnose(self, problem, cands, targets, starts_n, seed, stats, t0):
+        """No certified design: say why (a target out of its reachable range, or nothing meets all together)."""
+        reasons = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
+        reach, msgs = {}, []
         for k, v in targets.items():
-            res[f"{k} (exact)"] = abs(q[k] - v)
-        if "gamma_min" in problem.conditions:
-            res["gamma_min bound (exact)"] = max(0.0, problem.conditions["gamma_min"] - m.gamma_min().value)
-    return res
+            lo, hi = self.target_range(problem, k, targets, starts_n=starts_n, seed=seed)
+            reach[k] = (lo, hi)
+            msgs.append(_range_message(problem, k, v, lo, hi))
+        stats["t_total"] = time.perf_counter() - t0
+        outside = [m for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True) if not lo <= targets[k] <= hi]
+        if outside:
+            return Result("infeasible", "; ".join(outside), stats=stats, reachable=reach)
+        if all(max(c.residuals.values(), default=0.0) > self.tolerances["feasibility"] or c.mechanism is None
+               for c in cands):  # fmt: skip
+            ends: dict = {}
+            for c in cands:
+                k = c.statuses[-1] if c.statuses else "no run"
+                ends[k] = ends.get(k, 0) + 1
+            how = ", ".join(f"{n} {k}" for k, n in sorted(ends.items(), key=lambda kv: -kv[1]))
+            msg = f"none of {len(cands)} starts reaches a design meeting the targets and conditions together "
+            msg += f"(IPOPT: {how}), though each target alone can be met (" + "; ".join(msgs) + ")"
+            return Result("infeasible", msg, stats=stats, reachable=reach)
+        why = "; ".join(r for r in reasons[:3] if r)
+        return Result("failed", f"no start converged to a certified design ({why}); " + "; ".join(msgs),
+                      stats=stats, reachable=reach)  # fmt: skip
+
+    # ---- reachable range of one target ---------------------------------------------------------------
+    def target_range(self, problem, target, targets=None, *, starts_n=None, seed=None):
+        """(low, high) of one target over the free bounds and conditions (other targets dropped).
+
+        Every value is that of a certified design: the optimised extremes and the start designs themselves.
+        (nan, nan) if no design turns fully.
+        """
+        starts_n = self.starts_n if starts_n is None else starts_n
+        seed = self.seed if seed is None else seed
+        targets = dict(problem.targets if targets is None else targets)
+        if target not in targets:
+            raise ProblemError(f"{target!r} is not a target of this problem ({sorted(targets)})")
+        sub = problem.replace(targets={target: targets[target]})
+        seen = []
+
+        def value(m):
+            return m.time_ratio() if target == "time_ratio" else m.stroke()
+
+        pts = list(starts_.plan(problem).analytic) + starts_.sobol(problem, starts_n, seed)
+        for v in pts:
+            for br in starts_.branches(problem):
+                with contextlib.suppress(QroptError):
+                    seen.append(value(problem.build(v, br)))
+        for sense in (1, -1):
+            for v in pts:
+                for br in starts_.branches(problem):
+                    for way in (1, -1):
+                        c = self.local(sub, v, br, {target: targets[target]}, orientation=way, max_rounds=3,
+                                       range_target=target, sense=sense)  # fmt: skip
+                        m = c.mechanism
+                        internal = ("dead centre", "time_ratio orientation")
+                        conditions = [x for k, x in c.residuals.items() if not k.startswith(internal)]
+                        if m is not None and m.dead_centres().reversals == 1 and max(conditions, default=0.0) <= 1e-9:
+                            seen.append(value(m))  # the exact value of a design that meets every condition
+        if not seen:
+            return float("nan"), float("nan")
+        return float(min(seen)), float(max(seen))
 
 
-def _peaks(problem, values, branch):
-    """Initial lifted acceleration extremes: the start design's largest |d2x/dtheta2| (in the working
-    stroke when asked), else spread over the turn."""
-    if problem.objective != "min_peak_accel":
-        return None
-    try:
-        m = build(problem, values, branch)
-        ts, vs = (np.concatenate(x) for x in zip(*m._acceleration_extremes, strict=True))
-    except QroptError:
-        return None
-    order = np.argsort(-np.abs(vs))
-    if problem.accel_over == "working":
-        lo, length = m.working_arc()
-        order = [i for i in order if (ts[i] - lo) % TWO_PI <= length]
-        return [lo + (ts[i] - lo) % TWO_PI for i in order] or None
-    return [float(ts[i]) for i in order]
+def _positive(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) and v > 0
 
 
-def start_orientation(problem, values, branch):
-    """+1 if the start's slow interval runs from theta_max to theta_min (counter-clockwise), -1 if not,
-    None if it does not turn fully."""
-    try:
-        a, b = build(problem, values, branch).stroke_angles()
-        return 1 if a >= b else -1
-    except QroptError:
-        return None
+def _real(name, v) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
+        raise ProblemError(f"{name} must be a finite number, got {v!r}")
+    return float(v)
 
 
-def _place(slots, used, new, period, near):
-    """Put new sample angles into the extra slots: an angle close to an extra sample moves it there (the
-    worst angle drifts as the design changes), others take free slots. Returns the slots in use."""
-    for t in new:
-        extra = np.arange(BASE_SAMPLES, used)
-        if extra.size:
-            d = np.abs((slots[extra] - t + period / 2) % period - period / 2)
-            k = int(np.argmin(d))
-            if d[k] < near:
-                slots[extra[k]] = t
-                continue
-        if used < BASE_SAMPLES + EXTRA_SAMPLES:
-            slots[used] = t
-            used += 1
-    return used
+def _within(c: Candidate, tol) -> bool:
+    return max(c.residuals.values(), default=0.0) <= tol["feasibility"] and c.info.get("gap", 0.0) <= tol["gap"]
 
 
 def _converged(stats) -> bool:
     """IPOPT solved the NLP (to its tolerance, or to its acceptable level)."""
-    return bool(stats.get("success")) or stats.get("return_status") == "Solved_To_Acceptable_Level"
+    return bool(stats.get("success")) or stats.get("return_status") == ACCEPTABLE
 
 
-def run_start(problem, values0, branch, targets, max_rounds=30, range_target=None, sense=1, orientation=None):
-    """One local solve with its exchange loop: a dict describing the candidate.
-
-    orientation: which way the TR equality is met (+1, -1); None takes the start's own.
-    """
+def _dead_centre_start(problem, values, branch, targets, orientation, range_target):
+    """Dead-centre angles of the start design (moved to meet the TR target) and the TR orientation."""
     try:
-        m0 = build(problem, values0, branch)
+        m0 = problem.build(values, branch)
         d = m0.dead_centres()
         a, b = m0.stroke_angles()
         orientation = orientation or (1 if a >= b else -1)
@@ -243,129 +396,71 @@ def run_start(problem, values0, branch, targets, max_rounds=30, range_target=Non
         th0 = (0.5, 0.5 + slow_interval(tr, orientation))
     if "time_ratio" in targets and range_target != "time_ratio":
         th0 = (th0[0], th0[0] + slow_interval(targets["time_ratio"], orientation))
-    form = formulation(problem, branch, orientation, range_target, sense)
-    samples, fractions = form.base_samples()
-    used, used_f = BASE_SAMPLES, BASE_SAMPLES
-    p = form.param_vector(targets, samples, fractions)
-    w = form.epigraph_start(form.pack(values0, th0, phi=_peaks(problem, values0, branch)), p)
-    t_ipopt, iters, statuses, rounds = 0.0, 0, [], 0
-    while rounds < max_rounds:
-        rounds += 1
-        w, f, g, st = form.solve(w, p)
-        t_ipopt += st.get("t_wall_total", 0.0)
-        iters += st.get("iter_count", 0)
-        statuses.append(st.get("return_status", "?"))
-        values = dict(zip(form.free, w[: form.nx].tolist(), strict=True))
-        th, z = w[form.nx : form.nx + 2], w[form.nx + 2 : form.nx + 2 + form.nz]
-        m, info, add, frac = certify(problem, form, values, branch, th, z, targets)
-        if not _converged(st) and not range_target:
-            break
-        if not add and not frac:
-            break
-        used = _place(samples, used, add, TWO_PI, 0.05)
-        used_f = _place(fractions, used_f, frac, 1.0, 0.01)
-        p = form.param_vector(targets, samples, fractions)
-        w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
-    res = _residuals(problem, form, g, m, {k: targets[k] for k in form.targets})
-    ok = bool(info.get("ok")) and _converged(st)
-    ok = ok and max(res.values(), default=0.0) <= FEAS_TOL and info.get("gap", 0.0) <= GAP_TOL
-    return {
-        "ok": ok,
-        "q": quantities(problem, m) if ok else None,
-        "values": values,
-        "branch": branch,
-        "orientation": orientation,
-        "mechanism": m,
-        "info": {**info, "rounds": rounds},
-        "residuals": res,
-        "ipopt": {"statuses": statuses, "iterations": iters, "t_ipopt": t_ipopt},
-        "f": f,
-    }
+    return th0, orientation
+
+
+def _score(problem, values, branch):
+    """The exact objective of a design that builds and meets the gamma_min bound, else None."""
+    try:
+        m = problem.build(values, branch)
+        if m.dead_centres().reversals != 1:
+            return None
+        bound = problem.conditions.get("gamma_min")
+        if bound is not None and m.gamma_min().value < bound:
+            return None
+        return objective_of(problem, m) if problem.objective else 0.0
+    except QroptError:
+        return None
+
+
+def _peaks(problem, values, branch):
+    """Initial lifted acceleration extremes: the start design's largest |d2x/dtheta2| (in the working
+    stroke when asked), else spread over the turn."""
+    if problem.objective != "min_peak_accel":
+        return None
+    try:
+        ex = problem.build(values, branch).acceleration_extremes()
+        m = problem.build(values, branch)
+    except QroptError:
+        return None
+    ts = np.concatenate([ex.maxima[0], ex.minima[0]])
+    vs = np.concatenate([ex.maxima[1], ex.minima[1]])
+    order = np.argsort(-np.abs(vs))
+    if problem.accel_over == "working":
+        lo, length = m.working_arc()
+        order = [i for i in order if (ts[i] - lo) % TWO_PI <= length]
+        return [lo + (ts[i] - lo) % TWO_PI for i in order] or None
+    return [float(ts[i]) for i in order]
+
+
+def _place(slots, used, new, period, near, base):
+    """Put new sample angles into the extra slots: an angle close to an extra sample moves it there (the
+    worst angle drifts as the design changes), others take free slots. Returns the slots in use."""
+    for t in new:
+        extra = np.arange(base, used)
+        if extra.size:
+            d = np.abs((slots[extra] - t + period / 2) % period - period / 2)
+            k = int(np.argmin(d))
+            if d[k] < near:
+                slots[extra[k]] = t
+                continue
+        if used < slots.size:
+            slots[used] = t
+            used += 1
+    return used
 
 
 def _distinct(cands):
     out = []
     for c in cands:
-        v = np.array([c["values"][k] for k in sorted(c["values"])])
+        v = np.array([c.values[k] for k in sorted(c.values)])
         if all(
-            c["branch"] != o["branch"]
-            or np.max(np.abs(v - np.array([o["values"][k] for k in sorted(o["values"])])) / np.maximum(1, np.abs(v)))
-            > 1e-6
+            c.branch != o.branch
+            or np.max(np.abs(v - np.array([o.values[k] for k in sorted(o.values)])) / np.maximum(1, np.abs(v))) > 1e-6
             for o in out
         ):
             out.append(c)
     return out
-
-
-def _to_result(problem, c, status, message, stats, local=()):
-    m, q = c["mechanism"], c["q"]
-    params = dict(m.params)
-    return Result(
-        status=status,
-        message=message,
-        params=params,
-        mechanism=m,
-        objective=objective_value(problem, q),
-        quantities=q,
-        residuals=c["residuals"],
-        certificate=c["info"],
-        stats={**stats, **c["ipopt"], "branch": c["branch"], "orientation": c["orientation"]},
-        local_optima=tuple(local),
-    )
-
-
-def solve(problem: Problem, *, starts_n: int = 8, use_analytic: bool = True, seed: int = 0,
-          targets: dict | None = None, max_rounds: int = 30, extra_starts=()) -> Result:  # fmt: skip
-    """Solve a synthesis problem; returns a Result whatever happens (only invalid input raises).
-
-    starts_n: Sobol multi-start points; use_analytic: start from every closed form as well;
-    targets: override the problem's target values (the NLP is not rebuilt);
-    extra_starts: more starting points (free-parameter dicts), tried first.
-    """
-    t0 = time.perf_counter()
-    targets = dict(problem.targets if targets is None else targets)
-    cands = []
-    given = [("given", {k: v[k] for k in problem.free}) for v in extra_starts]
-    for origin, v in given + starts(problem, starts_n, seed, use_analytic):
-        for br in branches(problem):
-            own = start_orientation(problem, v, br)
-            ways = [own] if origin in ("analytic", "given") and own else [1, -1]
-            for orientation in ways:
-                c = run_start(problem, v, br, targets, max_rounds, orientation=orientation)
-                c["origin"] = origin
-                cands.append(c)
-    good = [c for c in cands if c["ok"]]
-    stats = {"starts": len(cands), "t_total": None, "formulations": len(_FORMULATIONS),
-             "iterations_total": sum(c["ipopt"]["iterations"] for c in cands)}  # fmt: skip
-    if good:
-        best_first = sorted(_distinct(good), key=lambda c: objective_value(problem, c["q"]) or 0.0,
-                            reverse=problem.objective == "max_gamma_min")  # fmt: skip
-        stats["t_total"] = time.perf_counter() - t0
-        stats["local_optima"] = len(best_first)
-        local = [_to_result(problem, c, "optimal" if problem.objective else "feasible", "local optimum", stats)
-                 for c in best_first]  # fmt: skip
-        status = "optimal" if problem.objective else "feasible"
-        msg = f"best of {len(best_first)} distinct local optima from {len(cands)} starts, certified"
-        return _to_result(problem, best_first[0], status, msg, stats, local)
-    reasons = sorted({c["info"].get("reason", "") or ", ".join(c["ipopt"]["statuses"][-1:]) for c in cands})
-    reach, msgs = {}, []
-    for k, v in targets.items():
-        lo, hi = target_range(problem, k, targets, starts_n=starts_n, seed=seed)
-        reach[k] = (lo, hi)
-        msgs.append(_range_message(problem, k, v, lo, hi))
-    stats["t_total"] = time.perf_counter() - t0
-    outside = [m for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True) if not lo <= targets[k] <= hi]
-    if outside:
-        return Result("infeasible", "; ".join(outside), stats=stats, reachable=reach)
-    if all(max(c["residuals"].values(), default=0.0) > FEAS_TOL or c["mechanism"] is None for c in cands):
-        ends = collections.Counter(c["ipopt"]["statuses"][-1] for c in cands)
-        how = ", ".join(f"{n} {k}" for k, n in ends.most_common())
-        msg = f"none of {len(cands)} starts reaches a design meeting the targets and conditions together (IPOPT: "
-        msg += f"{how}), though each target alone can be met (" + "; ".join(msgs) + ")"
-        return Result("infeasible", msg, stats=stats, reachable=reach)
-    why = "; ".join(reasons[:3])
-    return Result("failed", f"no start converged to a certified design ({why}); " + "; ".join(msgs), stats=stats,
-                  reachable=reach)  # fmt: skip
 
 
 def _range_message(problem, k, v, lo, hi):
@@ -376,36 +471,17 @@ def _range_message(problem, k, v, lo, hi):
     return f"{k} {v:g} is {where} the reachable {lo:.6g}..{hi:.6g} for {bounds}"
 
 
-def target_range(problem, target, targets=None, *, starts_n=8, seed=0):
-    """(low, high) of one target over the free bounds and conditions (other targets dropped).
-
-    Every value is that of a certified design: the optimised extremes and the start designs themselves.
-    (nan, nan) if no design turns fully.
-    """
-    targets = dict(problem.targets if targets is None else targets)
-    sub = problem.replace(targets={target: targets[target]})
-    seen = []
-
-    def value(m):
-        return m.time_ratio() if target == "time_ratio" else m.stroke()
-
-    pts = starts(problem, starts_n, seed, True)
-    for _, v in pts:
-        for br in branches(problem):
-            with contextlib.suppress(QroptError):
-                seen.append(value(problem.build(v, br)))
-    for sense in (1, -1):
-        for _, v in pts:
-            for br, way in itertools.product(branches(problem), (1, -1)):
-                c = run_start(sub, v, br, {target: targets[target]}, 3, target, sense, way)
-                m = c["mechanism"]
-                internal = ("dead centre", "time_ratio orientation")
-                conditions = [x for k, x in c["residuals"].items() if not k.startswith(internal)]
-                if m is not None and m.dead_centres().reversals == 1 and max(conditions, default=0.0) <= 1e-9:
-                    seen.append(value(m))  # the exact value of a design that meets every condition
-    if not seen:
-        return float("nan"), float("nan")
-    return float(min(seen)), float(max(seen))
+DEFAULT = Solver()
 
 
-__all__ = ["solve", "target_range", "formulation", "quantities"]
+def solve(problem: Problem, **options) -> Result:
+    """Solve with the default Solver (``qropt.solve.DEFAULT``); options as ``Solver.solve``."""
+    return DEFAULT.solve(problem, **options)
+
+
+def target_range(problem, target, targets=None, **options):
+    """(low, high) of one target with the default Solver; see ``Solver.target_range``."""
+    return DEFAULT.target_range(problem, target, targets, **options)
+
+
+__all__ = ["Solver", "DEFAULT", "solve", "target_range", "better"]

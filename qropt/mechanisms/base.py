@@ -12,17 +12,47 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
+from types import MappingProxyType
 from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
 from qropt import cycle
-from qropt.closures import RIGHT_ANGLE, transmission_angle
+from qropt.closures import transmission_angle
 from qropt.errors import AssemblyError, DegenerateMechanism, InvalidParameter, NoDeadCentres
+from qropt.kernel import kernel, resolved, second_derivative_on_grid
 from qropt.ops import JET, NUMPY, Jet
 
 REQUIRED = object()
 REGISTRY: dict[str, type[Mechanism]] = {}
+MAGNITUDE = 1e100  # lengths and offsets beyond this (or lengths below its inverse) overflow their squares
+MAX_ANGLES = 10_000_000  # crank angles evaluated in one call
+
+
+def _finite(name: str, value) -> float:
+    """A finite real number from the API, or InvalidParameter naming it."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InvalidParameter(f"{name} must be a real number, got {value!r}")
+    v = float(value)
+    if not math.isfinite(v):
+        raise InvalidParameter(f"{name} must be finite, got {v}")
+    return v
+
+
+def crank_angles(theta2) -> np.ndarray:
+    """Crank angles (rad) from the API as a 1-D float array: real, finite, at most MAX_ANGLES of them."""
+    if (
+        isinstance(theta2, (str, bytes))
+        or np.asarray(theta2).dtype.kind not in "biuf"
+        or (np.asarray(theta2).dtype.kind == "b")
+    ):
+        raise InvalidParameter(f"theta2 must be real numbers in radians, got {theta2!r}")
+    t = np.atleast_1d(np.asarray(theta2, float)).ravel()
+    if t.size > MAX_ANGLES:
+        raise InvalidParameter(f"theta2 has {t.size} angles; at most {MAX_ANGLES} in one call")
+    if not np.isfinite(t).all():
+        raise InvalidParameter("theta2 must be finite (got nan or inf)")
+    return t
 
 
 class Loop(NamedTuple):
@@ -81,6 +111,31 @@ class DeadCentres(NamedTuple):
     reversals: int = 1
 
 
+class PeakAcceleration(NamedTuple):
+    """Largest |slider acceleration| (length/s^2) at a constant omega2 and the crank angle (rad) where it occurs."""
+
+    value: float
+    theta2: float
+
+
+class AccelerationExtremes(NamedTuple):
+    """Local maxima and minima of d2x/dtheta2 over a turn: each (theta2 array in rad, value array)."""
+
+    maxima: tuple
+    minima: tuple
+
+
+class BoundingBox(NamedTuple):
+    """Extremes of every joint's path over a turn (length) and the crank angles (rad) where they occur
+    (in the order x_min, x_max, y_min, y_max)."""
+
+    x_min: float
+    x_max: float
+    y_min: float
+    y_max: float
+    angles: tuple
+
+
 class GammaMin(NamedTuple):
     """Smallest transmission angle over a full turn and every joint: value (rad), theta2 (rad), joint."""
 
@@ -121,15 +176,17 @@ class Mechanism:
                 raise InvalidParameter(f"{name}: {k} must be finite, got {v}")
             if k in self.LENGTHS and v <= 0:
                 raise InvalidParameter(f"{name}: length {k} must be positive, got {v:g}")
+            if abs(v) > MAGNITUDE or (k in self.LENGTHS and v < 1 / MAGNITUDE):
+                raise InvalidParameter(f"{name}: {k} = {v:g} is out of range (|value| in [1e-100, 1e100])")
             if k.startswith("sigma") and v not in (-1.0, 1.0):
                 raise InvalidParameter(f"{name}: branch sign {k} must be +1 or -1, got {v:g}")
             values[k] = v
         object.__setattr__(self, "params", values)
         self.validate()
-        if self.REQUIRES_FULL_TURN:
-            failures = self.assembly_failures()
-            if failures:
-                raise AssemblyError(name, self.params, failures)
+        object.__setattr__(self, "params", MappingProxyType(dict(self.params)))
+        failures = self.assembly_failures()
+        if failures and (self.REQUIRES_FULL_TURN or failures[0][1:] == (0.0, cycle.TWO_PI)):
+            raise AssemblyError(name, self.params, failures)
 
     def __setattr__(self, k, v):
         # cached properties write to __dict__ directly, so only user assignments arrive here
@@ -161,9 +218,21 @@ class Mechanism:
         with np.errstate(invalid="ignore", divide="ignore"):
             return self.loop(xp, theta2, self.params)
 
+    def _angles(self, theta2) -> np.ndarray:
+        """Validated crank angles at which the mechanism assembles (AssemblyError naming the others)."""
+        t = crank_angles(theta2)
+        if not self.REQUIRES_FULL_TURN and self.assembly_failures():
+            m = self.evaluate(NUMPY, t).margins
+            bad = np.zeros(t.shape, bool)
+            for _, v in m:
+                bad |= np.broadcast_to(np.asarray(v) < -cycle.MARGIN_TOL, t.shape)
+            if bad.any():
+                raise AssemblyError(type(self).__name__, self.params, self.assembly_failures())
+        return t
+
     def positions(self, theta2) -> Positions:
-        """Every joint (n, 2) and link angle at crank angles theta2 (rad); nan where it cannot assemble."""
-        t = np.atleast_1d(np.asarray(theta2, float))
+        """Every joint (n, 2) and link angle at crank angles theta2 (rad)."""
+        t = self._angles(theta2)
         lp = self.evaluate(NUMPY, t)
         pts = {k: np.column_stack(np.broadcast_arrays(x, y, t)[:2]) for k, (x, y) in lp.points.items()}
         ang = {k: np.broadcast_to(v, t.shape).astype(float) for k, v in lp.angles.items()}
@@ -171,7 +240,8 @@ class Mechanism:
 
     def motion(self, theta2, omega2: float = 1.0, alpha2: float = 0.0) -> Motion:
         """Exact output and link rates at theta2 (rad) for crank rate omega2 (rad/s) and alpha2 (rad/s^2)."""
-        t = np.atleast_1d(np.asarray(theta2, float))
+        t = self._angles(theta2)
+        omega2, alpha2 = _finite("omega2", omega2), _finite("alpha2", alpha2)
         lp = self.evaluate(JET, Jet.seed(t, omega2, alpha2))
 
         def parts(j):
@@ -197,7 +267,7 @@ class Mechanism:
 
     def transmission_angles(self, theta2) -> dict[str, np.ndarray]:
         """Transmission angle (rad, in [0, pi/2]) of every transmitting joint at theta2."""
-        t = np.atleast_1d(np.asarray(theta2, float))
+        t = self._angles(theta2)
         lp = self.evaluate(NUMPY, t)
         return {
             k: np.broadcast_to(transmission_angle(NUMPY, v), t.shape).astype(float) for k, v in lp.transmission.items()
@@ -205,34 +275,44 @@ class Mechanism:
 
     # ---- exact cycle quantities -------------------------------------------
     @cached_property
+    def _kernel(self):
+        return kernel(type(self), tuple(self.params))
+
+    @cached_property
+    def _grid(self):
+        """Cycle quantities (x, cos^2 of each varying joint, margins) on the coarsest grid of GRIDS that
+        resolves them (or shows an assembly failure): (Q, n) on ``cycle.grid(n)``."""
+        k = self._kernel
+        for n in cycle.GRIDS:
+            q = k.grid_values(self.params, cycle.grid(n))
+            if np.nanmin(q[1 + len(k.joints) :], initial=np.inf) < -cycle.MARGIN_TOL or resolved(q):
+                break
+        return q
+
+    @cached_property
     def _cycle(self) -> dict:
-        """Slider extremes, transmission minima and assembly-margin minima from one refined grid pass."""
-        lp0 = self.evaluate(NUMPY, np.zeros(1))
-        varying = [j for j, g in lp0.transmission.items() if g is not RIGHT_ANGLE]
-        n_margin = len(lp0.margins)
-
-        def quantities(t):
-            lp = self.evaluate(JET, t)
-            qs = [lp.x] + [transmission_angle(JET, lp.transmission[j]) for j in varying]
-            qs += [m for _, m in lp.margins]
-            return cycle.stack(qs, np.shape(t.v))
-
-        specs = [(0, "max"), (0, "min")] + [(1 + k, "min") for k in range(len(varying) + n_margin)]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            res, on_grid = cycle.extremes_many(quantities, specs)
-        gammas = {j: res[2 + k] for k, j in enumerate(varying)}
-        right = [j for j, g in lp0.transmission.items() if g is RIGHT_ANGLE]
-        gammas.update({j: (np.zeros(1), np.full(1, math.pi / 2)) for j in right})
+        """Slider extremes, transmission minima and assembly-margin minima, refined in one compiled call."""
+        k, q = self._kernel, self._grid
+        nj, nm = len(k.joints), len(k.margin_names)
+        margins_grid = q[1 + nj :]
+        least = [float(np.nanmin(m)) if np.isfinite(m).any() else -np.inf for m in margins_grid]
+        if any(v < -cycle.MARGIN_TOL for v in least):  # cannot assemble: nothing else is defined
+            return {"margins": [(v, 0.0) for v in least]}
+        specs = (
+            [(0, "max"), (0, "min")] + [(1 + j, "max") for j in range(nj)] + [(1 + nj + m, "min") for m in range(nm)]
+        )
+        res = k.refine("cycle", q, specs, k.vector(self.params))
+        gammas = {j: (res[2 + i].theta, res[2 + i].value) for i, j in enumerate(k.joints)}
+        gammas.update({j: (np.zeros(1), np.full(1, math.pi / 2)) for j in k.right_joints})
         margins = []
-        for k in range(n_margin):
-            t, v = res[2 + len(varying) + k]
-            grid_min = (
-                np.nanmin(on_grid[1 + len(varying) + k]) if np.isfinite(on_grid[1 + len(varying) + k]).any() else 0.0
-            )
-            k_min = int(np.nanargmin(v)) if np.isfinite(v).any() else None
-            refined = v[k_min] if k_min is not None else np.inf
-            margins.append((min(grid_min, refined), float(t[k_min]) if k_min is not None else 0.0))
-        return {"max": res[0], "min": res[1], "gamma": gammas, "margins": margins}
+        for m in range(nm):
+            e = res[2 + nj + m]
+            if e.value.size and e.value.min() < least[m]:
+                margins.append((float(e.value.min()), float(e.theta[np.argmin(e.value)])))
+            else:
+                margins.append((least[m], float(cycle.grid(q.shape[1])[np.nanargmin(margins_grid[m])])))
+        return {"max": (res[0].theta, res[0].value), "min": (res[1].theta, res[1].value), "gamma": gammas,
+                "margins": margins}  # fmt: skip
 
     def _require_full_turn(self):
         if not self.REQUIRES_FULL_TURN:
@@ -257,8 +337,15 @@ class Mechanism:
         return self._dead_centres
 
     def stroke_angles(self) -> tuple[float, float]:
-        """(a, b): crank turn (rad) from theta_max to theta_min counter-clockwise, and the rest."""
+        """(a, b): crank turn (rad) from theta_max to theta_min counter-clockwise, and the rest.
+
+        Raises NoDeadCentres if the output reverses more than once a turn (TR is then ill-posed)."""
         d = self.dead_centres()
+        if d.reversals != 1:
+            raise NoDeadCentres(
+                f"{self!r}: the output reverses {d.reversals} times a turn, so the time ratio and the "
+                "working stroke are ill-posed (dead_centres() gives the global extremes and the count)"
+            )
         a = (d.theta_min - d.theta_max) % cycle.TWO_PI
         return a, cycle.TWO_PI - a
 
@@ -273,7 +360,11 @@ class Mechanism:
         return d.x_max - d.x_min
 
     def working_direction(self, omega2: float = 1.0) -> str | None:
-        """'+x' or '-x': the way the output moves during the slow (working) stroke; None if TR = 1."""
+        """'+x' or '-x': the way the output moves during the slow (working) stroke; None if TR = 1.
+
+        omega2 (rad/s, nonzero): its sign is the crank's sense of rotation."""
+        if _finite("omega2", omega2) == 0.0:
+            raise InvalidParameter("omega2 must be nonzero: its sign sets the working direction")
         a, b = self.stroke_angles()
         if a == b:
             return None
@@ -310,47 +401,44 @@ class Mechanism:
         """Smallest transmission angle over the full turn and every joint, exact (not a grid sample)."""
         return self._gamma_min
 
-    def peak_acceleration(self, omega2: float = 1.0, over: str = "cycle") -> tuple[float, float]:
-        """Largest |slider acceleration| at constant omega2 (rad/s): (value, theta2 in rad).
-
-        ``over="working"`` restricts it to the working (slow) stroke.
-        """
+    def peak_acceleration(self, omega2: float = 1.0, over: str = "cycle") -> PeakAcceleration:
+        """Largest |slider acceleration| at constant omega2 (rad/s) over the turn ('cycle') or the working
+        (slow) stroke ('working'), exact: the extremes of d2x/dtheta2 refined with exact derivatives."""
+        omega2 = _finite("omega2", omega2)
+        if over not in ("cycle", "working"):
+            raise InvalidParameter(f"peak_acceleration: over is 'cycle' or 'working', got {over!r}")
         self._require_full_turn()
-
-        def acc(th):
-            return self.evaluate(JET, Jet.seed(th, 1.0, 0.0)).x.d2
-
-        cand = []
-        for t, v in self._acceleration_extremes:
-            cand += list(zip(t.tolist(), v.tolist(), strict=True))
+        ex = self.acceleration_extremes()
+        cand = list(zip(ex.maxima[0].tolist(), ex.maxima[1].tolist(), strict=True))
+        cand += list(zip(ex.minima[0].tolist(), ex.minima[1].tolist(), strict=True))
         if over == "working":
             lo, length = self.working_arc(omega2)
             inside = [(t, v) for t, v in cand if (t - lo) % cycle.TWO_PI <= length]
-            ends = [lo % cycle.TWO_PI, (lo + length) % cycle.TWO_PI]
-            cand = inside + list(zip(ends, acc(np.array(ends)).tolist(), strict=True))
+            ends = np.array([lo % cycle.TWO_PI, (lo + length) % cycle.TWO_PI])
+            acc = self._kernel.group("accel")[0].at(ends, self._kernel.vector(self.params))[0]
+            cand = inside + list(zip(ends.tolist(), acc.tolist(), strict=True))
         t, v = max(cand, key=lambda tv: abs(tv[1]))
-        return abs(v) * omega2 * omega2, float(t)
+        return PeakAcceleration(abs(v) * omega2 * omega2, float(t))
+
+    def acceleration_extremes(self) -> AccelerationExtremes:
+        """Local maxima and minima of d2x/dtheta2 over a turn (length/rad^2), exact."""
+        self._require_full_turn()
+        return self._acceleration_extremes
 
     @cached_property
-    def _acceleration_extremes(self):
-        """Local maxima and minima of d2x/dtheta2 over a turn: [(theta2, values), (theta2, values)]."""
-
-        def acc(th):
-            return self.evaluate(JET, Jet.seed(th, 1.0, 0.0)).x.d2
-
-        th = cycle.grid()
-        a = acc(th)
-        step = th[1] - th[0]
-        prev, nxt = np.roll(a, 1), np.roll(a, -1)
-        kinds = [(a >= prev) & (a > nxt), (a <= prev) & (a < nxt)]
-        idx = [np.flatnonzero(k) for k in kinds]
-        both = np.concatenate(idx)
-        t = cycle.wrap(
-            cycle.stationary(cycle.difference_jet(acc), th[both] - step, th[both] + step, xtol=cycle.FD_XTOL)
-        )
-        v = acc(t)
-        n = idx[0].size
-        return [(t[:n], v[:n]), (t[n:], v[n:])]
+    def _acceleration_extremes(self) -> AccelerationExtremes:
+        # bracketed on the coarsest grid whose spectral second derivative is resolved (exactly evaluated
+        # on the finest grid otherwise), refined with exact third and fourth derivatives
+        k, p = self._kernel, self._kernel.vector(self.params)
+        for n in cycle.GRIDS:
+            x = self._grid[0] if self._grid.shape[1] == n else k.grid_values(self.params, cycle.grid(n))[0]
+            a = second_derivative_on_grid(x)
+            if resolved(a[None, :]):
+                break
+        else:
+            a = k.group("accel")[0].at(cycle.grid(), p)[0]
+        mx, mn = k.refine("accel", a[None, :], [(0, "max"), (0, "min")], p)
+        return AccelerationExtremes((mx.theta, mx.value), (mn.theta, mn.value))
 
     def working_arc(self, omega2: float = 1.0) -> tuple[float, float]:
         """The crank interval of the working (slow) stroke as (counter-clockwise start, length), rad."""
@@ -358,38 +446,36 @@ class Mechanism:
         a, b = self.stroke_angles()
         return (d.theta_max, a) if a >= b else (d.theta_min, b)
 
-    def bounding_box(self):
-        """((x_min, x_max, y_min, y_max) of every joint's path over a turn, crank angles where they occur)."""
+    def bounding_box(self) -> BoundingBox:
+        """Extremes of every joint's path over a turn (exact), with the crank angles where they occur."""
         self._require_full_turn()
-        names = list(self.evaluate(NUMPY, np.zeros(1)).points)
-
-        def coords(t):
-            lp = self.evaluate(JET, t)
-            return cycle.stack([c for k in names for c in lp.points[k]], np.shape(t.v))
-
-        q = 2 * len(names)
-        res, on_grid = cycle.extremes_many(coords, [(k, kind) for k in range(q) for kind in ("max", "min")])
+        k = self._kernel
+        c = k.grid_coords(self.params, cycle.grid())
+        q = c.shape[0]
+        res = k.refine("coords", c, [(i, kind) for i in range(q) for kind in ("max", "min")], k.vector(self.params))
         grid = cycle.grid()
         box, angles = [], []
         for axis in (0, 1):
             for kind, pick in (("min", np.argmin), ("max", np.argmax)):
                 vals, ths = [], []
-                for k in range(axis, q, 2):
-                    t, v = res[2 * k + (kind == "min")]
-                    vals += [*v.tolist(), *on_grid[k].tolist()]
-                    ths += [*t.tolist(), *grid.tolist()]
-                i = int(pick(vals))
-                box.append(float(vals[i]))
-                angles.append(float(ths[i]))
-        return tuple(box), tuple(angles)
+                for i in range(axis, q, 2):
+                    e = res[2 * i + (kind == "min")]
+                    vals += [*e.value.tolist(), *c[i].tolist()]
+                    ths += [*e.theta.tolist(), *grid.tolist()]
+                j = int(pick(vals))
+                box.append(float(vals[j]))
+                angles.append(float(ths[j]))
+        return BoundingBox(*box, tuple(angles))
 
     def footprint(self) -> float:
         """Area of the bounding box of every joint's path over a turn (length^2), exact."""
-        (x0, x1, y0, y1), _ = self.bounding_box()
-        return float((x1 - x0) * (y1 - y0))
+        b = self.bounding_box()
+        return float((b.x_max - b.x_min) * (b.y_max - b.y_min))
 
     def size(self, measure: str = "sum") -> float:
         """Size by ``measure``: 'sum' of link lengths (ground included), 'longest' link, or 'footprint'."""
+        if measure not in ("sum", "longest", "footprint"):
+            raise InvalidParameter(f"size measure is 'sum', 'longest' or 'footprint', got {measure!r}")
         if measure == "footprint":
             return self.footprint()
         lengths = [self.params[k] for k in self.LENGTHS if k in self.params]
@@ -397,8 +483,11 @@ class Mechanism:
 
     def assembly_failures(self) -> list[tuple[str, float, float]]:
         """(closure, theta2_from, theta2_to) intervals (rad) where the loop cannot close; [] if it turns fully."""
-        lp = self.evaluate(NUMPY, np.zeros(1))
-        for k, (what, _) in enumerate(lp.margins):
+        return list(self._failures)
+
+    @cached_property
+    def _failures(self) -> tuple:
+        for k, what in enumerate(self._kernel.margin_names):
             least, at = self._cycle["margins"][k]
             if not least < -cycle.MARGIN_TOL:
                 continue
@@ -409,5 +498,5 @@ class Mechanism:
             found = cycle.negative_intervals(margin)
             if not found:  # a failure narrower than the check grid: at the refined minimum
                 found = [(at, at)]
-            return [(what, lo, hi) for lo, hi in found]
-        return []
+            return tuple((what, lo, hi) for lo, hi in found)
+        return ()

@@ -27,7 +27,7 @@ class CrankShaper(Mechanism):
         if "h" in p and "r6" not in p:
             raise InvalidParameter("CrankShaper: h (slide-line height) needs the rod length r6")
         if "r6" in p and "h" not in p:
-            object.__setattr__(self, "params", {**p, "h": 0.0})
+            object.__setattr__(self, "params", {**p, "h": 0.0})  # frozen by Mechanism.__init__
 
     @staticmethod
     def loop(xp, theta2, p):

@@ -1,0 +1,166 @@
+"""Exact evaluation of a candidate design: the quantities a Result reports, and the certificate of an NLP point.
+
+Every number here comes from the exact cycle analysis of the rebuilt mechanism, never from the NLP's
+sample angles; the exchange loop adds the angles where the two disagree.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from qropt.errors import AssemblyError, QroptError
+from qropt.mechanisms import FourBar
+
+TWO_PI = 2.0 * math.pi
+
+
+@dataclass(frozen=True)
+class Certificate:
+    """What a solve proves about its design.
+
+    exact: the NLP's epigraph value (``nlp``) and the exact value over the full turn (``certified``) agree to
+    ``gap`` (the exchange loop closed; for min_size 'sum' both are the same lengths); rounds: exchange rounds;
+    local: how the point is a local solution (IPOPT's status, or a point of a finite feasible set);
+    global_claim: 'by enumeration (...)', 'best along the closed-form family (...)' or
+    'best of K distinct local optima from N starts'.
+    """
+
+    exact: bool
+    nlp: float | None
+    certified: float | None
+    gap: float
+    rounds: int
+    local: str
+    global_claim: str = ""
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def quantities(problem, m) -> dict:
+    """Exact quantities of a mechanism for a Result (angles in rad, lengths in the problem's units;
+    peak_accel at the problem's omega2 over its ``accel_over`` span)."""
+    q = {"time_ratio": m.time_ratio(), "gamma_min": m.gamma_min().value}
+    q["swing" if isinstance(m, FourBar) else "stroke"] = m.stroke()
+    q["peak_accel"] = None if isinstance(m, FourBar) else m.peak_acceleration(problem.omega2, problem.accel_over).value
+    q["grashof"] = m.grashof().kind if hasattr(m, "grashof") else None
+    q["size"] = m.size(problem.size)
+    q["working_direction"] = m.working_direction(problem.omega2)
+    return q
+
+
+def objective_of(problem, m) -> float | None:
+    """The problem's objective of a mechanism, exactly: gamma_min (rad), size, or peak |a|; None without one."""
+    if problem.objective == "max_gamma_min":
+        return m.gamma_min().value
+    if problem.objective == "min_size":
+        return m.size(problem.size)
+    if problem.objective == "min_peak_accel":
+        return m.peak_acceleration(problem.omega2, problem.accel_over).value
+    return None
+
+
+def objective_value(problem, q) -> float | None:
+    """The problem's objective read from a quantities dict."""
+    return {"max_gamma_min": q["gamma_min"], "min_size": q["size"], "min_peak_accel": q["peak_accel"]}.get(
+        problem.objective
+    )
+
+
+def better(problem, a, b) -> bool:
+    """Whether objective value a beats b for this problem (None loses)."""
+    if b is None:
+        return a is not None
+    if a is None:
+        return False
+    return a > b if problem.objective == "max_gamma_min" else a < b
+
+
+def angle_gap(a, b):
+    return abs((a - b + math.pi) % TWO_PI - math.pi)
+
+
+def certify(problem, range_target, values, branch, th, z, f, gap_tol, feas_tol):
+    """Exact check of an NLP point. Returns (mechanism or None, info dict, angles to add, fractions to add).
+
+    z: the epigraph values and f the NLP objective (None for a point that did not come from the NLP).
+    """
+    try:
+        return _certify(problem, range_target, values, branch, th, z, f, gap_tol, feas_tol)
+    except AssemblyError as e:
+        mids = [((lo + hi) / 2) % TWO_PI for _, lo, hi in e.failures]
+        return None, {"ok": False, "reason": str(e)}, mids, []
+    except QroptError as e:
+        return None, {"ok": False, "reason": str(e)}, [], []
+
+
+def _certify(problem, range_target, values, branch, th, z, f, gap_tol, feas_tol):
+    m = problem.build(values, branch)
+    d = m.dead_centres()
+    if angle_gap(d.theta_max, th[0]) > 1e-7 or angle_gap(d.theta_min, th[1]) > 1e-7:
+        return m, {"ok": False, "reason": "the NLP's dead centres are local, not the global extremes"}, [], []
+    if d.reversals != 1:
+        return m, {"ok": False, "reason": f"the slider reverses {d.reversals} times a turn"}, [], []
+    info = {"ok": True, "nlp": None, "certified": None, "gap": 0.0}
+    add, frac = [], []
+    obj = problem.objective if not range_target else None
+    g = m.gamma_min()
+    if z is None:  # an enumerated point: the exact value only
+        info["certified"] = objective_of(problem, m) if obj else None
+    elif obj == "max_gamma_min":
+        exact = math.cos(g.value)
+        info.update(nlp=math.acos(min(1.0, z[0])), certified=g.value, gap=exact - z[0])
+        if exact - z[0] > gap_tol:  # every local minimum of every joint below the NLP's value
+            for t, v in m.transmission_minima():
+                add += [float(a) for a, b in sorted(zip(t, v, strict=True), key=lambda q: q[1]) if math.cos(b) > z[0]]
+    elif obj == "min_peak_accel":
+        peak = m.peak_acceleration(1.0, problem.accel_over)
+        w2 = problem.omega2**2
+        info.update(nlp=z[0] * w2, certified=peak.value * w2, gap=(peak.value - z[0]) * w2)
+        if peak.value - z[0] > gap_tol:  # every local extreme of the acceleration above the NLP's bound
+            ex = m.acceleration_extremes()
+            ts = np.concatenate([ex.maxima[0], ex.minima[0]])
+            vs = np.concatenate([ex.maxima[1], ex.minima[1]])
+            worst = [float(a) for a, b in sorted(zip(ts, vs, strict=True), key=lambda q: -abs(q[1])) if abs(b) > z[0]]
+            if problem.accel_over == "working":
+                lo, length = m.working_arc()
+                frac += [((a - lo) % TWO_PI) / length for a in worst if (a - lo) % TWO_PI <= length] or [
+                    ((peak.theta2 - lo) % TWO_PI) / length
+                ]
+            else:
+                add += worst or [peak.theta2]
+    elif obj == "min_size" and problem.size == "footprint":
+        box = m.bounding_box()
+        exact = (box.x_max - box.x_min) * (box.y_max - box.y_min)
+        nlp = (z[0] + z[1]) * (z[2] + z[3])
+        info.update(nlp=nlp, certified=exact, gap=exact - nlp)
+        if exact - nlp > gap_tol * max(1.0, exact):
+            add += list(box.angles)
+    elif obj == "min_size":
+        exact = m.size(problem.size)
+        info.update(nlp=f, certified=exact, gap=abs(exact - f) if f is not None else 0.0)
+    bound = problem.conditions.get("gamma_min")
+    if bound is not None and g.value < bound - feas_tol:
+        add.append(g.theta2)
+    return m, info, add, frac
+
+
+def residuals(problem, violations: dict, m, targets) -> dict:
+    """Named violations (>= 0): the NLP rows but its epigraphs, and the targets and gamma bound evaluated exactly."""
+    res = {k: v for k, v in violations.items() if not k.startswith("epigraph")}
+    if m is not None:
+        try:
+            q = {"time_ratio": m.time_ratio(), "stroke": m.stroke(), "swing": m.stroke()}
+        except QroptError:  # the output reverses more than once a turn: no target is met
+            q = dict.fromkeys(("time_ratio", "stroke", "swing"), math.inf)
+        for k, v in targets.items():
+            res[f"{k} (exact)"] = abs(q[k] - v)
+        if "gamma_min" in problem.conditions:
+            res["gamma_min bound (exact)"] = max(0.0, problem.conditions["gamma_min"] - m.gamma_min().value)
+    return res
+
+
+__all__ = ["Certificate", "quantities", "objective_of", "objective_value", "better", "certify", "residuals"]

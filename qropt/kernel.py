@@ -1,0 +1,257 @@
+"""Compiled exact cycle analysis: CasADi Functions built from each type's ``loop`` (the same source).
+
+A mechanism's cycle quantities are smooth periodic functions of the crank angle. Their
+extremes are bracketed on a uniform grid from one vectorised numpy evaluation of the loop,
+started at the vertex of the grid parabola (error O(h^3)), and refined by Newton steps with
+exact AD derivatives, all brackets in one compiled call. A refined point is accepted only if
+its last Newton step is below 1e-10 rad, it stays inside its bracket and the curvature has the
+extreme's sign; any other bracket is refined by the safeguarded Newton/false-position iteration
+of ``cycle.stationary`` on the same exact derivatives. Three groups of quantities are compiled
+on demand: ``cycle`` (output x, squared transmission cosines, assembly margins), ``accel``
+(d2x/dtheta2, refined with exact third and fourth derivatives) and ``coords`` (every joint
+coordinate, for bounding boxes).
+
+Kernels are pure functions of (type, parameter names): building one twice gives the same
+numbers, so they are kept per type for the life of the process.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi
+import numpy as np
+
+from qropt import cycle
+from qropt.closures import RIGHT_ANGLE, transmission_angle, transmission_cos2
+from qropt.ops import CASADI, NUMPY, Jet
+
+NEWTON_STEPS = 3  # from the grid parabola's vertex (error <~1e-4 rad), three steps reach rounding level
+TWO_PI = 2.0 * np.pi
+STEP_TOL = 1e-10  # rad: a last Newton step this small means the point is converged (error ~ step^2)
+_KERNELS: dict = {}
+
+
+@dataclass(frozen=True)
+class Extremes:
+    """Refined local extremes of one quantity: crank angles (rad, [0, 2pi)) and precise values."""
+
+    theta: np.ndarray
+    value: np.ndarray
+
+
+def kernel(cls, names: tuple) -> Kernel:
+    """The compiled analysis of type ``cls`` with parameters ``names`` (built once per process)."""
+    key = (cls, names)
+    k = _KERNELS.get(key)
+    if k is None:
+        k = _KERNELS[key] = Kernel(cls, names)
+    return k
+
+
+class Batched:
+    """A CasADi Function of one column z mapped over K columns, evaluated through CasADi's zero-copy
+    FunctionBuffer (the Python conversions of an ordinary call cost more than the arithmetic here)."""
+
+    def __init__(self, f: casadi.Function):
+        self.f, self.m, self.r = f, f.size1_in(0), f.size1_out(0)
+        self._by_k: dict = {}
+
+    def __call__(self, z: np.ndarray) -> np.ndarray:
+        """z: (K, m) -> (K, r)."""
+        k = z.shape[0]
+        e = self._by_k.get(k)
+        if e is None:
+            zin, out = np.zeros((k, self.m)), np.zeros((k, self.r))
+            buf, ev = self.f.map(k).buffer()
+            buf.set_arg(0, memoryview(zin))
+            buf.set_res(0, memoryview(out))
+            e = self._by_k[k] = (zin, out, ev, buf)
+        zin, out, ev, _ = e
+        zin[:] = z
+        ev()
+        return out.copy()
+
+
+class _Quantity:
+    """One scalar q(theta; p): exact derivatives at points, and a batched Newton refinement of its extremes."""
+
+    def __init__(self, t, P, q, precise):
+        d1 = casadi.jacobian(q, t)
+        d2 = casadi.jacobian(d1, t)
+        n = P.numel()
+        z = casadi.SX.sym("z", 1 + n)
+        d = casadi.Function("d", [t, P], [q, d1, d2])
+        self.derivs = Batched(casadi.Function("dz", [z], [casadi.vertcat(*d(z[0], z[1:]))]))
+        zn = casadi.SX.sym("z", 3 + n)
+        x, lo, hi, pz = zn[0], zn[1], zn[2], zn[3:]
+        for _ in range(NEWTON_STEPS):
+            _, g1, g2 = d(x, pz)
+            x = casadi.fmin(casadi.fmax(x - g1 / g2, lo), hi)
+        _, g1, g2 = d(x, pz)
+        value = casadi.Function("v", [t, P], [precise])
+        self.newton = Batched(casadi.Function("n", [zn], [casadi.vertcat(x, g1 / g2, g2, value(x, pz))]))
+        self.value = Batched(casadi.Function("vz", [z], [value(z[0], z[1:])]))
+
+    def at(self, theta, p):
+        """(q, dq/dtheta, d2q/dtheta2) at the crank angles theta (rad): three arrays."""
+        theta = np.atleast_1d(np.asarray(theta, float))
+        out = self.derivs(np.column_stack([theta, np.broadcast_to(p, (theta.size, p.size))]))
+        return out[:, 0], out[:, 1], out[:, 2]
+
+
+class Kernel:
+    """Compiled cycle analysis of one mechanism structure: quantities in three groups."""
+
+    def __init__(self, cls, names):
+        self.cls, self.names = cls, tuple(names)
+        t, P = casadi.SX.sym("t"), casadi.SX.sym("p", len(names))
+        p = {k: P[i] for i, k in enumerate(names)}
+        lp = cls.loop(CASADI, t, p)
+        self.joints = [j for j, lines in lp.transmission.items() if lines is not RIGHT_ANGLE]
+        self.right_joints = [j for j, lines in lp.transmission.items() if lines is RIGHT_ANGLE]
+        self.margin_names = [what for what, _ in lp.margins]
+        self.point_names = list(lp.points)
+        self._t, self._P, self._lp = t, P, lp
+        self._groups: dict = {}
+
+    def group(self, name: str) -> list[_Quantity]:
+        """'cycle': x, cos^2 of each varying joint (precise value: its transmission angle), margins;
+        'accel': d2x/dtheta2; 'coords': every joint coordinate. Compiled on first use."""
+        g = self._groups.get(name)
+        if g is None:
+            t, P, lp = self._t, self._P, self._lp
+            if name == "cycle":
+                pairs = [(lp.x, lp.x)]
+                lines = [lp.transmission[j] for j in self.joints]
+                pairs += [(transmission_cos2(CASADI, v), transmission_angle(CASADI, v)) for v in lines]
+                pairs += [(m, m) for _, m in lp.margins]
+            elif name == "accel":
+                a = casadi.jacobian(casadi.jacobian(lp.x, t), t)
+                pairs = [(a, a)]
+            else:
+                pairs = [
+                    (c, c) for pt in lp.points.values() for c in (casadi.SX(pt[0]) + 0 * t, casadi.SX(pt[1]) + 0 * t)
+                ]
+            g = self._groups[name] = [_Quantity(t, P, q, v) for q, v in pairs]
+        return g
+
+    def vector(self, params: dict) -> np.ndarray:
+        return np.array([params[k] for k in self.names], float)
+
+    # ---- grid pass -------------------------------------------------------------------------
+    def grid_values(self, params, theta):
+        """Cycle quantities (Q, n) on the crank angles theta, from one numpy evaluation of the loop."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            lp = self.cls.loop(NUMPY, theta, params)
+            q = [lp.x] + [transmission_cos2(NUMPY, lp.transmission[j]) for j in self.joints]
+            q += [m for _, m in lp.margins]
+        out = np.empty((len(q), theta.size))
+        for i, v in enumerate(q):
+            out[i] = v
+        return out
+
+    def grid_coords(self, params, theta):
+        """Every joint coordinate (2 per joint, x then y) on the crank angles theta: (C, n)."""
+        lp = self.cls.loop(NUMPY, theta, params)
+        c = [v for pt in lp.points.values() for v in pt]
+        out = np.empty((len(c), theta.size))
+        for i, v in enumerate(c):
+            out[i] = v
+        return out
+
+    # ---- refinement --------------------------------------------------------------------------
+    def _switch(self, group: str) -> Batched:
+        """One batched Newton call for every slot of a group: each slot runs its own quantity's steps."""
+        key = "switch " + group
+        f = self._groups.get(key)
+        if f is None:
+            fs = [q.newton.f for q in self.group(group)]
+            z = casadi.MX.sym("z", 1 + fs[0].size1_in(0))
+            sw = casadi.Function.conditional(f"{group}_switch", fs, fs[0])
+            f = self._groups[key] = Batched(casadi.Function(f"{group}_newton", [z], [sw(z[0], z[1:])]))
+        return f
+
+    def refine(self, group: str, grid_q, requests, p):
+        """Extremes of a group's quantities. requests: [(quantity index, 'max' | 'min')].
+
+        grid_q: the quantities on ``cycle.grid(n)`` (Q, n). Returns [Extremes] in request order.
+        """
+        n = grid_q.shape[1]
+        h = TWO_PI / n
+        rows = np.array([q for q, _ in requests], int)
+        sgn = np.array([1.0 if kind == "max" else -1.0 for _, kind in requests])
+        v = grid_q[rows] * sgn[:, None]  # every request as a search for maxima
+        prev = np.concatenate([v[:, -1:], v[:, :-1]], axis=1)
+        nxt = np.concatenate([v[:, 1:], v[:, :1]], axis=1)
+        with np.errstate(invalid="ignore"):
+            hit = (v >= prev) & (v > nxt) & np.isfinite(prev) & np.isfinite(nxt)
+        r, i = np.nonzero(hit)
+        counts = np.bincount(r, minlength=rows.size)
+        if not r.size:
+            return [Extremes(np.zeros(0), np.zeros(0)) for _ in requests]
+        v0, vm, vp = v[r, i], prev[r, i], nxt[r, i]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            shift = 0.5 * (vm - vp) / (vm - 2 * v0 + vp)
+        shift[~(np.abs(shift) <= 1.0)] = 0.0
+        th = h * i
+        lo, hi = th - h, th + h
+        z = np.empty((r.size, 4 + p.size))
+        z[:, 0], z[:, 1], z[:, 2], z[:, 3], z[:, 4:] = rows[r], th + shift * h, lo, hi, p
+        res = self._switch(group)(z)
+        x, val = res[:, 0], res[:, 3]
+        ok = (np.abs(res[:, 1]) <= STEP_TOL) & (x > lo) & (x < hi) & (sgn[r] * res[:, 2] < 0)
+        for j in np.flatnonzero(~ok):  # rare: a flat or narrow extreme; the safeguarded iteration
+            quantity = self.group(group)[rows[r[j]]]
+            x[j] = self._safeguarded(quantity, lo[j : j + 1], hi[j : j + 1], p)[0]
+            val[j] = quantity.value(np.concatenate([x[j : j + 1], p])[None, :])[0, 0]
+        x = np.mod(x, TWO_PI)
+        x[x > TWO_PI - 1e-12] = 0.0
+        out, start = [], 0
+        for c in counts.tolist():
+            out.append(Extremes(x[start : start + c], val[start : start + c]))
+            start += c
+        return out
+
+    @staticmethod
+    def _safeguarded(quantity, lo, hi, p):
+        """Bracketed Newton / false position (cycle.stationary) on the exact derivatives."""
+
+        def fun(tj):
+            return Jet.of(*quantity.at(tj.v, p))
+
+        return cycle.stationary(fun, lo, hi)
+
+
+def discrete_extremes(v, kind):
+    """Mask of the cyclic grid's discrete local maxima (or minima) of each row of v (Q, n)."""
+    prev = np.concatenate([v[:, -1:], v[:, :-1]], axis=1)
+    nxt = np.concatenate([v[:, 1:], v[:, :1]], axis=1)
+    with np.errstate(invalid="ignore"):
+        hit = (v >= prev) & (v > nxt) if kind == "max" else (v <= prev) & (v < nxt)
+    return hit & np.isfinite(prev) & np.isfinite(nxt)
+
+
+RESOLVED = 1e-9  # spectrum tail / largest mode below which the grid resolves a quantity
+
+
+def resolved(q) -> bool:
+    """Whether the uniform periodic samples q (Q, n) resolve every row: the top quarter of each row's
+    discrete Fourier spectrum is below RESOLVED times its largest non-constant mode (so the trigonometric
+    interpolant matches the function to that relative level and no extreme hides between samples)."""
+    if not np.isfinite(q).all():
+        return False
+    c = np.abs(np.fft.rfft(q, axis=1))
+    scale = c[:, 1:].max(axis=1)
+    tail = c[:, -(c.shape[1] // 4) :].max(axis=1)
+    return bool(np.all(tail <= RESOLVED * scale))
+
+
+def second_derivative_on_grid(x):
+    """d2x/dtheta2 on a uniform periodic grid by spectral differentiation (used for bracketing only)."""
+    c = np.fft.rfft(x)
+    k = np.arange(c.size)
+    return np.fft.irfft(-(k * k) * c, x.size)
+
+
+__all__ = ["kernel", "Kernel", "Extremes", "discrete_extremes", "resolved", "second_derivative_on_grid"]

@@ -1,0 +1,90 @@
+"""Where local solves begin: the closed forms first, then a scrambled Sobol design over the free bounds.
+
+A closed form that enumerates every solution of a problem's structure replaces the multi-start; one
+that walks a family holding every solution is scanned and only its best points are refined.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import qmc
+
+from qropt import analytic
+from qropt.errors import QroptError
+
+
+@dataclass(frozen=True)
+class Plan:
+    """The starts of one solve. kind: 'enumeration', 'family', 'partial' or 'none' (see analytic.WarmStarts)."""
+
+    analytic: tuple
+    kind: str
+    how: str
+
+
+def branches(problem) -> list[dict]:
+    """Every combination of the problem's allowed assembly-branch signs."""
+    names = list(problem.branches)
+    return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*problem.branches.values())]
+
+
+def plan(problem, use_analytic: bool = True) -> Plan:
+    """The closed-form starts (clipped to the bounds) and what they cover."""
+    if not use_analytic:
+        return Plan((), "none", "closed forms not used")
+    w = analytic.warm_starts(problem)
+
+    def clip(v):
+        return {k: min(max(x, problem.free[k][0]), problem.free[k][1]) for k, x in v.items()}
+
+    return Plan(tuple(clip(v) for v in w.points), w.kind, w.how)
+
+
+def sobol(problem, n: int, seed: int) -> list[dict]:
+    """Up to n scrambled-Sobol points over the free bounds (log-spaced for lengths) whose mechanism turns fully
+    on the first branch; if none does among 8n, the first n points as they are."""
+    if n <= 0:
+        return []
+    names = list(problem.free)
+    points, kept = [], []
+    branch = branches(problem)[0]
+    for row in qmc.Sobol(len(names), scramble=True, seed=seed).random(8 * n):
+        v = {}
+        for k, x in zip(names, row, strict=True):
+            lo, hi = problem.free[k]
+            v[k] = lo * (hi / lo) ** x if k in problem.mechanism.LENGTHS and lo > 0 else lo + (hi - lo) * x
+        points.append(v)
+        if orientation(problem, v, branch) is not None:
+            kept.append(v)
+            if len(kept) == n:
+                break
+    return kept or points[:n]
+
+
+def orientation(problem, values, branch) -> int | None:
+    """+1 if the design's slow interval runs from theta_max to theta_min (counter-clockwise), -1 if not,
+    None if it does not build or turn fully."""
+    try:
+        a, b = problem.build(values, branch).stroke_angles()
+    except QroptError:
+        return None
+    return 1 if a >= b else -1
+
+
+def local_best(scores: list, maximise: bool, keep: int = 3) -> list[int]:
+    """Indices of the best local optima of a sequence of scores (None where a point is invalid), best first."""
+    s = np.array([np.nan if v is None else (v if maximise else -v) for v in scores], float)
+    ok = np.isfinite(s)
+    idx = []
+    for i in np.flatnonzero(ok):
+        left = s[i - 1] if i > 0 and ok[i - 1] else -np.inf
+        right = s[i + 1] if i + 1 < s.size and ok[i + 1] else -np.inf
+        if s[i] >= left and s[i] >= right:
+            idx.append(int(i))
+    return sorted(idx, key=lambda i: -s[i])[:keep]
+
+
+__all__ = ["Plan", "branches", "plan", "sobol", "orientation", "local_best"]
