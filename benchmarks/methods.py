@@ -4,14 +4,12 @@ values it returns (or None), its function evaluations and a message. All start f
 from __future__ import annotations
 
 import importlib
-import math
 
 import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
 
-from qropt import QroptError, solve
-from qropt.nlp import slow_interval
-from qropt.solve import branches, build, formulation, start_orientation, starts
+from qropt import solve, starts
+from qropt.solve import DEFAULT
 
 STARTS = 8  # Sobol starts for every multi-start method, as qropt's default
 FEASIBLE = 1e-6  # a local method's design counts only if it meets the targets this well
@@ -38,35 +36,22 @@ def _from_result(problem, r):
 
 
 def _scipy_local(problem, seed, method):
-    """A local scipy method on qropt's NLP functions (exact CasADi derivatives) from qropt's starts, both TR
-    orientations for the space-filling starts; no exchange loop. The best design by exact evaluation."""
+    """A local scipy method on qropt's NLP functions (exact CasADi derivatives) from qropt's starts (every closed
+    form, then the Sobol points, both TR orientations for those); no exchange loop. The best design by exact
+    evaluation."""
     from problems import _oracle
 
     best, nfev = None, 0
-    for origin, v in starts(problem, STARTS, seed, True):
-        for br in branches(problem):
-            own = start_orientation(problem, v, br)
-            for way in [own] if origin == "analytic" and own else [1, -1]:
-                form = formulation(problem, br, way)
-                samples, fractions = form.base_samples()
-                p = form.param_vector(dict(problem.targets), samples, fractions)
-                tr = problem.targets.get("time_ratio")
-                try:
-                    d = build(problem, v, br).dead_centres()
-                    t0 = d.theta_max
-                except QroptError:
-                    t0 = 0.5
-                th0 = (t0, t0 + (slow_interval(tr, way) if tr else math.pi))
-                w0 = form.epigraph_start(form.pack(v, th0), p)
-                x, n = _local(form, w0, p, method)
-                nfev += n
-                if x is None:
-                    continue
-                values = dict(zip(form.free, x[: form.nx].tolist(), strict=True))
-                s = _oracle.score(problem, values)
-                feasible = s is not None and violation(problem, s[1]) <= FEASIBLE
-                if feasible and _oracle._better(problem, s[0], best[0] if best else None):
-                    best = (s[0], values, br)
+    for _origin, _v, br, _way, form, w0, p in local_starts(problem, seed):
+        x, n = local_solve(form, w0, p, method)
+        nfev += n
+        if x is None:
+            continue
+        values = dict(zip(form.free, x[: form.nx].tolist(), strict=True))
+        s = _oracle.score(problem, values)
+        feasible = s is not None and violation(problem, s[1]) <= FEASIBLE
+        if feasible and _oracle._better(problem, s[0], best[0] if best else None):
+            best = (s[0], values, br)
     return {
         "values": best[1] if best else None,
         "nfev": nfev,
@@ -75,7 +60,25 @@ def _scipy_local(problem, seed, method):
     }
 
 
-def _local(form, w0, p, method):
+def local_starts(problem, seed, starts_n=STARTS, solver=DEFAULT):
+    """qropt's start points on its formulation: (origin, values, branch, orientation, formulation, w0, p)."""
+    pts = [("analytic", v) for v in starts.plan(problem).analytic]
+    pts += [("multistart", v) for v in starts.sobol(problem, starts_n, seed)]
+    targets = dict(problem.targets)
+    for origin, v in pts:
+        for br in starts.branches(problem):
+            own = starts.orientation(problem, v, br)
+            for way in [own] if origin == "analytic" and own else [1, -1]:
+                th0, way = starts.dead_centre_start(problem, v, br, targets, way, None)
+                form = solver.formulation(problem, br, way)
+                samples, fractions = form.base_samples()
+                p = form.param_vector(targets, samples, fractions)
+                yield origin, v, br, way, form, form.epigraph_start(form.pack(v, th0), p), p
+
+
+def local_solve(form, w0, p, method="SLSQP"):
+    """The one scipy driver of the benchmarks: SLSQP or trust-constr on a formulation, exact derivatives.
+    Returns (w or None, function evaluations)."""
     fn = form.functions
     lbx, ubx = form.bounds()
     w0 = np.clip(w0, lbx, ubx)

@@ -1,29 +1,26 @@
-"""The paper's design task three ways, in one run: the closed form alone (the floor), ``solve()``
-re-solving the NLP it built once, and scipy SLSQP on the same formulation (same CasADi functions,
-exact derivatives, same starts). ``solve()`` also builds every local optimum and certifies it (exact
-dead centres, gamma_min, peak acceleration); SLSQP returns its iterate only. Prints medians (ms) and
-ratios; writes benchmarks/results/synthesis.json.
+"""The paper's design task, in one run: the closed form alone (the floor), ``solve()`` with its defaults (every
+local optimum, certified), ``solve()`` with the closed-form starts only, and scipy SLSQP on the same formulation
+(the benchmarks' one driver: same CasADi functions, exact derivatives, qropt's starts). Also the exact analysis
+of a new mechanism (construction, TR, stroke, gamma_min), its peak acceleration, and a full-cycle motion.
+Prints medians and ratios; writes benchmarks/results/synthesis.json.
 
 Run: ``python -m benchmarks.synthesis``.
 """
 
 from __future__ import annotations
 
-import importlib
 import math
 import statistics
 import time
 
-import casadi
 import numpy as np
-from scipy.optimize import minimize
 
 import qropt
+from benchmarks.methods import local_solve, local_starts
 from benchmarks.report import save
 from qropt import DragLinkSlider, analytic
-from qropt.solve import branches, formulation, start_orientation, starts
+from qropt.examples import paper_mechanism, paper_problem
 
-solve_module = importlib.import_module("qropt.solve")
 R1, R2, R4, R6 = 0.1, 0.225, 0.275, 0.3
 
 
@@ -45,93 +42,64 @@ def closed_form():
 
 
 def slsqp(problem):
-    """SLSQP on qropt's NLP (same variables, constraints, starts): the best converged design."""
+    """SLSQP on qropt's NLP from qropt's starts: the best converged design's values (no certificate)."""
     best = None
-    for _, v in starts(problem, 0, 0, True):
-        for br in branches(problem):
-            way = start_orientation(problem, v, br)
-            form = formulation(problem, br, way)
-            samples, fractions = form.base_samples()
-            p = form.param_vector(dict(problem.targets), samples, fractions)
-            m0 = solve_module.build(problem, v, br)
-            d = m0.dead_centres()
-            w0 = form.epigraph_start(form.pack(v, (d.theta_max, d.theta_max + m0.stroke_angles()[0])), p)
-            lbx, ubx = form.bounds()
-            fn = form.functions
-
-            def f(w, fn=fn, p=p):
-                return float(fn(w, p)[0])
-
-            def df(w, fn=fn, p=p):
-                return np.array(fn(w, p)[2]).ravel()
-
-            eq = form.lbg == form.ubg
-            lo = ~eq & np.isfinite(form.lbg)
-            hi = ~eq & np.isfinite(form.ubg)
-
-            def g_all(w, fn=fn, p=p):
-                out = fn(w, p)
-                return np.array(out[1]).ravel(), casadi.DM(out[3]).full()
-
-            cons = [
-                {
-                    "type": "eq",
-                    "fun": lambda w, m=eq, f=form: g_all(w)[0][m] - f.lbg[m],
-                    "jac": lambda w, m=eq: g_all(w)[1][m],
-                },
-                {
-                    "type": "ineq",
-                    "fun": lambda w, m=lo, f=form: g_all(w)[0][m] - f.lbg[m],
-                    "jac": lambda w, m=lo: g_all(w)[1][m],
-                },
-                {
-                    "type": "ineq",
-                    "fun": lambda w, m=hi, f=form: f.ubg[m] - g_all(w)[0][m],
-                    "jac": lambda w, m=hi: -g_all(w)[1][m],
-                },
-            ]
-            bounds = list(
-                zip(np.where(np.isfinite(lbx), lbx, None), np.where(np.isfinite(ubx), ubx, None), strict=True)
-            )
-            r = minimize(
-                f, w0, jac=df, bounds=bounds, constraints=cons, method="SLSQP", options={"ftol": 1e-12, "maxiter": 300}
-            )
-            if r.success and (best is None or r.fun < best.fun):
-                best = r
-    return best
+    for *_, form, w0, p in local_starts(problem, 0):
+        x, _ = local_solve(form, w0, p, "SLSQP")
+        if x is not None:
+            f = float(form.functions(x, p)[0])
+            g = np.array(form.functions(x, p)[1]).ravel()
+            feasible = np.all(g >= form.lbg - 1e-8) and np.all(g <= form.ubg + 1e-8)
+            if feasible and (best is None or f < best[0]):
+                best = (f, dict(zip(form.free, x[: form.nx].tolist(), strict=True)))
+    return best[1] if best else None
 
 
-def main(repeat: int = 15):
-    problem = importlib.import_module("problems.paper_drag_link").build()
-    qropt.solve(problem, starts_n=0)  # build the NLP once
+def analysis(params):
+    m = DragLinkSlider(**params)
+    return m.time_ratio(), m.stroke(), m.gamma_min().value
+
+
+def main(repeat: int = 21):
+    problem = paper_problem()
+    qropt.solve(problem)  # build the NLPs and compile the kinematics once
     t_floor, m_floor = timed(closed_form, repeat)
-    fresh = solve_module._build.cache_clear  # no design carried over between repeats
-
-    t_solve, res = timed(lambda: (fresh(), qropt.solve(problem, starts_n=0))[1], repeat)
-    t_slsqp, best = timed(lambda: (fresh(), slsqp(problem))[1], repeat)
-    r3_slsqp = float(best.x[0]) if best is not None else float("nan")
-    g_slsqp = DragLinkSlider(r1=R1, r2=R2, r3=r3_slsqp, r4=R4, r5=float(best.x[1]), r6=R6).gamma_min().value
-    g_floor = m_floor.gamma_min().value
+    t_default, res = timed(lambda: qropt.solve(problem), repeat)
+    t_analytic, res0 = timed(lambda: qropt.solve(problem, starts_n=0), repeat)
+    t_slsqp, best = timed(lambda: slsqp(problem), max(3, repeat // 4))
+    r3_slsqp = best["r3"] if best else float("nan")
+    g_slsqp = DragLinkSlider(r1=R1, r2=R2, r3=r3_slsqp, r4=R4, r5=best["r5"], r6=R6).gamma_min().value
+    params = dict(paper_mechanism().params)
+    t_ana, _ = timed(lambda: analysis(params), 200)
+    t_peak, _ = timed(lambda: DragLinkSlider(**params).peak_acceleration(10.0), 200)
+    m = DragLinkSlider(**params)
+    theta = np.linspace(0.0, 2 * math.pi, 3600, endpoint=False)
+    t_motion, _ = timed(lambda: m.motion(theta, 10.0), 200)
     rows = [
-        ("closed form (eqs. 7-13 + exact gamma_min)", t_floor, m_floor.params["r3"], math.degrees(g_floor)),
-        ("qropt solve(), NLP built once", t_solve, res.params["r3"], math.degrees(res.objective)),
-        ("scipy SLSQP, same formulation (no certificate)", t_slsqp, r3_slsqp, math.degrees(g_slsqp)),
+        ("closed form (eqs. 7-13 + exact gamma_min)", t_floor, m_floor.params["r3"], m_floor.gamma_min().value),
+        ("qropt solve(), defaults", t_default, res.params["r3"], res.objective),
+        ("qropt solve(), closed-form starts only", t_analytic, res0.params["r3"], res0.objective),
+        ("scipy SLSQP, same formulation and starts", t_slsqp, r3_slsqp, g_slsqp),
     ]
     print(f"paper design task: TR 1.5, stroke 0.3 m, max gamma_min (median of {repeat}, ms)")
     for name, t, r3, g in rows:
-        print(f"  {name:48s} {t:9.2f} ms  {t / t_floor:7.1f}x floor  r3 = {r3:.10f}  gamma_min {g:.6f} deg")
-    print(
-        f"  solve(): {len(res.local_optima)} local optima, certificate gap {res.certificate['gap']:.1e}, "
-        f"IPOPT {1e3 * res.stats['t_ipopt']:.2f} ms of it"
-    )
-    print(f"  SLSQP / solve(): {t_slsqp / t_solve:.2f}x")
+        print(
+            f"  {name:44s} {t:9.2f} ms  {t / t_floor:7.1f}x floor  r3 = {r3:.10f}  gamma_min {math.degrees(g):.6f} deg"
+        )
+    print(f"  solve(): {len(res.local_optima)} local optima; {res.certificate.global_claim}")
+    print(f"  SLSQP / solve() defaults: {t_slsqp / t_default:.1f}x")
+    print("exact analysis of the paper's mechanism (median of 200)")
+    print(f"  construction + TR + stroke + gamma_min      {1e3 * t_ana:9.1f} us")
+    print(f"  construction + peak acceleration            {1e3 * t_peak:9.1f} us")
+    print(f"  x, v, a and link rates at 3,600 angles      {1e3 * t_motion:9.1f} us")
     save(
         "synthesis.json",
         {
-            "median_ms": {"closed_form": t_floor, "solve": t_solve, "slsqp": t_slsqp},
+            "median_ms": {"closed_form": t_floor, "solve_default": t_default, "solve_closed_form_starts": t_analytic,
+                          "slsqp": t_slsqp, "analysis": t_ana, "peak_acceleration": t_peak, "motion_3600": t_motion},
             "r3": {"closed_form": m_floor.params["r3"], "solve": res.params["r3"], "slsqp": r3_slsqp},
         },
-    )
+    )  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -40,6 +40,36 @@ class Certificate:
         return asdict(self)
 
 
+class Designs:
+    """Mechanisms built from a problem's free values, each built once (they are immutable); one per Solver.
+
+    Calling it is ``problem.build(values, branch)``, raising the same QroptError for a design that cannot exist.
+    """
+
+    def __init__(self, size: int = 512):
+        self.size, self._memo = size, {}
+
+    def __call__(self, problem, values: dict, branch: dict):
+        key = (id(problem), tuple(sorted(values.items())), tuple(sorted(branch.items())))
+        hit = self._memo.get(key)
+        if hit is None or hit[0] is not problem:
+            if len(self._memo) >= self.size:
+                self._memo.clear()
+            try:
+                hit = (problem, problem.build(values, branch), None)
+            except QroptError as e:
+                hit = (problem, None, e)
+            self._memo[key] = hit
+        if hit[2] is not None:
+            raise hit[2]
+        return hit[1]
+
+
+def build(problem, values, branch):
+    """problem.build, uncached (the default where no Solver's Designs is given)."""
+    return problem.build(values, branch)
+
+
 def quantities(problem, m) -> dict:
     """Exact quantities of a mechanism for a Result (angles in rad, lengths in the problem's units;
     peak_accel at the problem's omega2 over its ``accel_over`` span)."""
@@ -83,13 +113,13 @@ def angle_gap(a, b):
     return abs((a - b + math.pi) % TWO_PI - math.pi)
 
 
-def certify(problem, range_target, values, branch, th, z, f, gap_tol, feas_tol):
+def certify(problem, range_target, values, branch, th, z, f, gap_tol, feas_tol, build=build):
     """Exact check of an NLP point. Returns (mechanism or None, info dict, angles to add, fractions to add).
 
     z: the epigraph values and f the NLP objective (None for a point that did not come from the NLP).
     """
     try:
-        return _certify(problem, range_target, values, branch, th, z, f, gap_tol, feas_tol)
+        return _certify(problem, range_target, build(problem, values, branch), th, z, f, gap_tol, feas_tol)
     except AssemblyError as e:
         mids = [((lo + hi) / 2) % TWO_PI for _, lo, hi in e.failures]
         return None, {"ok": False, "reason": str(e)}, mids, []
@@ -97,8 +127,7 @@ def certify(problem, range_target, values, branch, th, z, f, gap_tol, feas_tol):
         return None, {"ok": False, "reason": str(e)}, [], []
 
 
-def _certify(problem, range_target, values, branch, th, z, f, gap_tol, feas_tol):
-    m = problem.build(values, branch)
+def _certify(problem, range_target, m, th, z, f, gap_tol, feas_tol):
     d = m.dead_centres()
     if angle_gap(d.theta_max, th[0]) > 1e-7 or angle_gap(d.theta_min, th[1]) > 1e-7:
         return m, {"ok": False, "reason": "the NLP's dead centres are local, not the global extremes"}, [], []
@@ -149,8 +178,9 @@ def _certify(problem, range_target, values, branch, th, z, f, gap_tol, feas_tol)
 
 
 def residuals(problem, violations: dict, m, targets) -> dict:
-    """Named violations (>= 0): the NLP rows but its epigraphs, and the targets and gamma bound evaluated exactly."""
-    res = {k: v for k, v in violations.items() if not k.startswith("epigraph")}
+    """Named violations (>= 0): the NLP rows but its objective's own (epigraphs, lifted extremes), and the targets
+    and gamma bound evaluated exactly."""
+    res = {k: v for k, v in violations.items() if not k.startswith(("epigraph", "lifted"))}
     if m is not None:
         try:
             q = {"time_ratio": m.time_ratio(), "stroke": m.stroke(), "swing": m.stroke()}
@@ -163,4 +193,14 @@ def residuals(problem, violations: dict, m, targets) -> dict:
     return res
 
 
-__all__ = ["Certificate", "quantities", "objective_of", "objective_value", "better", "certify", "residuals"]
+__all__ = [
+    "Certificate",
+    "Designs",
+    "build",
+    "quantities",
+    "objective_of",
+    "objective_value",
+    "better",
+    "certify",
+    "residuals",
+]

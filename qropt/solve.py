@@ -17,14 +17,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qropt import starts as starts_
-from qropt.certify import Certificate, better, certify, objective_of, objective_value, quantities, residuals
+from qropt.certify import Certificate, Designs, better, certify, objective_of, objective_value, quantities, residuals
 from qropt.errors import ProblemError, QroptError
-from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, TWO_PI, Formulation, slow_interval
+from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, TWO_PI, Formulation
 from qropt.problem import Problem
 from qropt.result import Result
 
 TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
 ACCEPTABLE = "Solved_To_Acceptable_Level"
+MIN_WAY = 3  # space-filling starts tried in each way of meeting the TR equality, at least
 
 
 @dataclass
@@ -44,6 +45,7 @@ class Candidate:
     rounds: int = 0
     origin: str = ""
     q: dict | None = None
+    pruned: bool = False
 
 
 class Solver:
@@ -56,8 +58,9 @@ class Solver:
     Results do not depend on what the Solver solved before: formulations take every value as a parameter.
     """
 
-    def __init__(self, *, tolerances: dict | None = None, ipopt_options: dict | None = None, samples: int = BASE_SAMPLES,
-                 extra: int = EXTRA_SAMPLES, starts_n: int = 8, seed: int = 0, max_rounds: int = 30):  # fmt: skip
+    def __init__(self, *, tolerances: dict | None = None, ipopt_options: dict | None = None,
+                 samples: int = BASE_SAMPLES, extra: int = EXTRA_SAMPLES, starts_n: int = 8, seed: int = 0,
+                 max_rounds: int = 30):  # fmt: skip
         tol = {**TOLERANCES, **(tolerances or {})}
         if set(tol) != set(TOLERANCES) or not all(_positive(v) for v in tol.values()):
             raise ProblemError(f"tolerances are positive numbers for {sorted(TOLERANCES)}, got {tolerances!r}")
@@ -98,16 +101,20 @@ class Solver:
 
     # ---- one local solve -------------------------------------------------------------------------
     def local(self, problem, values0, branch, targets, *, orientation=None, max_rounds=None, range_target=None,
-              sense=1) -> Candidate:  # fmt: skip
+              sense=1, designs=None, bound=None) -> Candidate:  # fmt: skip
         """IPOPT from values0 with the exchange loop; orientation: which way the TR equality is met (+1, -1),
-        None for the start's own."""
+        None for the start's own; designs: the solve's memo of built mechanisms; bound: the incumbent's NLP
+        objective value, above which the exchange loop stops (the start is pruned)."""
         max_rounds = self.max_rounds if max_rounds is None else max_rounds
-        th0, orientation = _dead_centre_start(problem, values0, branch, targets, orientation, range_target)
+        designs = designs or Designs()
+        th0, orientation = starts_.dead_centre_start(
+            problem, values0, branch, targets, orientation, range_target, designs
+        )
         form = self.formulation(problem, branch, orientation, range_target, sense)
         samples, fractions = form.base_samples()
         used = used_f = form.n_base
         p = form.param_vector(targets, samples, fractions)
-        w = form.epigraph_start(form.pack(values0, th0, phi=_peaks(problem, values0, branch)), p)
+        w = form.epigraph_start(form.pack(values0, th0, phi=_peaks(problem, values0, branch, designs)), p)
         c = Candidate(False, dict(values0), branch, orientation)
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
         st, g, info, m = {}, None, {}, None
@@ -119,10 +126,13 @@ class Solver:
             c.statuses.append(st.get("return_status", "?"))
             c.values = dict(zip(form.free, w[: form.nx].tolist(), strict=True))
             th, z = w[form.nx : form.nx + 2], w[form.nx + 2 : form.nx + 2 + form.nz]
-            m, info, add, frac = certify(problem, range_target, c.values, branch, th, z, f, gap_tol, feas_tol)
+            m, info, add, frac = certify(problem, range_target, c.values, branch, th, z, f, gap_tol, feas_tol, designs)
             if not _converged(st) and not range_target:
                 break
             if not add and not frac:
+                break
+            if bound is not None and info.get("ok") and f > bound + 1e-9 * max(1.0, abs(bound)):
+                c.pruned = True  # more samples only raise this basin's NLP value: it cannot beat the incumbent
                 break
             used = _place(samples, used, add, TWO_PI, 0.05, form.n_base)
             used_f = _place(fractions, used_f, frac, 1.0, 0.01, form.n_base)
@@ -130,17 +140,18 @@ class Solver:
             w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
         c.mechanism, c.info = m, info
         c.residuals = residuals(problem, form.violations(g), m, {k: targets[k] for k in form.targets})
-        c.ok = bool(info.get("ok")) and _converged(st) and _within(c, self.tolerances)
+        c.ok = bool(info.get("ok")) and _converged(st) and _within(c, self.tolerances) and not c.pruned
         return c
 
-    def polish(self, problem, values0, branch, targets) -> Candidate:
+    def polish(self, problem, values0, branch, targets, designs=None) -> Candidate:
         """Newton on the target and dead-centre equations from a closed-form point of a square problem (as many
         free parameters as targets): the point of the finite solution set that the closed form names."""
-        th0, orientation = _dead_centre_start(problem, values0, branch, targets, None, None)
+        designs = designs or Designs()
+        th0, orientation = starts_.dead_centre_start(problem, values0, branch, targets, None, None, designs)
         form = self.formulation(problem, branch, orientation)
         rows = form.square_rows
         if rows is None:
-            return self.local(problem, values0, branch, targets, orientation=orientation)
+            return self.local(problem, values0, branch, targets, orientation=orientation, designs=designs)
         p = form.param_vector(targets, *form.base_samples())
         w = form.pack(values0, th0)
         n = form.nx + 2
@@ -162,7 +173,7 @@ class Solver:
         g = np.array(form.functions(w, p)[1]).ravel()
         tol = self.tolerances
         m, info, _, _ = certify(problem, None, c.values, branch, w[form.nx : n], None, None, tol["gap"],
-                                tol["feasibility"])  # fmt: skip
+                                tol["feasibility"], designs)  # fmt: skip
         c.mechanism, c.info, c.statuses = m, info, ["enumerated point (Newton)"]
         c.residuals = residuals(problem, form.violations(g), m, {k: targets[k] for k in form.targets})
         inside = all(lo - 1e-12 <= c.values[k] <= hi + 1e-12 for k, (lo, hi) in problem.free.items())
@@ -184,31 +195,28 @@ class Solver:
             problem, targets, extra_starts, starts_n, seed, max_rounds
         )
         plan = starts_.plan(problem, use_analytic)
+        designs = Designs()  # every mechanism this solve builds, built once
         runs = [("given", v) for v in extra]
         cands: list[Candidate] = []
         claim = ""
         if plan.kind == "enumeration" and not extra:
             for v in plan.analytic:
                 for br in starts_.branches(problem):
-                    cands.append(self.polish(problem, v, br, targets))
+                    cands.append(self.polish(problem, v, br, targets, designs))
             claim = f"by enumeration: {plan.how}"
         elif plan.kind == "family" and not extra:
-            runs += self._family_starts(problem, plan)
+            runs += self._family_starts(problem, plan, designs)
             claim = (
                 f"best along a closed-form family that holds every solution ({plan.how}; {len(plan.analytic)} points)"
             )
         else:
-            runs += [("analytic", v) for v in plan.analytic] + [("multistart", v) for v in
-                                                                 starts_.sobol(problem, starts_n, seed)]  # fmt: skip
-        for origin, v, *br in runs:
-            for b in br or starts_.branches(problem):
-                own = starts_.orientation(problem, v, b)
-                ways = [own] if origin != "multistart" and own else [1, -1]
-                for way in ways:
-                    c = self.local(problem, v, b, targets, orientation=way, max_rounds=max_rounds)
-                    c.origin = origin
-                    cands.append(c)
+            runs += [("analytic", v) for v in plan.analytic]
+            runs += [("multistart", v) for v in starts_.sobol(problem, starts_n, seed, designs)]
+        cands += self._run(problem, runs, targets, max_rounds, designs, both_ways=False)
         good = [c for c in cands if c.ok]
+        if not good and any(o == "multistart" for o, *_ in runs):  # the other way of meeting the TR equality
+            cands += self._run(problem, [r for r in runs if r[0] == "multistart"], targets, max_rounds, designs, True)
+            good = [c for c in cands if c.ok]
         if plan.kind == "enumeration" and not extra and not good:  # the closed form missed: search instead
             return self.solve(problem, starts_n=starts_n, use_analytic=False, seed=seed, targets=targets,
                               max_rounds=max_rounds)  # fmt: skip
@@ -229,11 +237,39 @@ class Solver:
             return self._result(problem, best_first[0], None, claim, stats, local)
         return self._diagnose(problem, cands, targets, starts_n, seed, stats, t0)
 
-    def _family_starts(self, problem, plan):
+    def _run(self, problem, runs, targets, max_rounds, designs, both_ways):
+        """A local solve from every start in its own TR orientation (both where it has none, or if asked); the
+        space-filling starts also try the other orientation until each has at least MIN_WAY of them."""
+        plans, count = [], {1: 0, -1: 0}
+        for origin, v, *br in runs:
+            for b in br or starts_.branches(problem):
+                own = starts_.orientation(problem, v, b, designs)
+                ways = [own] if own and not both_ways else [1, -1]
+                plans.append((origin, v, b, ways))
+                if origin == "multistart":
+                    for way in ways:
+                        count[way] += 1
+        for origin, _, _, ways in plans:
+            if origin == "multistart" and len(ways) == 1 and count[-ways[0]] < MIN_WAY:
+                ways.append(-ways[0])
+                count[-ways[0]] += 1
+        out, bound = [], None
+        for origin, v, b, ways in plans:
+            for way in ways:
+                c = self.local(problem, v, b, targets, orientation=way, max_rounds=max_rounds, designs=designs,
+                               bound=bound)  # fmt: skip
+                c.origin = origin
+                out.append(c)
+                if c.ok and problem.objective:
+                    f = _nlp_value(problem, c.info)
+                    bound = f if bound is None else min(bound, f)
+        return out
+
+    def _family_starts(self, problem, plan, designs):
         """The best local optima of the objective along the closed-form family (exact evaluation), per branch."""
         out = []
         for br in starts_.branches(problem):
-            scores = [_score(problem, v, br) for v in plan.analytic]
+            scores = [_score(problem, v, br, designs) for v in plan.analytic]
             out += [("family", plan.analytic[i], br) for i in starts_.local_best(scores, problem.objective
                                                                                 == "max_gamma_min")]  # fmt: skip
         return out
@@ -249,6 +285,8 @@ class Solver:
                 raise ProblemError(f"targets {unknown} are not targets of this problem ({sorted(problem.targets)})")
             problem = problem.replace(targets={**problem.targets, **targets})
         extra = []
+        if isinstance(extra_starts, (dict, str, bytes)) or not hasattr(extra_starts, "__iter__"):
+            raise ProblemError(f"extra_starts is a list of free-parameter dicts, got {extra_starts!r}")
         for v in extra_starts:
             if not isinstance(v, dict) or set(problem.free) - set(v):
                 raise ProblemError(f"each extra start gives every free parameter {sorted(problem.free)}, got {v!r}")
@@ -369,9 +407,24 @@ def _positive(v) -> bool:
 
 
 def _real(name, v) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
+    try:
+        ok = (
+            isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool) and math.isfinite(float(v))
+        )
+    except OverflowError:
+        ok = False
+    if not ok:
         raise ProblemError(f"{name} must be a finite number, got {v!r}")
     return float(v)
+
+
+def _nlp_value(problem, info) -> float:
+    """A certified objective in the NLP's terms (what IPOPT minimises): cos gamma_min, peak |d2x/dtheta2|, size."""
+    if problem.objective == "max_gamma_min":
+        return math.cos(info["certified"])
+    if problem.objective == "min_peak_accel":
+        return info["certified"] / problem.omega2**2
+    return info["certified"]
 
 
 def _within(c: Candidate, tol) -> bool:
@@ -383,26 +436,10 @@ def _converged(stats) -> bool:
     return bool(stats.get("success")) or stats.get("return_status") == ACCEPTABLE
 
 
-def _dead_centre_start(problem, values, branch, targets, orientation, range_target):
-    """Dead-centre angles of the start design (moved to meet the TR target) and the TR orientation."""
-    try:
-        m0 = problem.build(values, branch)
-        d = m0.dead_centres()
-        a, b = m0.stroke_angles()
-        orientation = orientation or (1 if a >= b else -1)
-        th0 = (d.theta_max, d.theta_max + a)
-    except QroptError:
-        orientation, tr = orientation or 1, targets.get("time_ratio", 1.5)
-        th0 = (0.5, 0.5 + slow_interval(tr, orientation))
-    if "time_ratio" in targets and range_target != "time_ratio":
-        th0 = (th0[0], th0[0] + slow_interval(targets["time_ratio"], orientation))
-    return th0, orientation
-
-
-def _score(problem, values, branch):
+def _score(problem, values, branch, build):
     """The exact objective of a design that builds and meets the gamma_min bound, else None."""
     try:
-        m = problem.build(values, branch)
+        m = build(problem, values, branch)
         if m.dead_centres().reversals != 1:
             return None
         bound = problem.conditions.get("gamma_min")
@@ -413,14 +450,14 @@ def _score(problem, values, branch):
         return None
 
 
-def _peaks(problem, values, branch):
+def _peaks(problem, values, branch, build):
     """Initial lifted acceleration extremes: the start design's largest |d2x/dtheta2| (in the working
     stroke when asked), else spread over the turn."""
     if problem.objective != "min_peak_accel":
         return None
     try:
-        ex = problem.build(values, branch).acceleration_extremes()
-        m = problem.build(values, branch)
+        m = build(problem, values, branch)
+        ex = m.acceleration_extremes()
     except QroptError:
         return None
     ts = np.concatenate([ex.maxima[0], ex.minima[0]])

@@ -14,6 +14,7 @@ from scipy.stats import qmc
 
 from qropt import analytic
 from qropt.errors import QroptError
+from qropt.nlp import slow_interval
 
 
 @dataclass(frozen=True)
@@ -23,6 +24,10 @@ class Plan:
     analytic: tuple
     kind: str
     how: str
+
+
+def _build(problem, values, branch):
+    return problem.build(values, branch)
 
 
 def branches(problem) -> list[dict]:
@@ -43,7 +48,7 @@ def plan(problem, use_analytic: bool = True) -> Plan:
     return Plan(tuple(clip(v) for v in w.points), w.kind, w.how)
 
 
-def sobol(problem, n: int, seed: int) -> list[dict]:
+def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
     """Up to n scrambled-Sobol points over the free bounds (log-spaced for lengths) whose mechanism turns fully
     on the first branch; if none does among 8n, the first n points as they are."""
     if n <= 0:
@@ -57,21 +62,37 @@ def sobol(problem, n: int, seed: int) -> list[dict]:
             lo, hi = problem.free[k]
             v[k] = lo * (hi / lo) ** x if k in problem.mechanism.LENGTHS and lo > 0 else lo + (hi - lo) * x
         points.append(v)
-        if orientation(problem, v, branch) is not None:
+        if orientation(problem, v, branch, build) is not None:
             kept.append(v)
             if len(kept) == n:
                 break
     return kept or points[:n]
 
 
-def orientation(problem, values, branch) -> int | None:
+def orientation(problem, values, branch, build=None) -> int | None:
     """+1 if the design's slow interval runs from theta_max to theta_min (counter-clockwise), -1 if not,
     None if it does not build or turn fully."""
     try:
-        a, b = problem.build(values, branch).stroke_angles()
+        a, b = (build or _build)(problem, values, branch).stroke_angles()
     except QroptError:
         return None
     return 1 if a >= b else -1
+
+
+def dead_centre_start(problem, values, branch, targets, orientation, range_target, build=None):
+    """Dead-centre angles of the start design (moved to meet the TR target) and the TR orientation."""
+    try:
+        m0 = (build or _build)(problem, values, branch)
+        d = m0.dead_centres()
+        a, b = m0.stroke_angles()
+        orientation = orientation or (1 if a >= b else -1)
+        th0 = (d.theta_max, d.theta_max + a)
+    except QroptError:
+        orientation, tr = orientation or 1, targets.get("time_ratio", 1.5)
+        th0 = (0.5, 0.5 + slow_interval(tr, orientation))
+    if "time_ratio" in targets and range_target != "time_ratio":
+        th0 = (th0[0], th0[0] + slow_interval(targets["time_ratio"], orientation))
+    return th0, orientation
 
 
 def local_best(scores: list, maximise: bool, keep: int = 3) -> list[int]:
@@ -87,4 +108,4 @@ def local_best(scores: list, maximise: bool, keep: int = 3) -> list[int]:
     return sorted(idx, key=lambda i: -s[i])[:keep]
 
 
-__all__ = ["Plan", "branches", "plan", "sobol", "orientation", "local_best"]
+__all__ = ["Plan", "branches", "plan", "sobol", "orientation", "dead_centre_start", "local_best"]

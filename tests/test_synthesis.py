@@ -14,7 +14,7 @@ from qropt import ProblemError, Solver, analytic, solve
 from tests import brute
 from tests.synth_tasks import TASKS
 
-N_TASKS = 50
+N_TASKS = 30
 
 
 def load(name):

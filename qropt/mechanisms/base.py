@@ -33,7 +33,10 @@ def _finite(name: str, value) -> float:
     """A finite real number from the API, or InvalidParameter naming it."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise InvalidParameter(f"{name} must be a real number, got {value!r}")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:
+        v = math.inf
     if not math.isfinite(v):
         raise InvalidParameter(f"{name} must be finite, got {v}")
     return v
@@ -171,7 +174,10 @@ class Mechanism:
                 continue
             if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
                 raise InvalidParameter(f"{name}: {k} must be a number, got {v!r}")
-            v = float(v)
+            try:
+                v = float(v)
+            except OverflowError:
+                v = math.inf
             if not math.isfinite(v):
                 raise InvalidParameter(f"{name}: {k} must be finite, got {v}")
             if k in self.LENGTHS and v <= 0:
