@@ -22,7 +22,7 @@ import casadi
 import numpy as np
 
 from qropt.closures import RIGHT_ANGLE, transmission_cos
-from qropt.mechanisms import CrankShaper, FourBar, FourBarSlider, SliderCrank, Whitworth
+from qropt.mechanisms import FourBar, FourBarSlider
 from qropt.ops import CASADI
 
 TWO_PI = 2.0 * math.pi
@@ -185,22 +185,7 @@ class Formulation:
     @staticmethod
     def _conditions(params, problem):
         cls, c = problem.mechanism, problem.conditions
-        rows = []
-        if "grashof" in c:
-            s = "r1" if c["grashof"] == "drag-link" else "r2"
-            total = params["r1"] + params["r2"] + params["r3"] + params["r4"]
-            for k in ("r1", "r2", "r3", "r4"):
-                if k != s:
-                    rows.append(Row(f"grashof: {s} <= {k}", params[s] - params[k], -casadi.inf, 0.0))
-                    rows.append(Row(f"grashof: 2({s} + {k}) <= sum", 2 * (params[s] + params[k]) - total,
-                                    -casadi.inf, 0.0))  # fmt: skip
-        if cls is SliderCrank:
-            rows.append(Row("full rotation: r3 >= r2 + e", params["r3"] - params["r2"] - params["e"], 0.0, casadi.inf))
-            rows.append(Row("full rotation: r3 >= r2 - e", params["r3"] - params["r2"] + params["e"], 0.0, casadi.inf))
-        if cls is CrankShaper:
-            rows.append(Row("crank-shaper: r2 < r1", params["r2"] - (1 - 1e-6) * params["r1"], -casadi.inf, 0.0))
-        if cls is Whitworth:
-            rows.append(Row("Whitworth: r2 > r1", params["r2"] - (1 + 1e-6) * params["r1"], 0.0, casadi.inf))
+        rows = [Row(r.name, r.value, 0.0, casadi.inf) for r in cls.rules(CASADI, params, c.get("grashof"))]
         for coeffs, lo, hi in c.get("linear", ()):
             e = sum(v * params[k] for k, v in coeffs.items())
             rows.append(Row(f"linear {dict(coeffs)}", e, lo, hi))

@@ -12,34 +12,25 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from qropt.errors import InvalidParameter, QroptError
-from qropt.mechanisms import FourBar, FourBarSlider, Mechanism
+from qropt.mechanisms import FourBar, Mechanism
+from qropt.ops import NUMPY
 
-LINKS = ("r1", "r2", "r3", "r4")
 
-
-def _grashof_interval(m: Mechanism, free: str):
-    """The free link's interval where the type's Grashof class holds (smooth inequalities, linear in it)."""
-    cls = type(m)
-    shortest = getattr(cls, "SHORTEST", "") or ("r2" if isinstance(m, FourBar) else "")
+def _rule_interval(m: Mechanism, free: str):
+    """The free parameter's interval where the type's rules hold (each rule is linear in one length)."""
     lo, hi = 0.0, math.inf
     p = dict(m.params)
-    for i in LINKS:
-        if i == shortest:
-            continue
-        for row in ("short", "sum"):
-
-            def g(x, i=i, row=row):
-                q = {**p, free: x}
-                total = sum(q[k] for k in LINKS)
-                return q[shortest] - q[i] if row == "short" else 2 * (q[shortest] + q[i]) - total
-
-            a, b = g(1.0) - g(0.0), g(0.0)  # g(x) = a x + b <= 0
-            if a > 0:
-                hi = min(hi, -b / a)
-            elif a < 0:
-                lo = max(lo, -b / a)
-            elif b > 0:
-                return 0.0, 0.0
+    kind = "crank-rocker" if isinstance(m, FourBar) else None  # a bare four-bar: the class problems default to
+    at0 = type(m).rules(NUMPY, {**p, free: 0.0}, kind)
+    at1 = type(m).rules(NUMPY, {**p, free: 1.0}, kind)
+    for r0, r1 in zip(at0, at1, strict=True):
+        a, b = r1.value - r0.value, r0.value  # rule value a x + b >= 0
+        if a > 0:
+            lo = max(lo, -b / a)
+        elif a < 0:
+            hi = min(hi, -b / a)
+        elif b < 0:
+            return 0.0, 0.0
     return lo, hi
 
 
@@ -200,9 +191,9 @@ def reachable(mechanism: Mechanism, free: str = "r3", bounds: tuple | None = Non
     if isinstance(n, bool) or not isinstance(n, int) or not 3 <= n <= 100_000:
         raise InvalidParameter(f"n (scan points) must be an integer in [3, 100000], got {n!r}")
     if bounds is None:
-        if not (isinstance(mechanism, (FourBar, FourBarSlider)) and free in LINKS):
-            raise InvalidParameter(f"give bounds for {free}: only a four-bar link's interval follows from Grashof")
-        bounds = _grashof_interval(mechanism, free)
+        bounds = _rule_interval(mechanism, free)
+        if not math.isfinite(bounds[1]):
+            raise InvalidParameter(f"give bounds for {free}: the type's rules do not bound it above")
     try:
         lo, hi = (float(b) for b in bounds)
     except (TypeError, ValueError):

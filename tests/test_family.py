@@ -82,7 +82,7 @@ def test_closed_form_points_lie_on_the_traced_curve_without_gaps(paper_family):
             else:
                 assert abs(_interp(branch, "r3", "r1", r3) - r1) < 1e-8
     ends = {e.reason.split(":")[0] for e in paper_family.ends}
-    assert ends == {"bound", "singularity at a Grashof change point (grashof"}
+    assert ends == {"bound", "singularity at a Grashof change point (grashof drag-link"}
 
 
 def test_fold_matches_the_discriminant(paper_family):

@@ -58,6 +58,16 @@ def crank_angles(theta2) -> np.ndarray:
     return t
 
 
+class Rule(NamedTuple):
+    """A feasibility rule of a type, written once over a math namespace: it holds where ``value >= 0``.
+
+    Construction checks it on numbers, the NLP states it as a row, ``reachable`` reads the interval it leaves
+    a parameter (the rules are linear in each length)."""
+
+    name: str
+    value: Any
+
+
 class Loop(NamedTuple):
     """One evaluation of a mechanism's closed-form loop.
 
@@ -211,8 +221,22 @@ class Mechanism:
     def required(cls) -> list[str]:
         return [k for k, v in cls.PARAMS.items() if v is REQUIRED]
 
+    @classmethod
+    def rules(cls, xp, p, grashof: str | None = None) -> list[Rule]:
+        """The type's feasibility rules at parameters p (override); grashof: a four-bar class to require."""
+        return []
+
+    def broken_rules(self, grashof: str | None = None) -> list[str]:
+        """Names of the rules these parameters break (beyond rounding)."""
+        scale = max(abs(v) for k, v in self.params.items() if not k.startswith("sigma"))
+        return [r.name for r in self.rules(NUMPY, self.params, grashof) if r.value < -1e-12 * scale]
+
     def validate(self) -> None:
-        """Type-specific checks beyond positive lengths (override)."""
+        """Type-specific checks beyond positive lengths: the type's rules (override for a richer message)."""
+        broken = self.broken_rules()
+        if broken:
+            given = ", ".join(f"{k}={v:g}" for k, v in self.params.items())
+            raise InvalidParameter(f"{type(self).__name__}({given}) breaks: {'; '.join(broken)}")
 
     @staticmethod
     def loop(xp, theta2, p) -> Loop:  # pragma: no cover - abstract

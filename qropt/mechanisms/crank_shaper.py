@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from qropt.closures import RIGHT_ANGLE, on_ray, pin_in_slot, rod_lines, rod_to_line
 from qropt.errors import InvalidParameter
-from qropt.mechanisms.base import REQUIRED, Loop, Mechanism
+from qropt.mechanisms.base import REQUIRED, Loop, Mechanism, Rule
 
 
 class CrankShaper(Mechanism):
@@ -17,13 +17,13 @@ class CrankShaper(Mechanism):
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r4": REQUIRED, "r6": None, "h": None, "sigma_slider": 1.0}
     LENGTHS = ("r1", "r2", "r4", "r6")
 
+    @classmethod
+    def rules(cls, xp, p, grashof=None):
+        return [Rule("crank-shaper: crank r2 < centres r1 (r2 > r1 is a Whitworth)", (1 - 1e-9) * p["r1"] - p["r2"])]
+
     def validate(self):
+        super().validate()
         p = self.params
-        if p["r2"] >= p["r1"]:
-            raise InvalidParameter(
-                f"CrankShaper: needs crank r2 < centres r1, got r2={p['r2']:g} >= r1={p['r1']:g} "
-                "(r2 > r1 is a Whitworth)"
-            )
         if "h" in p and "r6" not in p:
             raise InvalidParameter("CrankShaper: h (slide-line height) needs the rod length r6")
         if "r6" in p and "h" not in p:

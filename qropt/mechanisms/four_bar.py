@@ -8,7 +8,7 @@ from typing import ClassVar, NamedTuple
 
 from qropt.closures import circle_circle, joint_lines, on_ray, rod_lines, rod_to_line
 from qropt.errors import GrashofError
-from qropt.mechanisms.base import REQUIRED, Loop, Mechanism
+from qropt.mechanisms.base import REQUIRED, Loop, Mechanism, Rule
 
 LINKS = ("r1", "r2", "r3", "r4")
 
@@ -45,6 +45,21 @@ def four_bar(xp, theta2, p):
     b, theta4, m = circle_circle(xp, a, p["r3"], o4, p["r4"], p["sigma"], around=math.pi)
     theta3 = xp.atan2(b[1] - a[1], b[0] - a[0])
     return a, o4, b, theta3, theta4, m
+
+
+SHORTEST = {"drag-link": "r1", "crank-rocker": "r2"}
+
+
+def grashof_rules(xp, p, kind: str) -> list[Rule]:
+    """Grashof with a given shortest link, as smooth inequalities: s <= r_i and 2 (s + r_i) <= r1 + r2 + r3 + r4."""
+    s = SHORTEST[kind]
+    total = p["r1"] + p["r2"] + p["r3"] + p["r4"]
+    out = []
+    for k in LINKS:
+        if k != s:
+            out.append(Rule(f"grashof {kind}: {s} <= {k}", p[k] - p[s]))
+            out.append(Rule(f"grashof {kind}: 2({s} + {k}) <= r1 + r2 + r3 + r4", total - 2 * (p[s] + p[k])))
+    return out
 
 
 class _FourBarBase(Mechanism):
@@ -89,6 +104,11 @@ class FourBar(_FourBarBase):
             margins=[("four-bar closure at B", m)],
         )
 
+    @classmethod
+    def rules(cls, xp, p, grashof=None):
+        """Any class builds; a problem may require one (its 'grashof' condition)."""
+        return grashof_rules(xp, p, grashof) if grashof else []
+
     def follower(self, theta2, omega2: float = 1.0, alpha2: float = 0.0):
         """Follower angle theta4 (x), omega4 (v), alpha4 (a) and all link rates; see ``motion``."""
         return self.motion(theta2, omega2, alpha2)
@@ -111,11 +131,14 @@ class FourBarSlider(_FourBarBase):
     CLASS: ClassVar[str] = ""
     SHORTEST: ClassVar[str] = ""
 
+    @classmethod
+    def rules(cls, xp, p, grashof=None):
+        return grashof_rules(xp, p, grashof or cls.CLASS)
+
     def validate(self):
         g = self.grashof()
         p = {k: self.params[k] for k in LINKS}
-        ok = g.s_plus_l <= g.p_plus_q * (1 + 1e-12) and p[self.SHORTEST] <= min(p.values())
-        if not ok:
+        if self.broken_rules():
             raise GrashofError(
                 f"{type(self).__name__} needs a Grashof {self.CLASS} ({self.SHORTEST} shortest, s + l <= p + q); "
                 f"got {g.kind}: shortest {g.shortest}={p[g.shortest]:g}, s + l = {g.s_plus_l:g}, "
@@ -144,4 +167,4 @@ class FourBarSlider(_FourBarBase):
         )
 
 
-__all__ = ["FourBar", "FourBarSlider", "Grashof", "grashof", "four_bar"]
+__all__ = ["FourBar", "FourBarSlider", "Grashof", "grashof", "grashof_rules", "four_bar"]

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from qropt.closures import rod_lines, rod_to_line
-from qropt.errors import InvalidParameter
-from qropt.mechanisms.base import REQUIRED, Loop, Mechanism
+from qropt.mechanisms.base import REQUIRED, Loop, Mechanism, Rule
 
 
 class SliderCrank(Mechanism):
@@ -14,13 +13,12 @@ class SliderCrank(Mechanism):
     PARAMS = {"r2": REQUIRED, "r3": REQUIRED, "e": 0.0, "sigma_slider": 1.0}
     LENGTHS = ("r2", "r3")
 
-    def validate(self):
-        p = self.params
-        if p["r3"] < p["r2"] + abs(p["e"]):
-            raise InvalidParameter(
-                f"SliderCrank: full rotation needs r3 >= r2 + |e|, got r3={p['r3']:g} < "
-                f"{p['r2'] + abs(p['e']):g} (r2={p['r2']:g}, e={p['e']:g})"
-            )
+    @classmethod
+    def rules(cls, xp, p, grashof=None):
+        return [
+            Rule("full rotation: r3 >= r2 + e", p["r3"] - p["r2"] - p["e"]),
+            Rule("full rotation: r3 >= r2 - e", p["r3"] - p["r2"] + p["e"]),
+        ]
 
     @staticmethod
     def loop(xp, theta2, p):

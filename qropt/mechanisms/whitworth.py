@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from qropt.closures import RIGHT_ANGLE, on_ray, pin_in_slot, rod_lines, rod_to_line
-from qropt.errors import InvalidParameter
-from qropt.mechanisms.base import REQUIRED, Loop, Mechanism
+from qropt.mechanisms.base import REQUIRED, Loop, Mechanism, Rule
 
 
 class Whitworth(Mechanism):
@@ -14,13 +13,9 @@ class Whitworth(Mechanism):
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r5": REQUIRED, "r6": REQUIRED, "h": 0.0, "sigma_slider": 1.0}
     LENGTHS = ("r1", "r2", "r5", "r6")
 
-    def validate(self):
-        p = self.params
-        if p["r2"] <= p["r1"]:
-            raise InvalidParameter(
-                f"Whitworth: needs crank r2 > centres r1, got r2={p['r2']:g} <= r1={p['r1']:g} "
-                "(r2 < r1 is a crank-shaper)"
-            )
+    @classmethod
+    def rules(cls, xp, p, grashof=None):
+        return [Rule("Whitworth: crank r2 > centres r1 (r2 < r1 is a crank-shaper)", p["r2"] - (1 + 1e-9) * p["r1"])]
 
     @staticmethod
     def loop(xp, theta2, p):
