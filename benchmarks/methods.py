@@ -9,6 +9,7 @@ import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
 
 from qropt import solve, starts
+from qropt.certify import better
 from qropt.solve import DEFAULT
 
 STARTS = 8  # Sobol starts for every multi-start method, as qropt's default
@@ -50,7 +51,7 @@ def _scipy_local(problem, seed, method):
         values = dict(zip(form.free, x[: form.nx].tolist(), strict=True))
         s = _oracle.score(problem, values)
         feasible = s is not None and violation(problem, s[1]) <= FEASIBLE
-        if feasible and _oracle._better(problem, s[0], best[0] if best else None):
+        if feasible and better(problem, s[0], best[0] if best else None):
             best = (s[0], values, br)
     return {
         "values": best[1] if best else None,

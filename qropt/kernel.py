@@ -26,7 +26,7 @@ from qropt import cycle
 from qropt.closures import RIGHT_ANGLE, transmission_angle, transmission_cos2
 from qropt.ops import CASADI, NUMPY, Jet
 
-NEWTON_STEPS = 3  # from the grid parabola's vertex (error <~1e-4 rad), three steps reach rounding level
+NEWTON_STEPS = 2  # from the grid parabola's vertex (error <~1e-4 rad), two steps reach ~1e-16 rad
 TWO_PI = 2.0 * np.pi
 STEP_TOL = 1e-10  # rad: a last Newton step this small means the point is converged (error ~ step^2)
 _KERNELS: dict = {}
@@ -201,15 +201,24 @@ class Kernel:
         res = self._switch(group)(z)
         x, val = res[:, 0], res[:, 3]
         ok = (np.abs(res[:, 1]) <= STEP_TOL) & (x > lo) & (x < hi) & (sgn[r] * res[:, 2] < 0)
-        for j in np.flatnonzero(~ok):  # rare: a flat or narrow extreme; the safeguarded iteration
-            quantity = self.group(group)[rows[r[j]]]
-            x[j] = self._safeguarded(quantity, lo[j : j + 1], hi[j : j + 1], p)[0]
-            val[j] = quantity.value(np.concatenate([x[j : j + 1], p])[None, :])[0, 0]
+        quantity_of, keep = rows[r], np.ones(r.size, bool)
+        for q in np.unique(quantity_of[~ok]):  # rare: flat, narrow or no extremes; the safeguarded iteration
+            j = np.flatnonzero(~ok & (quantity_of == q))
+            quantity = self.group(group)[q]
+            # a true extreme turns the slope inside its bracket; a jump (an angle wrapping at +-pi) does not
+            s = sgn[r[j]]
+            turns = (s * quantity.at(lo[j], p)[1] >= 0) & (s * quantity.at(hi[j], p)[1] <= 0)
+            keep[j[~turns]] = False
+            j = j[turns]
+            if j.size:
+                x[j] = self._safeguarded(quantity, lo[j], hi[j], p)
+                val[j] = quantity.value(np.column_stack([x[j], np.broadcast_to(p, (j.size, p.size))]))[:, 0]
         x = np.mod(x, TWO_PI)
         x[x > TWO_PI - 1e-12] = 0.0
         out, start = [], 0
         for c in counts.tolist():
-            out.append(Extremes(x[start : start + c], val[start : start + c]))
+            k = keep[start : start + c]
+            out.append(Extremes(x[start : start + c][k], val[start : start + c][k]))
             start += c
         return out
 
@@ -220,7 +229,7 @@ class Kernel:
         def fun(tj):
             return Jet.of(*quantity.at(tj.v, p))
 
-        return cycle.stationary(fun, lo, hi)
+        return cycle.stationary(fun, lo, hi, iters=60, xtol=1e-14)
 
 
 def discrete_extremes(v, kind):

@@ -58,6 +58,7 @@ class Jet:
     """
 
     __slots__ = ("c", "_sc")
+    __array_ufunc__ = None  # ndarray * Jet defers to Jet.__rmul__ instead of building an object array
 
     def __init__(self, c):
         self.c = c

@@ -132,3 +132,56 @@ def test_positions_close_every_loop(kind):
                 np.testing.assert_allclose(pos.points[name][:, 1], np.real(ref[name][1]), atol=1e-12)
         if kind == "slider-crank":
             np.testing.assert_allclose(pos.points["C"][:, 0], np.real(ref["D"][0]), atol=1e-12)
+
+
+def _brute_accel(kind, p, th, h=2e-4):
+    """d2x/dtheta2: central differences of the complex-step derivative, Richardson-extrapolated (error ~h^4)."""
+
+    def d(step):
+        xp = np.imag(brute.output(kind, p, th + step + 1j * brute.STEP)) / brute.STEP
+        xm = np.imag(brute.output(kind, p, th - step + 1j * brute.STEP)) / brute.STEP
+        return (xp - xm) / (2 * step)
+
+    return (4 * d(h / 2) - d(h)) / 3
+
+
+def _grid_peak(f, th):
+    """Largest |f| on the grid, refined by bounded Brent around the best sample."""
+    from scipy.optimize import minimize_scalar
+
+    k = int(np.argmax(np.abs(f(th))))
+    h = th[1] - th[0]
+    r = minimize_scalar(lambda t: -abs(float(f(np.array([t]))[0])), bounds=(th[k] - h, th[k] + h), method="bounded",
+                        options={"xatol": 1e-12})  # fmt: skip
+    return -r.fun
+
+
+@pytest.mark.parametrize("kind", [k for k in KINDS if k != "four-bar"])
+def test_peak_acceleration_matches_brute_force(kind):
+    for p, m in random_mechanisms(kind, 20, seed=3):
+        brute_peak = _grid_peak(lambda t, p=p: _brute_accel(kind, p, t), brute.TH)
+        peak = m.peak_acceleration(1.0)
+        assert abs(peak.value - brute_peak) <= 1e-6 * max(1.0, brute_peak), (p, peak, brute_peak)
+        assert abs(peak.value - abs(m.motion(peak.theta2).a[0])) <= 1e-12 * max(1.0, peak.value)
+        w = m.peak_acceleration(3.0, over="working")
+        assert w.value <= 9.0 * peak.value * (1 + 1e-12)
+        start, length = m.working_arc(3.0)
+        assert (w.theta2 - start) % (2 * np.pi) <= length + 1e-12
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_bounding_box_matches_brute_force(kind):
+    for p, m in random_mechanisms(kind, 20, seed=4):
+        j = brute.joints(kind, p, brute.TH)
+        pts = [v for k, v in j.items() if k in ("A", "B", "C", "D")] + [(np.zeros(1), np.zeros(1))]
+        if kind in ("crank-shaper", "whitworth"):
+            pts.append((np.zeros(1), np.full(1, -p["r1"])))
+        else:
+            pts.append((np.full(1, p.get("r1", 0.0)), np.zeros(1)))
+        xs = np.concatenate([np.real(x) for x, _ in pts])
+        ys = np.concatenate([np.real(y) for _, y in pts])
+        b = m.bounding_box()
+        tol = 1e-7 * max(1.0, xs.max() - xs.min())
+        assert b.x_min <= xs.min() + 1e-12 and b.x_max >= xs.max() - 1e-12
+        assert abs(b.x_min - xs.min()) < tol and abs(b.x_max - xs.max()) < tol, (p, b)
+        assert abs(b.y_min - ys.min()) < tol and abs(b.y_max - ys.max()) < tol, (p, b)

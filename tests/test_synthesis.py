@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, minimize_scalar
 
+import qropt
 from qropt import ProblemError, Solver, analytic, solve
 from tests import brute
 from tests.synth_tasks import TASKS
@@ -234,3 +235,47 @@ def test_gamma_min_condition_is_respected():
 def test_solver_failure_is_a_status_not_an_exception():
     r = solve(load("paper_drag_link"), starts_n=1, use_analytic=False, max_rounds=1, seed=3)
     assert r.status in ("optimal", "infeasible", "failed") and isinstance(r.message, str) and r.message
+
+
+# ---- typed results and honest certificates ------------------------------------------------------------------
+def test_result_round_trips_through_strict_json_and_prints_short():
+    import json
+
+    r = solve(load("paper_drag_link"))
+    text = json.dumps(r.to_dict(), allow_nan=False)
+    back = qropt.Result.from_dict(json.loads(text))
+    assert back.status == r.status and back.params == r.params and back.objective == r.objective
+    assert back.certificate == r.certificate and len(back.local_optima) == len(r.local_optima)
+    assert back.mechanism == r.mechanism
+    assert len(repr(r).splitlines()) <= 15
+    bad = solve(load("paper_drag_link"), targets={"time_ratio": 9.0})
+    assert bad.status == "infeasible" and not bad.success
+    json.dumps(bad.to_dict(), allow_nan=False)
+    assert len(repr(bad).splitlines()) <= 15
+
+
+def test_statuses_and_global_claims():
+    r = solve(load("paper_drag_link"))
+    assert r.status == "optimal" and [o.status for o in r.local_optima] == ["optimal", "local_optimum"]
+    assert r.certificate.global_claim.startswith("by enumeration")
+    cold = solve(load("paper_drag_link"), use_analytic=False)
+    assert cold.certificate.global_claim.startswith("best of") and "starts" in cold.certificate.global_claim
+    assert cold.params["r3"] == pytest.approx(r.params["r3"], abs=1e-9)
+    assert set(qropt.STATUSES) == {"optimal", "local_optimum", "acceptable", "feasible", "infeasible", "failed"}
+
+
+def test_min_size_certificate_compares_two_sources():
+    p = load("paper_drag_link_min_size")
+    r = solve(p, use_analytic=False)
+    c = r.certificate
+    assert c.nlp is not None and c.certified == pytest.approx(r.mechanism.size("sum"), abs=1e-15)
+    assert c.gap == pytest.approx(abs(c.certified - c.nlp), abs=1e-15) and c.gap <= 1e-8
+
+
+def test_a_result_does_not_depend_on_earlier_solves():
+    names = ["whitworth_accel", "slider_crank_gamma", "paper_drag_link_footprint"]
+    fresh = {n: Solver().solve(load(n)) for n in names}
+    shared = Solver()
+    for n in names[::-1] + names:
+        r = shared.solve(load(n))
+        assert r.params == fresh[n].params and r.objective == fresh[n].objective

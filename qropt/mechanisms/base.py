@@ -229,7 +229,8 @@ class Mechanism:
     def broken_rules(self, grashof: str | None = None) -> list[str]:
         """Names of the rules these parameters break (beyond rounding)."""
         scale = max(abs(v) for k, v in self.params.items() if not k.startswith("sigma"))
-        return [r.name for r in self.rules(NUMPY, self.params, grashof) if r.value < -1e-12 * scale]
+        broken = [r.name for r in self.rules(NUMPY, self.params, grashof) if r.value < -1e-12 * scale]
+        return list(dict.fromkeys(broken))
 
     def validate(self) -> None:
         """Type-specific checks beyond positive lengths: the type's rules (override for a richer message)."""

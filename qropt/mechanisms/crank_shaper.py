@@ -19,7 +19,9 @@ class CrankShaper(Mechanism):
 
     @classmethod
     def rules(cls, xp, p, grashof=None):
-        return [Rule("crank-shaper: crank r2 < centres r1 (r2 > r1 is a Whitworth)", (1 - 1e-9) * p["r1"] - p["r2"])]
+        return [
+            Rule("a crank-shaper needs crank r2 < centres r1 (r2 > r1 is a Whitworth)", (1 - 1e-9) * p["r1"] - p["r2"])
+        ]
 
     def validate(self):
         super().validate()

@@ -16,8 +16,8 @@ class SliderCrank(Mechanism):
     @classmethod
     def rules(cls, xp, p, grashof=None):
         return [
-            Rule("full rotation: r3 >= r2 + e", p["r3"] - p["r2"] - p["e"]),
-            Rule("full rotation: r3 >= r2 - e", p["r3"] - p["r2"] + p["e"]),
+            Rule("full rotation needs r3 >= r2 + |e|", p["r3"] - p["r2"] - p["e"]),
+            Rule("full rotation needs r3 >= r2 + |e|", p["r3"] - p["r2"] + p["e"]),
         ]
 
     @staticmethod

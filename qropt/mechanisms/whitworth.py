@@ -15,7 +15,9 @@ class Whitworth(Mechanism):
 
     @classmethod
     def rules(cls, xp, p, grashof=None):
-        return [Rule("Whitworth: crank r2 > centres r1 (r2 < r1 is a crank-shaper)", p["r2"] - (1 + 1e-9) * p["r1"])]
+        return [
+            Rule("a Whitworth needs crank r2 > centres r1 (r2 < r1 is a crank-shaper)", p["r2"] - (1 + 1e-9) * p["r1"])
+        ]
 
     @staticmethod
     def loop(xp, theta2, p):
