@@ -69,27 +69,29 @@ class Result:
     def max_violation(self) -> float:
         return max(self.residuals.values(), default=0.0)
 
+    def _quantity_parts(self, sep: str) -> list[str]:
+        q = self.quantities
+        parts = [f"time_ratio{sep}{q['time_ratio']:.10g}"]
+        parts += [f"{k}{sep}{q[k]:.10g}" for k in ("stroke", "swing") if k in q]
+        parts.append(f"gamma_min{sep}{math.degrees(q['gamma_min']):.6f} deg")
+        if q.get("peak_accel") is not None:
+            parts.append(f"peak_accel{sep}{q['peak_accel']:.6g}")
+        return parts
+
     def __repr__(self):
         lines = [f"Result(status={self.status!r}, objective={self.objective!r})", f"  message: {self.message}"]
         if self.params:
             lines.append("  params: " + ", ".join(f"{k}={v:.10g}" for k, v in self.params.items()))
-        q = self.quantities
-        if q:
-            parts = [f"time_ratio={q['time_ratio']:.10g}"]
-            parts += [f"{k}={q[k]:.10g}" for k in ("stroke", "swing") if k in q]
-            parts.append(f"gamma_min={math.degrees(q['gamma_min']):.6f} deg")
-            if q.get("peak_accel") is not None:
-                parts.append(f"peak_accel={q['peak_accel']:.6g}")
-            lines.append("  quantities: " + ", ".join(parts))
+        if self.quantities:
+            lines.append("  quantities: " + ", ".join(self._quantity_parts("=")))
         if self.certificate is not None:
             c = self.certificate
             lines.append(f"  certificate: gap {c.gap:.1e} after {c.rounds} round(s); {c.local}")
         if self.local_optima:
             lines.append(f"  local_optima: {len(self.local_optima)}")
         if self.reachable:
-            lines.append(
-                "  reachable: " + ", ".join(f"{k} {lo:.6g}..{hi:.6g}" for k, (lo, hi) in self.reachable.items())
-            )
+            ranges = (f"{k} {lo:.6g}..{hi:.6g}" for k, (lo, hi) in self.reachable.items())
+            lines.append("  reachable: " + ", ".join(ranges))
         lines.append(f"  max_violation: {self.max_violation:.1e}, time {self.stats.get('t_total') or 0.0:.3g} s")
         return "\n".join(lines)
 
@@ -98,16 +100,9 @@ class Result:
         lines = [f"status: {self.status} - {self.message}"]
         if self.params:
             lines.append("design: " + ", ".join(f"{k}={v:.10g}" for k, v in self.params.items()))
-        q = self.quantities
-        if q:
-            parts = [f"TR {q['time_ratio']:.10g}"]
-            parts += [f"{k} {q[k]:.10g}" for k in ("stroke", "swing") if k in q]
-            parts.append(f"gamma_min {math.degrees(q['gamma_min']):.6f} deg")
-            if q.get("peak_accel") is not None:
-                parts.append(f"peak accel {q['peak_accel']:.6g}")
-            if q.get("grashof"):
-                parts.append(q["grashof"])
-            lines.append("quantities: " + ", ".join(parts))
+        if self.quantities:
+            extra = [self.quantities["grashof"]] if self.quantities.get("grashof") else []
+            lines.append("quantities: " + ", ".join(self._quantity_parts(" ") + extra))
         if self.certificate is not None:
             c = self.certificate
             obj = "" if c.certified is None else f"objective {c.certified:.12g}"

@@ -32,7 +32,7 @@ MAX_ANGLES = 10_000_000  # crank angles evaluated in one call
 def _finite(name: str, value) -> float:
     """A finite real number from the API, or InvalidParameter naming it."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InvalidParameter(f"{name} must be a real number, got {value!r}")
+        raise InvalidParameter(f"{name} must be a number, got {value!r}")
     try:
         v = float(value)
     except OverflowError:
@@ -182,14 +182,7 @@ class Mechanism:
                 raise InvalidParameter(f"{name}: missing parameter {k!r}; it needs {self.required()}")
             if v is None:
                 continue
-            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-                raise InvalidParameter(f"{name}: {k} must be a number, got {v!r}")
-            try:
-                v = float(v)
-            except OverflowError:
-                v = math.inf
-            if not math.isfinite(v):
-                raise InvalidParameter(f"{name}: {k} must be finite, got {v}")
+            v = _finite(f"{name}: {k}", v)
             if k in self.LENGTHS and v <= 0:
                 raise InvalidParameter(f"{name}: length {k} must be positive, got {v:g}")
             if abs(v) > MAGNITUDE or (k in self.LENGTHS and v < 1 / MAGNITUDE):
