@@ -1,0 +1,122 @@
+"""``qropt tolerance``: exact sensitivities and the largest link tolerances that keep the time ratio, stroke,
+gamma_min or peak acceleration within limits (qropt.tolerance), with a Monte Carlo check."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+from qropt.errors import InvalidParameter
+from qropt.mechanisms import REGISTRY, mechanism_type
+from qropt.tolerance import QUANTITIES, allocate
+
+COMMAND = "tolerance"
+HELP = "exact sensitivities and the largest tolerances keeping TR, stroke, gamma_min within limits"
+PARAM_NAMES = ("r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider")
+SUFFIX = {"um": 1e-6, "mm": 1e-3, "cm": 1e-2, "m": 1.0, "deg": math.pi / 180, "rad": 1.0}
+
+
+def limit(text: str) -> tuple[str, float]:
+    """'QUANTITY=VALUE[unit]': mm, cm, um, m convert to metres, deg to rad; a plain number is as is."""
+    name, sep, value = text.partition("=")
+    name = name.strip()
+    if not sep or name not in QUANTITIES:
+        raise argparse.ArgumentTypeError(f"not a limit: {text!r} (use e.g. time_ratio=0.01 or stroke=1mm; "
+                                         f"quantities: {', '.join(QUANTITIES)})")  # fmt: skip
+    v = value.strip().lower()
+    scale = 1.0
+    for suffix in sorted(SUFFIX, key=len, reverse=True):
+        if v.endswith(suffix):
+            v, scale = v[: -len(suffix)], SUFFIX[suffix]
+            break
+    try:
+        return name, float(v) * scale
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number in the limit {text!r}") from None
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("target", nargs="?",
+                        help="mechanism type (" + ", ".join(sorted(REGISTRY)) + ") or a JSON file with 'type' "
+                        "and 'params' (as 'qropt synth --json' or 'qropt analyze --json' print); default: the "
+                        "paper's mechanism")  # fmt: skip
+    for k in PARAM_NAMES:
+        parser.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
+    parser.add_argument("--limit", type=limit, action="append", required=True, metavar="QUANTITY=VALUE",
+                        help="allowed deviation: time_ratio=0.01, stroke=1mm, gamma_min=1deg (repeatable)")  # fmt: skip
+    parser.add_argument("--params", help="toleranced parameters, comma-separated (default: lengths and offsets)")
+    parser.add_argument("--rss", action="store_true", help="statistical stack-up ||S t|| <= E / k")
+    parser.add_argument("--k", type=float, default=3.0, help="rss: limit over k (default 3)")
+    parser.add_argument("--omega2", type=float, help="crank speed, rad/s, for a peak_acceleration limit")
+    parser.add_argument("--monte-carlo", type=int, metavar="N", help="check the allocation on N random mechanisms")
+    parser.add_argument("--seed", type=int, default=0, help="Monte Carlo seed (default 0)")
+    parser.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+
+def mechanism_from(args):
+    """The mechanism from TYPE and --r1 ..., or from a JSON file; the paper's mechanism by default."""
+    given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
+    if args.target is None:
+        if given:
+            raise InvalidParameter("give the mechanism TYPE before its parameters: " + ", ".join(sorted(REGISTRY)))
+        from qropt.examples import paper_mechanism
+
+        return paper_mechanism()
+    path = Path(args.target)
+    if args.target.endswith(".json") or path.is_file():
+        try:
+            d = json.loads(path.read_text())
+            kind, params = d["type"], {**d["params"], **given}
+        except (OSError, ValueError, KeyError, TypeError) as e:
+            raise InvalidParameter(f"{args.target}: not a JSON design with 'type' and 'params' ({e})") from None
+        return mechanism_type(kind)(**params)
+    return mechanism_type(args.target)(**given)
+
+
+def _finite(v):
+    """Strict JSON: infinite tolerances (no limited quantity depends on the parameter) become null."""
+    if isinstance(v, dict):
+        return {k: _finite(x) for k, x in v.items()}
+    return None if isinstance(v, float) and not math.isfinite(v) else v
+
+
+def run(args) -> int:
+    m = mechanism_from(args)
+    limits = dict(args.limit)
+    params = None if args.params is None else [p.strip() for p in args.params.split(",") if p.strip()]
+    al = allocate(m, limits, params=params, method="rss" if args.rss else "worst-case", k=args.k, omega2=args.omega2)
+    mc = None
+    if al.status == "optimal" and args.monte_carlo is not None:
+        mc = al.monte_carlo(args.monte_carlo, seed=args.seed)
+    if args.json:
+        out = {"type": m.KIND, "params": dict(m.params), "status": al.status, "message": al.message,
+               "method": al.method, "k": al.k, "limits": al.limits, "tolerances": al.tolerances,
+               "sensitivities": al.sensitivities, "usage": al.usage}  # fmt: skip
+        if mc is not None:
+            out["monte_carlo"] = {"n": mc.n, "within": mc.within, "worst": mc.worst, "all_within": mc.all_within,
+                                  "linearisation": mc.linearisation, "failed": mc.failed}  # fmt: skip
+        json.dump(_finite(out), sys.stdout, indent=2)
+        sys.stdout.write("\n")
+        return 0 if al.status == "optimal" else 1
+    print(f"{m.KIND}: " + ", ".join(f"{k}={v:g}" for k, v in m.params.items()))
+    rule = "sum |S| t <= E" if al.method == "worst-case" else f"||S t|| <= E / {al.k:g}"
+    print(f"  {al.method} ({rule}); status {al.status}: {al.message}")
+    if al.status != "optimal":
+        return 1
+    qs = list(al.limits)
+    print(f"  {'param':8s} {'nominal':>12s} {'tolerance':>12s} " + " ".join(f"{'d' + q + '/dp':>20s}" for q in qs))
+    for p, t in al.tolerances.items():
+        sens = " ".join(f"{al.sensitivities[q][p]:20.6g}" for q in qs)
+        print(f"  {p:8s} {m.params[p]:12.6g} {'+/- ' + format(t, '.4g'):>12s} {sens}")
+    for q in qs:
+        print(f"  {q}: limit {al.limits[q]:.6g}, stack-up uses {100 * al.usage[q]:.4g}% of it")
+    if mc is not None:
+        print(f"  Monte Carlo, {mc.n} mechanisms (exact re-analysis), {mc.failed} not analysable:")
+        for q in qs:
+            print(f"    {q}: {100 * mc.within[q]:.2f}% within, worst |deviation| {mc.worst[q]:.6g}, "
+                  f"linearisation error <= {mc.linearisation[q]:.3g}")  # fmt: skip
+        print(f"    every limit met: {100 * mc.all_within:.2f}%")
+    return 0
