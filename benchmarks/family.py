@@ -9,9 +9,11 @@ Run: ``python -m benchmarks.family``.
 from __future__ import annotations
 
 import importlib
+import sys
 import time
 
 import numpy as np
+from tqdm import tqdm
 
 from benchmarks.report import save
 from qropt import Problem, solve
@@ -37,7 +39,7 @@ def main(points: int = 1000):
     solve(sweep, starts_n=0)
     t = time.perf_counter()
     found = 0
-    for x in r1:
+    for x in tqdm(r1, desc="naive sweep", unit="solve", disable=not sys.stderr.isatty()):
         r = solve(sweep.replace(fixed={**problem.fixed, "r1": float(x)}), starts_n=2)
         found += len(r.local_optima)
     t_sweep = time.perf_counter() - t

@@ -18,8 +18,11 @@ import sys
 import time
 from pathlib import Path
 
+from tqdm import tqdm
+
 from benchmarks.methods import METHODS, violation
 from benchmarks.report import environment
+from qropt import solve
 
 ROOT = Path(__file__).resolve().parent.parent
 FEASIBLE = 1e-6  # largest accepted violation of a target (relative for lengths) or condition
@@ -48,16 +51,24 @@ def evaluate(problem, values):
     return s[0], violation(problem, s[1])
 
 
+def warm_up(problem, seed):
+    """Build the NLPs of a problem's structures once, untimed: every method then solves on built formulations
+    (the default Solver's, shared by qropt and the scipy methods), so the times compare solving, not compiling."""
+    for use_analytic in (True, False):
+        solve(problem, seed=seed, use_analytic=use_analytic)
+
+
 def run(names, methods, repeat=1, seed=0, progress=True):
     """Rows (one per problem and method) and oracles."""
     rows, oracles = [], {}
-    total, done = len(names) * len(methods), 0
+    bar = tqdm(total=len(names) * len(methods), disable=not progress or not sys.stderr.isatty(), unit="run")
     for name in names:
         mod = _module(name)
         problem, spec = mod.build(), mod.ORACLE
         t = time.perf_counter()
         ref = mod.oracle()
         oracles[name] = {**spec, "objective": ref["objective"], "seconds": time.perf_counter() - t}
+        warm_up(problem, seed)
         for method in methods:
             times, out = [], None
             for _ in range(repeat):
@@ -67,13 +78,10 @@ def run(names, methods, repeat=1, seed=0, progress=True):
                 except Exception as e:  # noqa: BLE001 - a method that crashes is a result, reported as such
                     out = {"values": None, "nfev": None, "message": f"error: {type(e).__name__}: {e}"[:120]}
                 times.append(time.perf_counter() - t)
-            done += 1
-            if progress:
-                sys.stderr.write(f"\r[{done}/{total}] {name} {method}".ljust(70))
-                sys.stderr.flush()
+            bar.set_description(f"{name} {method}")
+            bar.update()
             rows.append(_row(name, method, problem, spec, ref, out, statistics.median(times)))
-    if progress:
-        sys.stderr.write("\n")
+    bar.close()
     return rows, oracles
 
 
