@@ -1,11 +1,15 @@
-"""Command line: ``qropt analyze`` (and, built on ``solve``, ``qropt synth``). Errors print one line."""
+"""Command line: ``qropt analyze``, ``synth``, ``family``, ``reachable``, ``bench``, and every command module
+of this package (a module defining ``COMMAND``, ``HELP``, ``add_arguments(parser)`` and ``run(args) -> int``).
+Errors print one line."""
 
 from __future__ import annotations
 
 import argparse
 import csv
+import importlib
 import json
 import math
+import pkgutil
 import sys
 
 import numpy as np
@@ -208,6 +212,12 @@ def parser() -> argparse.ArgumentParser:
     r.add_argument("--plot", help="PNG file: TR against the parameter (the paper's Fig. 5)")
     r.set_defaults(run=cmd_reachable)
     sub.add_parser("bench", help="the benchmark suite, from the repository root (options: qropt bench --help)")
+    for info in pkgutil.iter_modules(__path__):
+        mod = importlib.import_module(f"{__name__}.{info.name}")
+        if hasattr(mod, "COMMAND"):
+            c = sub.add_parser(mod.COMMAND, help=mod.HELP)
+            mod.add_arguments(c)
+            c.set_defaults(run=mod.run)
     return p
 
 
@@ -311,7 +321,7 @@ def cmd_reachable(args):
         print(f"{type(m).__name__}: {args.free} varies, the rest as given")
         print("  feasible " + " and ".join(f"{args.free} in [{a:.10g}, {b:.10g}]" for a, b in r.intervals))
         print(f"  time ratio {tmin:.10g} (at {args.free} = {xmin:.10g}) .. {tmax:.10g} (at {args.free} = {xmax:.10g})")
-        print(f"  stroke {r.stroke_range[0]:.10g} .. {r.stroke_range[1]:.10g}")
+        print(f"  stroke {r.stroke_range.low:.10g} .. {r.stroke_range.high:.10g}")
         for t, xs in counts.items():
             print(f"  TR {t:g}: {len(xs)} design(s)" + (": " + ", ".join(f"{x:.10g}" for x in xs) if xs else ""))
         print(f"  adjustable {args.free}: {adj.explanation}")
