@@ -197,10 +197,10 @@ class SpeedProfile:
         from qropt import plots
 
         s = self.motion()
-        rows = [("crank omega2 [rad/s]", s.omega, ["omega_max"]), ("slider v", s.v, ["v_max", "v_cut"]),
-                ("slider a", s.a, ["a_max"])]  # fmt: skip
+        rows = [("crank omega2 [rad/s]", s.omega, ["omega_max"]), ("slider v [length/s]", s.v, ["v_max", "v_cut"]),
+                ("slider a [length/s^2]", s.a, ["a_max"])]  # fmt: skip
         if self.peak_torque is not None:
-            rows.append(("motor torque", s.torque, ["torque_max"]))
+            rows.append(("motor torque [N length]", s.torque, ["torque_max"]))
         fig, axes = plots.plt.subplots(len(rows), 1, figsize=(8, 2.2 * len(rows) + 0.6), sharex=True)
         tw = self.working_time
         for ax, (label, y, names) in zip(axes, rows, strict=True):
