@@ -6,8 +6,10 @@ constraints, conditions inequalities, the objective one of ``OBJECTIVES``.
 
 from __future__ import annotations
 
+import json
 import math
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Any
 
@@ -22,6 +24,11 @@ BRANCHES = ("sigma", "sigma_slider")
 
 def _frozen(d):
     return MappingProxyType(dict(d or {}))
+
+
+def _number(v) -> bool:
+    """A finite real number (not a bool)."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
 @dataclass(frozen=True, eq=False)
@@ -55,8 +62,22 @@ class Problem:
             raise ProblemError(str(e)) from None
         set_ = object.__setattr__
         set_(self, "mechanism", cls)
+        if not isinstance(self.name, str):
+            raise ProblemError(f"{cls.__name__}: name must be a string, got {self.name!r}")
         for k in ("fixed", "free", "targets", "conditions", "branches"):
-            set_(self, k, _frozen(getattr(self, k)))
+            v = getattr(self, k)
+            if v is not None and not isinstance(v, Mapping):
+                raise self._err(f"{k} must be a dict (name -> value), got {v!r}")
+            set_(self, k, _frozen(v))
+        try:
+            self._validate()
+        except (TypeError, ValueError, KeyError, IndexError, AttributeError) as e:  # malformed nested values
+            if isinstance(e, ProblemError):
+                raise
+            raise self._err(f"malformed problem ({type(e).__name__}: {e})") from None
+
+    def _validate(self):
+        set_ = object.__setattr__
         set_(self, "free", _frozen({k: (float(lo), float(hi)) for k, (lo, hi) in self._check_free().items()}))
         set_(self, "branches", _frozen(self._branches()))
         set_(self, "fixed", _frozen(self._completed_fixed()))
@@ -105,10 +126,10 @@ class Problem:
             if k not in self.mechanism.PARAMS:
                 continue
             vals = self.branches.get(k, (self.fixed.get(k, self.mechanism.PARAMS[k]),))
-            vals = tuple(float(v) for v in (vals if isinstance(vals, (tuple, list)) else (vals,)))
-            if not vals or any(v not in (-1.0, 1.0) for v in vals):
+            vals = tuple(vals if isinstance(vals, (tuple, list)) else (vals,))
+            if not vals or not all(_number(v) and v in (-1.0, 1.0) for v in vals):
                 raise self._err(f"branch {k} takes signs from (-1, +1), got {vals}")
-            out[k] = vals
+            out[k] = tuple(float(v) for v in vals)
         for k in self.branches:
             if k not in out:
                 raise self._err(f"{self.mechanism.__name__} has no branch {k!r}")
@@ -160,16 +181,32 @@ class Problem:
         elif "grashof" in c:
             raise self._err(f"{self.mechanism.__name__} has no four-bar: no grashof condition")
         g = c.get("gamma_min")
-        if g is not None and not 0 <= g < math.pi / 2:
-            raise self._err(f"gamma_min bound must be in [0, pi/2) rad, got {g!r}")
-        for coeffs, lo, hi in c.get("linear", ()):
+        if g is not None and not (_number(g) and 0 <= g < math.pi / 2):
+            raise self._err(f"gamma_min bound must be a number in [0, pi/2) rad, got {g!r}")
+        linear = []
+        for row in c.get("linear", ()):
+            if not (isinstance(row, (list, tuple)) and len(row) == 3 and isinstance(row[0], Mapping)
+                    and all(_number(v) for v in (*row[0].values(), row[1], row[2]))):  # fmt: skip
+                raise self._err(f"a linear condition is (coefficients dict, lower, upper) of numbers, got {row!r}")
+            coeffs, lo, hi = dict(row[0]), float(row[1]), float(row[2])
             self._check_names(coeffs)
             if lo > hi:
                 raise self._err(f"linear condition {coeffs} has lower {lo:g} > upper {hi:g}")
-        for num, den, lo, hi in c.get("ratio", ()):
+            linear.append((coeffs, lo, hi))
+        ratio = []
+        for row in c.get("ratio", ()):
+            if not (isinstance(row, (list, tuple)) and len(row) == 4 and all(isinstance(v, str) for v in row[:2])
+                    and all(_number(v) for v in row[2:])):  # fmt: skip
+                raise self._err(f"a ratio condition is (numerator, denominator, lower, upper), got {row!r}")
+            num, den, lo, hi = row[0], row[1], float(row[2]), float(row[3])
             self._check_names({num: 1, den: 1})
             if den not in self.mechanism.LENGTHS or lo > hi:
                 raise self._err(f"ratio {num}/{den} needs a length denominator and lower <= upper")
+            ratio.append((num, den, lo, hi))
+        if "linear" in c:
+            c["linear"] = tuple(linear)
+        if "ratio" in c:
+            c["ratio"] = tuple(ratio)
         return c
 
     def _check_names(self, names):
@@ -184,8 +221,79 @@ class Problem:
             raise self._err(f"unknown size measure {self.size!r}; measures are {SIZES}")
         if self.accel_over not in ("cycle", "working"):
             raise self._err(f"accel_over is 'cycle' or 'working', got {self.accel_over!r}")
+        if not (_number(self.omega2) and self.omega2 != 0):
+            raise self._err(f"omega2 is the crank speed in rad/s, a nonzero finite number; got {self.omega2!r}")
         if self.objective == "min_peak_accel" and self.mechanism is FourBar:
             raise self._err("FourBar has no slider: min_peak_accel does not apply")
+
+    # ---- equality and serialisation (angles in radians, lengths in the problem's units) -------------
+    def to_dict(self) -> dict:
+        """Plain JSON-ready values: the mechanism by its kind, bounds as [lower, upper], objective None or a name."""
+        c = dict(self.conditions)
+        if "linear" in c:
+            c["linear"] = [[dict(k), lo, hi] for k, lo, hi in c["linear"]]
+        if "ratio" in c:
+            c["ratio"] = [list(r) for r in c["ratio"]]
+        return {
+            "mechanism": self.mechanism.KIND,
+            "fixed": dict(self.fixed),
+            "free": {k: [lo, hi] for k, (lo, hi) in self.free.items()},
+            "targets": dict(self.targets),
+            "conditions": c,
+            "objective": self.objective,
+            "size": self.size,
+            "omega2": self.omega2,
+            "accel_over": self.accel_over,
+            "branches": {k: list(v) for k, v in self.branches.items()},
+            "name": self.name,
+        }
+
+    @classmethod
+    def from_dict(cls, d) -> Problem:
+        """The Problem of ``to_dict`` (or a hand-written dict, TOML or JSON table), validated as always."""
+        if not isinstance(d, Mapping):
+            raise ProblemError(f"a problem is a table of fields, got {type(d).__name__}")
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(d) - known)
+        if unknown or "mechanism" not in d:
+            raise ProblemError(f"problem fields are {sorted(known)} ('mechanism' required); unknown: {unknown}")
+        d = dict(d)
+        if d.get("objective") in ("none", "None", ""):
+            d["objective"] = None
+        return cls(**d)
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=2, allow_nan=False)
+
+    @classmethod
+    def from_json(cls, text: str) -> Problem:
+        try:
+            return cls.from_dict(json.loads(text))
+        except json.JSONDecodeError as e:
+            raise ProblemError(f"not a JSON problem: {e}") from None
+
+    def to_toml(self) -> str:
+        """TOML (an objective of None is written "none")."""
+        import tomli_w
+
+        d = self.to_dict()
+        d["objective"] = d["objective"] or "none"
+        return tomli_w.dumps(d)
+
+    @classmethod
+    def from_toml(cls, text: str) -> Problem:
+        import tomllib
+
+        try:
+            return cls.from_dict(tomllib.loads(text))
+        except tomllib.TOMLDecodeError as e:
+            raise ProblemError(f"not a TOML problem: {e}") from None
+
+    def __eq__(self, other):
+        return isinstance(other, Problem) and self.to_dict() == other.to_dict()
+
+    def __hash__(self):
+        return hash(json.dumps(self.to_dict(), sort_keys=True))
 
     # ---- helpers --------------------------------------------------------------
     def replace(self, **changes) -> Problem:
