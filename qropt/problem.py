@@ -182,7 +182,7 @@ class Problem:
             raise self._err(f"{self.mechanism.__name__} has no four-bar: no grashof condition")
         g = c.get("gamma_min")
         if g is not None and not (_number(g) and 0 <= g < math.pi / 2):
-            raise self._err(f"gamma_min bound must be a number in [0, pi/2) rad, got {g!r}")
+            raise self._err(f"gamma_min bound must be in [0, pi/2) rad, a number; got {g!r}")
         linear = []
         for row in c.get("linear", ()):
             if not (isinstance(row, (list, tuple)) and len(row) == 3 and isinstance(row[0], Mapping)

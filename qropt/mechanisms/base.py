@@ -39,6 +39,8 @@ def _finite(name: str, value) -> float:
         v = math.inf
     if not math.isfinite(v):
         raise InvalidParameter(f"{name} must be finite, got {v}")
+    if abs(v) > MAGNITUDE:
+        raise InvalidParameter(f"{name} = {v:g} is out of range (|value| <= 1e100)")
     return v
 
 
