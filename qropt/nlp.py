@@ -293,6 +293,28 @@ class Formulation:
         rows = [i for i, r in enumerate(self.rows) if r.lb == r.ub and not r.name.startswith("lifted")]
         return np.array(rows, int) if len(rows) == self.nx + 2 else None
 
+    @functools.cached_property
+    def square_system(self):
+        """z = [w, p] -> [residual of the square rows, their Jacobian in (free, theta_max, theta_min)
+        (column-major)], evaluated without conversions (see kernel.Batched)."""
+        from qropt.kernel import Batched
+
+        rows, n = self.square_rows, self.nx + 2
+        r = self.g_sym[rows.tolist()] - casadi.DM(self.lbg[rows])
+        jac = casadi.jacobian(r, self.w_sym[:n])
+        z = casadi.SX.sym("z", self.w_sym.numel() + self.p_sym.numel())
+        f = casadi.Function("sq", [self.w_sym, self.p_sym], [casadi.vertcat(r, casadi.vec(jac))])
+        return Batched(casadi.Function("sqz", [z], [f(z[: self.w_sym.numel()], z[self.w_sym.numel() :])]))
+
+    @functools.cached_property
+    def constraint_values(self):
+        """z = [w, p] -> g, evaluated without conversions."""
+        from qropt.kernel import Batched
+
+        z = casadi.SX.sym("z", self.w_sym.numel() + self.p_sym.numel())
+        f = casadi.Function("g", [self.w_sym, self.p_sym], [self.g_sym])
+        return Batched(casadi.Function("gz", [z], [f(z[: self.w_sym.numel()], z[self.w_sym.numel() :])]))
+
     def violations(self, g):
         """Named constraint violations (>= 0) of constraint values g."""
         v = np.maximum(np.maximum(self.lbg - g, g - self.ubg), 0.0)

@@ -157,20 +157,23 @@ class Solver:
         n = form.nx + 2
         c = Candidate(False, dict(values0), branch, orientation, origin="enumeration")
         for _ in range(30):
-            out = form.functions(w, p)
-            r = np.array(out[1]).ravel()[rows] - form.lbg[rows]
-            jac = np.array(out[3])[np.ix_(rows, np.arange(n))]
+            out = form.square_system(np.concatenate([w, p])[None, :])[0]
             try:
-                step = np.linalg.solve(jac, r)
+                step = np.linalg.solve(out[n:].reshape(n, n, order="F"), out[:n])
             except np.linalg.LinAlgError:
                 break
             w[:n] -= step
             c.iterations += 1
             if np.max(np.abs(step)) <= 1e-14 * max(1.0, np.max(np.abs(w[:n]))):
                 break
-        c.values = dict(zip(form.free, w[: form.nx].tolist(), strict=True))
+        # the closed form's own values where Newton only moved them by rounding (one design built, not two)
+        free = [
+            values0[k] if abs(w[i] - values0[k]) <= 4e-16 * abs(values0[k]) else w[i] for i, k in enumerate(form.free)
+        ]
+        c.values = dict(zip(form.free, free, strict=True))
+        w[: form.nx] = free
         w = form.epigraph_start(w, p)
-        g = np.array(form.functions(w, p)[1]).ravel()
+        g = form.constraint_values(np.concatenate([w, p])[None, :])[0]
         tol = self.tolerances
         m, info, _, _ = certify(problem, None, c.values, branch, w[form.nx : n], None, None, tol["gap"],
                                 tol["feasibility"], designs)  # fmt: skip
