@@ -40,7 +40,7 @@ def _scipy_local(problem, seed, method):
     """A local scipy method on qropt's NLP functions (exact CasADi derivatives) from qropt's starts (every closed
     form, then the Sobol points, both TR orientations for those); no exchange loop. The best design by exact
     evaluation."""
-    from problems import _oracle
+    from qropt import oracles
 
     best, nfev = None, 0
     for _origin, _v, br, _way, form, w0, p in local_starts(problem, seed):
@@ -49,7 +49,7 @@ def _scipy_local(problem, seed, method):
         if x is None:
             continue
         values = dict(zip(form.free, x[: form.nx].tolist(), strict=True))
-        s = _oracle.score(problem, values)
+        s = oracles.score(problem, values)
         feasible = s is not None and violation(problem, s[1]) <= FEASIBLE
         if feasible and better(problem, s[0], best[0] if best else None):
             best = (s[0], values, br)
@@ -146,7 +146,7 @@ def scipy_trust_constr(problem, seed):
 def scipy_de(problem, seed):
     """differential_evolution over the free parameters: exact objective plus a penalty on target and
     condition violations (a design that does not work scores 1e6)."""
-    from problems import _oracle
+    from qropt import oracles
 
     names = list(problem.free)
     sign = -1.0 if problem.objective == "max_gamma_min" else 1.0
@@ -155,7 +155,7 @@ def scipy_de(problem, seed):
     def f(x):
         calls[0] += 1
         values = dict(zip(names, x.tolist(), strict=True))
-        s = _oracle.score(problem, values)
+        s = oracles.score(problem, values)
         if s is None:
             return 1e6
         obj, q = s

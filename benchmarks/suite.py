@@ -39,11 +39,11 @@ def _module(name):
 
 def evaluate(problem, values):
     """(objective, violation) of a returned design by exact analysis; (None, inf) if it does not work."""
-    from problems import _oracle
+    from qropt import oracles
 
     if values is None:
         return None, math.inf
-    s = _oracle.score(
+    s = oracles.score(
         problem.replace(conditions={k: v for k, v in problem.conditions.items() if k != "gamma_min"}), values
     )
     if s is None:

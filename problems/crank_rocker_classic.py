@@ -3,15 +3,15 @@ maximise the minimum transmission angle (r2, r3, r4 free).
 
 Oracle: grid along the classical construction ``analytic.crank_rocker_design``, refined."""
 
-from problems import _bases, _oracle
+from qropt import oracles, problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 
 
 def build():
-    return _bases.classic_crank_rocker(objective="max_gamma_min", name="crank_rocker_classic")
+    return problem_bases.classic_crank_rocker(objective="max_gamma_min", name="crank_rocker_classic")
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _oracle.along(build(), _bases.classic_design, 0.005, 0.495)
+    return oracles.along(build(), problem_bases.classic_design, 0.005, 0.495)

@@ -3,15 +3,15 @@ r6 = 0.5 fixed; r3, r4, r5 free; best transmission angle.
 
 Oracle: grid along r4 (r3 from the rocker's closed-form TR, r5 from the stroke, both by brentq), refined."""
 
-from problems import _bases
+from qropt import problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-6}
 
 
 def build():
-    return _bases.crank_rocker_slider(objective="max_gamma_min", name="crank_rocker_slider_gamma")
+    return problem_bases.crank_rocker_slider(objective="max_gamma_min", name="crank_rocker_slider_gamma")
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _bases.crank_rocker_slider_oracle(build())
+    return problem_bases.crank_rocker_slider_oracle(build())

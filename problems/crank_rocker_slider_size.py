@@ -2,15 +2,15 @@
 
 Oracle: grid along r4 (closed forms and brentq), refined."""
 
-from problems import _bases
+from qropt import problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-6}
 
 
 def build():
-    return _bases.crank_rocker_slider(objective="min_size", name="crank_rocker_slider_size")
+    return problem_bases.crank_rocker_slider(objective="min_size", name="crank_rocker_slider_size")
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _bases.crank_rocker_slider_oracle(build())
+    return problem_bases.crank_rocker_slider_oracle(build())

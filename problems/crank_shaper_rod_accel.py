@@ -3,15 +3,15 @@ over the rod length.
 
 Oracle: r2, r4 in closed form; grid over r6, refined."""
 
-from problems import _bases
+from qropt import problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-6}
 
 
 def build():
-    return _bases.crank_shaper_rod(objective="min_peak_accel", omega2=5.0, name="crank_shaper_rod_accel")
+    return problem_bases.crank_shaper_rod(objective="min_peak_accel", omega2=5.0, name="crank_shaper_rod_accel")
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _bases.crank_shaper_rod_oracle(build())
+    return problem_bases.crank_shaper_rod_oracle(build())

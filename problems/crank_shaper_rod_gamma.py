@@ -3,15 +3,15 @@ best transmission angle over the rod length.
 
 Oracle: r2, r4 in closed form (TR and stroke fix them); grid over r6, refined."""
 
-from problems import _bases
+from qropt import problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 
 
 def build():
-    return _bases.crank_shaper_rod(objective="max_gamma_min", name="crank_shaper_rod_gamma")
+    return problem_bases.crank_shaper_rod(objective="max_gamma_min", name="crank_shaper_rod_gamma")
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _bases.crank_shaper_rod_oracle(build())
+    return problem_bases.crank_shaper_rod_oracle(build())

@@ -4,8 +4,7 @@ Oracle: closed form r2 = r1 sin(phi / 2), r4 = stroke r1 / (2 r2) (phi of eq. 7)
 is fixed by TR and stroke, so ``min_size`` must return it.
 """
 
-from problems import _oracle
-from qropt import Problem, analytic
+from qropt import Problem, analytic, oracles
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-9}
 
@@ -25,4 +24,4 @@ def build() -> Problem:
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
     k = analytic.crank_shaper_ratio(1.6)
-    return _oracle.best_of(build(), [{"r2": 0.3 * k, "r4": 0.4 / (2 * k)}])
+    return oracles.best_of(build(), [{"r2": 0.3 * k, "r4": 0.4 / (2 * k)}])

@@ -3,7 +3,7 @@ optima in two mirror pairs.
 
 Oracle: closed form, eqs. (7)-(13) (the branch mirrors give the same lengths and gamma_min)."""
 
-from problems import _oracle
+from qropt import oracles
 from qropt.examples import paper_problem
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-8}
@@ -15,4 +15,4 @@ def build():
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _oracle.paper(build())
+    return oracles.paper(build())

@@ -3,7 +3,7 @@ the change point r3 = 0.4 and the transmission angle collapses.
 
 Oracle: closed form, eqs. (7)-(13)."""
 
-from problems import _oracle
+from qropt import oracles
 from qropt.examples import paper_problem
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-8}
@@ -15,4 +15,4 @@ def build():
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _oracle.paper(build())
+    return oracles.paper(build())

@@ -3,8 +3,7 @@ around one of its two solutions.
 
 Oracle: closed form (the rocker's TR from its limit positions) solved for r3 by brentq."""
 
-from problems import _oracle
-from qropt import Problem
+from qropt import Problem, oracles
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-09}
 
@@ -23,4 +22,4 @@ def build() -> Problem:
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
     p = build()
-    return _oracle.best_of(p, [{"r3": x} for x in _oracle.crank_rocker_r3(1.2, 1.0, 0.2, 0.9)])
+    return oracles.best_of(p, [{"r3": x} for x in oracles.crank_rocker_r3(1.2, 1.0, 0.2, 0.9)])

@@ -4,13 +4,13 @@ Oracle: grid along the classical construction, the gamma_min boundary located by
 
 import math
 
-from problems import _bases, _oracle
+from qropt import oracles, problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 
 
 def build():
-    return _bases.classic_crank_rocker(
+    return problem_bases.classic_crank_rocker(
         conditions={"grashof": "crank-rocker", "gamma_min": math.radians(35)},
         objective="min_size",
         size="longest",
@@ -21,5 +21,5 @@ def build():
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
     p = build()
-    margin = _bases.gamma_margin(p, _bases.classic_design, math.radians(35))
-    return _oracle.along(p, _bases.classic_design, 0.005, 0.495, boundary=margin)
+    margin = problem_bases.gamma_margin(p, problem_bases.classic_design, math.radians(35))
+    return oracles.along(p, problem_bases.classic_design, 0.005, 0.495, boundary=margin)

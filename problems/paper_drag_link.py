@@ -6,7 +6,7 @@ Oracle: closed form, eqs. (7)-(13): r3 = 0.2504281 m (gamma_min 27.008 deg) or 0
 (9.095 deg), r5 = 0.15 m.
 """
 
-from problems import _oracle
+from qropt import oracles
 from qropt.examples import paper_problem
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-9}
@@ -18,4 +18,4 @@ def build():
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'} (the best of eqs. 7-13's roots)."""
-    return _oracle.paper(build())
+    return oracles.paper(build())

@@ -2,7 +2,7 @@
 
 Oracle: closed form, eqs. (7)-(13): the best of its roots (peak acceleration evaluated exactly)."""
 
-from problems import _oracle
+from qropt import oracles
 from qropt.examples import paper_problem
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-8}
@@ -14,4 +14,4 @@ def build():
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _oracle.paper(build())
+    return oracles.paper(build())

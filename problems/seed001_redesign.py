@@ -3,8 +3,7 @@ lengths, the shortest lever.
 
 Oracle: closed form r2 = r1 sin(phi / 2), r4 = stroke / (2 sin(phi / 2))."""
 
-from problems import _oracle
-from qropt import Problem, analytic
+from qropt import Problem, analytic, oracles
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-09}
 
@@ -24,4 +23,4 @@ def build() -> Problem:
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
     k = analytic.crank_shaper_ratio(1.6)
-    return _oracle.best_of(build(), [{"r2": 160.0 * k, "r4": 120.0 / (2 * k)}])
+    return oracles.best_of(build(), [{"r2": 160.0 * k, "r4": 120.0 / (2 * k)}])

@@ -2,15 +2,15 @@
 
 Oracle: grid along the closed-form family, refined."""
 
-from problems import _bases
+from qropt import problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-6}
 
 
 def build():
-    return _bases.slider_crank(objective="min_peak_accel", name="slider_crank_accel")
+    return problem_bases.slider_crank(objective="min_peak_accel", name="slider_crank_accel")
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _bases.slider_crank_oracle(build())
+    return problem_bases.slider_crank_oracle(build())

@@ -2,15 +2,15 @@
 
 Oracle: grid along the closed-form family (r2 -> r3, e from the stroke triangle), refined."""
 
-from problems import _bases
+from qropt import problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 
 
 def build():
-    return _bases.slider_crank(objective="max_gamma_min", name="slider_crank_gamma")
+    return problem_bases.slider_crank(objective="max_gamma_min", name="slider_crank_gamma")
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _bases.slider_crank_oracle(build())
+    return problem_bases.slider_crank_oracle(build())

@@ -4,13 +4,13 @@ Oracle: grid along the closed-form family; the gamma_min boundary located by bre
 
 import math
 
-from problems import _bases, _oracle
+from qropt import oracles, problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 
 
 def build():
-    return _bases.slider_crank(
+    return problem_bases.slider_crank(
         conditions={"gamma_min": math.radians(30)}, objective="min_size", name="slider_crank_size"
     )
 
@@ -18,5 +18,5 @@ def build():
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
     p = build()
-    margin = _bases.gamma_margin(p, _oracle.slider_crank_family(1.3, 0.3), math.radians(30))
-    return _bases.slider_crank_oracle(p, boundary=margin)
+    margin = problem_bases.gamma_margin(p, oracles.slider_crank_family(1.3, 0.3), math.radians(30))
+    return problem_bases.slider_crank_oracle(p, boundary=margin)

@@ -4,15 +4,15 @@ at omega2 = 10 rad/s; the rod r6 is free.
 Oracle: r2 = r1 / sin(phi / 2) = 0.2 m and r5 = 0.15 m are forced; the peak acceleration falls as
 the rod lengthens, so the optimum is r6 at its upper bound (reference: grid over r6, refined)."""
 
-from problems import _bases, _oracle
+from qropt import oracles, problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-6}
 
 
 def build():
-    return _bases.whitworth(objective="min_peak_accel", omega2=10.0, name="whitworth_accel")
+    return problem_bases.whitworth(objective="min_peak_accel", omega2=10.0, name="whitworth_accel")
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _oracle.along(build(), _bases.whitworth_design, 0.2, 0.6)
+    return oracles.along(build(), problem_bases.whitworth_design, 0.2, 0.6)

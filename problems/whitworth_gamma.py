@@ -2,15 +2,15 @@
 
 Oracle: r2, r5 in closed form; grid over r6, refined."""
 
-from problems import _bases, _oracle
+from qropt import oracles, problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 
 
 def build():
-    return _bases.whitworth(objective="max_gamma_min", name="whitworth_gamma")
+    return problem_bases.whitworth(objective="max_gamma_min", name="whitworth_gamma")
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
-    return _oracle.along(build(), _bases.whitworth_design, 0.2, 0.6)
+    return oracles.along(build(), problem_bases.whitworth_design, 0.2, 0.6)

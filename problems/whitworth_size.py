@@ -4,17 +4,19 @@ Oracle: r2, r5 in closed form; grid over r6 with the gamma_min boundary located 
 
 import math
 
-from problems import _bases, _oracle
+from qropt import oracles, problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 
 
 def build():
-    return _bases.whitworth(conditions={"gamma_min": math.radians(60)}, objective="min_size", name="whitworth_size")
+    return problem_bases.whitworth(
+        conditions={"gamma_min": math.radians(60)}, objective="min_size", name="whitworth_size"
+    )
 
 
 def oracle() -> dict:
     """The reference optimum: {'objective', 'params'}."""
     p = build()
-    margin = _bases.gamma_margin(p, _bases.whitworth_design, math.radians(60))
-    return _oracle.along(p, _bases.whitworth_design, 0.2, 0.6, boundary=margin)
+    margin = problem_bases.gamma_margin(p, problem_bases.whitworth_design, math.radians(60))
+    return oracles.along(p, problem_bases.whitworth_design, 0.2, 0.6, boundary=margin)

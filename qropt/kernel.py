@@ -54,6 +54,9 @@ class Batched:
     FunctionBuffer (the Python conversions of an ordinary call cost more than the arithmetic here)."""
 
     def __init__(self, f: casadi.Function):
+        if not f.sparsity_out(0).is_dense():  # the buffer holds nonzeros only: make every entry one
+            z = f.mx_in(0)
+            f = casadi.Function(f.name() + "_dense", [z], [casadi.densify(f(z))])
         self.f, self.m, self.r = f, f.size1_in(0), f.size1_out(0)
         self._by_k: dict = {}
 

@@ -1,7 +1,7 @@
-"""Oracle helpers for the problem files: the best of a set of closed-form designs, or a dense grid along a
-one-parameter closed-form family with bounded-Brent refinement. Designs are evaluated by qropt's exact
-analysis (itself checked against an independent brute-force simulator in tests/); the search over designs
-never uses the NLP."""
+"""Oracles of the benchmark problems (``problems/``), independent of the NLP: the best of a set of
+closed-form designs, or a dense grid along a one-parameter closed-form family with bounded-Brent refinement.
+Designs are evaluated by qropt's exact analysis (itself checked against an independent brute-force simulator
+in tests/); the search over designs never uses the NLP."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from qropt import QroptError, analytic
-from qropt.solve import objective_value, quantities
+from qropt.certify import better, objective_value, quantities
 
 
 def score(problem, values: dict):
@@ -32,18 +32,12 @@ def score(problem, values: dict):
     return objective_value(problem, q), q
 
 
-def _better(problem, a, b):
-    if b is None:
-        return True
-    return a > b if problem.objective == "max_gamma_min" else a < b
-
-
 def best_of(problem, candidates):
     """The best of closed-form candidate designs: {'objective', 'params'}."""
     best, where = None, None
     for c in candidates:
         s = score(problem, c)
-        if s is not None and _better(problem, s[0], best):
+        if s is not None and better(problem, s[0], best):
             best, where = s[0], dict(c)
     return {"objective": best, "params": where}
 

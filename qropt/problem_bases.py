@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import math
 
-from problems import _oracle
-from qropt import Problem, analytic
+from qropt import Problem, analytic, oracles
 
 
 def slider_crank(**changes) -> Problem:
@@ -20,7 +19,7 @@ def slider_crank(**changes) -> Problem:
 
 
 def slider_crank_oracle(problem, boundary=None):
-    return _oracle.along(problem, _oracle.slider_crank_family(1.3, 0.3), 0.0501, 0.14999, boundary=boundary)
+    return oracles.along(problem, oracles.slider_crank_family(1.3, 0.3), 0.0501, 0.14999, boundary=boundary)
 
 
 def crank_shaper_rod(**changes) -> Problem:
@@ -37,7 +36,7 @@ def crank_shaper_rod(**changes) -> Problem:
 def crank_shaper_rod_oracle(problem):
     """r2, r4 in closed form (TR and stroke fix them); grid over the rod r6."""
     k = analytic.crank_shaper_ratio(1.6)
-    return _oracle.along(problem, lambda r6: {"r2": k * 0.3, "r4": 0.4 / (2 * k), "r6": r6}, 0.15, 0.8)
+    return oracles.along(problem, lambda r6: {"r2": k * 0.3, "r4": 0.4 / (2 * k), "r6": r6}, 0.15, 0.8)
 
 
 def whitworth(**changes) -> Problem:
@@ -69,7 +68,7 @@ def crank_rocker_slider(**changes) -> Problem:
 
 def crank_rocker_slider_oracle(problem):
     """Grid along r4 for each root of the rocker's TR (r3), r5 from the stroke; the better of the two."""
-    runs = [_oracle.along(problem, _oracle.crank_rocker_slider_family(1.2, 0.15, 0.3, 0.1, 0.5, k), 0.15, 0.45, n=150)
+    runs = [oracles.along(problem, oracles.crank_rocker_slider_family(1.2, 0.15, 0.3, 0.1, 0.5, k), 0.15, 0.45, n=150)
             for k in (0, 1)]  # fmt: skip
     runs = [r for r in runs if r["objective"] is not None]
     pick = max if problem.objective == "max_gamma_min" else min
@@ -98,7 +97,7 @@ def gamma_margin(problem, design, bound):
     """t -> gamma_min(design(t)) - bound, for locating a gamma_min condition's boundary along a family."""
 
     def margin(t):
-        s = _oracle.score(problem.replace(conditions={**problem.conditions, "gamma_min": 0.0}), design(t))
+        s = oracles.score(problem.replace(conditions={**problem.conditions, "gamma_min": 0.0}), design(t))
         return -1.0 if s is None else s[1]["gamma_min"] - bound
 
     return margin
