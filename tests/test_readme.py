@@ -1,0 +1,63 @@
+"""Every ``qropt`` command the README shows, run as a subprocess of the installed executable from a directory
+outside the repository (holding a copy of ``problems/``, which the commands name): exit code 0, and every file
+the command names written and not empty. ``qropt bench`` and the ``python -m benchmarks`` lines are the
+benchmarks' own (minutes long, run from the repository root): they are not run here."""
+
+from __future__ import annotations
+
+import re
+import shlex
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+OUTPUT_FLAGS = ("--plot", "--csv", "--animate", "--dxf", "--svg", "--save", "-o")
+
+
+def readme_commands() -> list[str]:
+    """The README's shell lines that start with ``qropt``, comments removed."""
+    text = (ROOT / "README.md").read_text()
+    lines = [line for block in re.findall(r"```sh\n(.*?)```", text, re.S) for line in block.splitlines()]
+    out = []
+    for line in lines:
+        command = re.sub(r"\s+#.*$", "", line).strip()
+        if command.startswith("qropt ") or command == "qropt":
+            out.append(command)
+    return out
+
+
+def outputs(command: str) -> list[str]:
+    words = shlex.split(command.replace("&&", " ").replace(">", " > "))
+    files = [words[i + 1] for i, w in enumerate(words[:-1]) if w in OUTPUT_FLAGS or w == ">"]
+    return [f for f in files if f != "-"]
+
+
+COMMANDS = readme_commands()
+
+
+def test_the_readme_shows_commands():
+    assert len(COMMANDS) >= 10 and COMMANDS[0].startswith("qropt ")
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory):
+    d = tmp_path_factory.mktemp("readme")
+    shutil.copytree(ROOT / "problems", d / "problems")
+    return d
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_readme_command_runs(command, workdir):
+    exe = shutil.which("qropt")
+    assert exe is not None, "qropt is not installed on PATH"
+    shell = command.replace("qropt ", f"{shlex.quote(exe)} ") if command != "qropt" else exe
+    if command.startswith("qropt bench"):
+        pytest.skip("the benchmark suite runs from the repository root and takes minutes")
+    r = subprocess.run(shell, shell=True, cwd=workdir, capture_output=True, text=True, timeout=240)
+    assert r.returncode == 0, (command, r.stdout[-2000:], r.stderr[-2000:])
+    for name in outputs(command):
+        path = workdir / name
+        assert path.is_file() and path.stat().st_size > 0, (command, name)
