@@ -31,9 +31,13 @@ class AssemblyError(QroptError):
         self.mechanism, self.params, self.failures = mechanism, dict(params), list(failures)
         by_closure: dict[str, list[str]] = {}
         for what, lo, hi in self.failures:
+            if hi - lo >= 2 * math.pi - 1e-9:
+                by_closure.setdefault(what, []).append("the whole turn")
+                continue
             span = f"[{math.degrees(lo) % 360:.4f}, {math.degrees(hi) % 360:.4f}]"
             by_closure.setdefault(what, []).append(span)
-        parts = [f"{what} fails for theta2 in {' and '.join(s)} deg" for what, s in by_closure.items()]
+        parts = [f"{what} fails for theta2 in {' and '.join(s)}" + (" deg" if s[-1][0] == "[" else "")
+                 for what, s in by_closure.items()]  # fmt: skip
         given = ", ".join(f"{k}={v:g}" for k, v in self.params.items())
         super().__init__(f"{mechanism}({given}) cannot turn through a full revolution: " + "; ".join(parts))
 

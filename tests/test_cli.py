@@ -98,3 +98,68 @@ def test_angle_parsing():
     assert cli.angle("60") == pytest.approx(math.radians(60))
     assert cli.angle("60deg") == pytest.approx(math.radians(60))
     assert cli.angle("1.5rad") == 1.5
+
+
+@pytest.mark.parametrize(
+    ("argv", "code", "words"),
+    [
+        (["analyze", "--table", "1e-6", "--csv", "x.csv"], 2, "0.01 to 360"),
+        (["analyze", "--table", "0"], 2, "0.01 to 360"),
+        (["analyze", "--table", "400"], 2, "0.01 to 360"),
+        (["analyze", "--plot", "out.txt"], 2, "picture formats"),
+        (["analyze", "--json", "--table", "90"], 2, "--csv FILE"),
+        (["analyze", "--theta2", "nan"], 2, "finite angle"),
+        (["analyze", "--theta2", "1e400"], 2, "finite angle"),
+        (["analyze", "--omega2", "0"], 2, "nonzero"),
+        (["analyze", "--omega2", "nan"], 2, "finite number"),
+        (["reachable", "--tr", "nan"], 2, "finite number"),
+        (["synth", "--starts", "-3"], 2, "--starts"),
+        (["synth", "--size", "footprint"], 2, "min_size"),
+        (["analyze", "whitworth", "--r1", "0.1", "--r2", "0.2", "--r5", "0.12", "--r6", "0.05"], 1, "fails for theta2"),
+    ],
+)
+def test_bad_command_lines_print_one_line(argv, code, words, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(argv) == code
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and words in err, err
+    assert not (tmp_path / "x.csv").exists()
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        ("def build(:\n", "does not load: SyntaxError"),
+        ("def build():\n    return 42\n", "must return a qropt.Problem, got int"),
+        ("def build():\n    return None\n", "got NoneType"),
+        ("x = 1\n", "no build()"),
+    ],
+)
+def test_bad_problem_files_print_one_line(text, words, capsys, tmp_path):
+    f = tmp_path / "bad.py"
+    f.write_text(text)
+    assert cli.main(["synth", str(f)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and words in err, err
+
+
+def test_toml_and_json_problem_files_solve_like_the_python_one(capsys, tmp_path):
+    from qropt.examples import paper_problem
+
+    (tmp_path / "task.json").write_text(paper_problem().to_json())
+    (tmp_path / "bad.toml").write_text("mechanism = \n")
+    for f in ("problems/paper_task.toml", str(tmp_path / "task.json")):
+        assert cli.main(["synth", f, "--json"]) == 0
+        out = json.loads(capsys.readouterr().out)
+        assert out["params"]["r3"] == pytest.approx(0.2504281217548, abs=1e-12)
+    assert cli.main(["synth", str(tmp_path / "bad.toml")]) == 1
+    assert "TOML" in capsys.readouterr().err
+
+
+def test_infeasible_synth_json_is_strict(capsys, tmp_path):
+    from qropt.examples import paper_problem
+
+    (tmp_path / "far.json").write_text(paper_problem().replace(targets={"time_ratio": 9.0, "stroke": 0.3}).to_json())
+    assert cli.main(["synth", str(tmp_path / "far.json"), "--json"]) == 1
+    out = capsys.readouterr().out
+    assert "NaN" not in out and json.loads(out)["status"] == "infeasible"

@@ -115,7 +115,7 @@ def test_cli_one_line_nonzero(name, kw, err, fragment, cli_extra, capsys):
         (["analyze", "crank-shaper", "--r1", "1", "--r2", "0.5", "--r4", "2", "--theta2", "abc"], "not an angle"),
         (["analyze", "nonsense", "--r1", "1"], "unknown mechanism type 'nonsense'"),
         (["analyze", "--r1", "1"], "give the mechanism TYPE"),
-        (["analyze", "whitworth", "--r1", "x"], "invalid float value"),
+        (["analyze", "whitworth", "--r1", "x"], "not a number"),
         (["frobnicate"], "invalid choice"),
         (["analyze", "four-bar", "--r1", "3.5", "--r2", "1.6", "--r3", "2.14", "--r4", "2.06"], "104.6361, 255.3639"),
         (["analyze", "four-bar", "--r1", "0.1", "--r2", "0.3", "--r3", "0.3", "--r4", "0.3"], "no regular extremes"),

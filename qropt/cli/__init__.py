@@ -33,11 +33,34 @@ def angle(text: str) -> float:
     """An angle from the command line: '60', '60deg' (degrees) or '1.05rad' (radians) -> radians."""
     t = text.strip().lower()
     try:
-        if t.endswith("rad"):
-            return float(t[:-3])
-        return math.radians(float(t.removesuffix("deg")))
+        v = float(t[:-3]) if t.endswith("rad") else math.radians(float(t.removesuffix("deg")))
     except ValueError:
         raise argparse.ArgumentTypeError(f"not an angle: {text!r} (use e.g. 60deg or 1.05rad)") from None
+    if not math.isfinite(v) or abs(v) > 1e6:
+        raise argparse.ArgumentTypeError(f"not a finite angle of sensible size: {text!r}")
+    return v
+
+
+def real(text: str) -> float:
+    """A finite number from the command line."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"not a finite number: {text!r}")
+    return v
+
+
+PLOT_FORMATS = (".png", ".pdf", ".svg")
+MIN_STEP = math.radians(0.01)  # the finest full-cycle table: 36,000 rows
+
+
+def picture_path(path: str) -> str:
+    """A path for a matplotlib picture, or CliError naming the formats."""
+    if not path.lower().endswith(PLOT_FORMATS):
+        raise CliError(f"--plot {path}: the picture formats are {', '.join(PLOT_FORMATS)}")
+    return path
 
 
 def build_mechanism(args) -> Mechanism:
@@ -152,10 +175,16 @@ def write_table(m: Mechanism, step: float, omega2: float, alpha2: float, path: s
 
 
 def cmd_analyze(args):
+    if args.omega2 == 0:
+        raise CliError("--omega2 must be nonzero (rad/s; its sign is the crank's sense of rotation)")
+    if args.table is not None and not MIN_STEP <= args.table <= 2 * math.pi:
+        raise CliError(f"--table is a crank-angle step from 0.01 to 360 deg, got {math.degrees(args.table):g} deg")
+    if args.json and args.table is not None and args.csv in (None, "-"):
+        raise CliError("--json prints JSON on standard output: give the table a file with --csv FILE")
     m = build_mechanism(args)
     r = report(m, args.theta2, args.omega2, args.alpha2)
     if args.json:
-        json.dump(r, sys.stdout, indent=2)
+        json.dump(r, sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")
     else:
         print_report(r)
@@ -177,10 +206,10 @@ def parser() -> argparse.ArgumentParser:
     a = sub.add_parser("analyze", help="exact TR, stroke, dead centres, gamma_min and slider state")
     a.add_argument("type", nargs="?", help="mechanism type: " + ", ".join(sorted(REGISTRY)))
     for k in PARAM_NAMES:
-        a.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
+        a.add_argument(f"--{k.replace('_', '-')}", dest=k, type=real, help=f"parameter {k}")
     a.add_argument("--theta2", type=angle, default=math.radians(60.0), help="crank angle (deg, or 1.05rad)")
-    a.add_argument("--omega2", type=float, default=1.0, help="crank speed, rad/s (sign = direction)")
-    a.add_argument("--alpha2", type=float, default=0.0, help="crank acceleration, rad/s^2")
+    a.add_argument("--omega2", type=real, default=1.0, help="crank speed, rad/s (sign = direction)")
+    a.add_argument("--alpha2", type=real, default=0.0, help="crank acceleration, rad/s^2")
     a.add_argument("--json", action="store_true", help="print JSON instead of text")
     a.add_argument("--table", type=angle, help="full-cycle table step (deg, or rad with suffix)")
     a.add_argument("--csv", help="file for the full-cycle table ('-' for standard output)")
@@ -204,10 +233,10 @@ def parser() -> argparse.ArgumentParser:
     r = sub.add_parser("reachable", help="TR range, solution counts and adjustable-link travel of one parameter")
     r.add_argument("type", nargs="?", help="mechanism type (default: the paper's mechanism)")
     for k in PARAM_NAMES:
-        r.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
+        r.add_argument(f"--{k.replace('_', '-')}", dest=k, type=real, help=f"parameter {k}")
     r.add_argument("--free", default="r3", help="the adjustable parameter (default r3)")
-    r.add_argument("--bounds", nargs=2, type=float, metavar=("LOW", "HIGH"), help="its interval")
-    r.add_argument("--tr", type=float, action="append", default=[], help="count the designs for this TR")
+    r.add_argument("--bounds", nargs=2, type=real, metavar=("LOW", "HIGH"), help="its interval")
+    r.add_argument("--tr", type=real, action="append", default=[], help="count the designs for this TR")
     r.add_argument("--json", action="store_true", help="print JSON")
     r.add_argument("--plot", help="PNG file: TR against the parameter (the paper's Fig. 5)")
     r.set_defaults(run=cmd_reachable)
@@ -332,19 +361,41 @@ def cmd_reachable(args):
 
 
 def load_problem(path: str):
-    """The Problem built by a problem file's ``build()``."""
+    """The Problem of a file: a ``.py`` file's ``build()``, or a ``.toml`` / ``.json`` problem table."""
     import importlib.util
     from pathlib import Path
+
+    from qropt.errors import ProblemError
+    from qropt.problem import Problem
 
     file = Path(path)
     if not file.is_file():
         raise CliError(f"no problem file {path!r}")
+    if file.suffix in (".toml", ".json"):
+        try:
+            text = file.read_text()
+        except (OSError, UnicodeDecodeError) as e:
+            raise CliError(f"cannot read {path}: {e}") from None
+        try:
+            return Problem.from_toml(text) if file.suffix == ".toml" else Problem.from_json(text)
+        except ProblemError as e:
+            raise ProblemError(f"{path}: {e}") from None
+    if file.suffix != ".py":
+        raise CliError(f"{path}: a problem file is .py (with build()), .toml or .json")
     spec = importlib.util.spec_from_file_location(f"qropt_problem_{file.stem}", file)
     module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    if not hasattr(module, "build"):
+    try:
+        spec.loader.exec_module(module)
+        built = module.build() if callable(getattr(module, "build", None)) else None
+    except QroptError as e:
+        raise type(e)(f"{path}: {e}") from None
+    except Exception as e:  # noqa: BLE001 - a user's file may fail in any way: one line naming it
+        raise CliError(f"{path} does not load: {type(e).__name__}: {e}") from None
+    if not callable(getattr(module, "build", None)):
         raise CliError(f"{path} has no build() function")
-    return module.build()
+    if not isinstance(built, Problem):
+        raise CliError(f"{path}: build() must return a qropt.Problem, got {type(built).__name__}")
+    return built
 
 
 def cmd_synth(args):
@@ -360,12 +411,16 @@ def cmd_synth(args):
     if args.objective:
         changes["objective"] = None if args.objective == "none" else args.objective
     if args.size:
+        if (changes.get("objective", problem.objective)) != "min_size":
+            raise CliError("--size applies to the min_size objective only (give --objective min_size)")
         changes["size"] = args.size
     if changes:
         problem = problem.replace(**changes)
+    if args.starts < 0:
+        raise CliError(f"--starts must be >= 0, got {args.starts}")
     r = solve(problem, starts_n=args.starts)
     if args.json:
-        json.dump(r.to_dict(), sys.stdout, indent=2, default=str)
+        json.dump(r.to_dict(), sys.stdout, indent=2, default=str, allow_nan=False)
         sys.stdout.write("\n")
     else:
         print(f"{problem.name or args.problem}: {problem.mechanism.KIND}, objective {problem.objective}")
@@ -393,6 +448,8 @@ def main(argv=None) -> int:
         if argv[:1] == ["bench"]:
             return cmd_bench(argv[1:])
         args = parser().parse_args(argv)
+        if getattr(args, "plot", None):
+            picture_path(args.plot)
         return args.run(args) or 0
     except CliError as e:
         print(f"qropt: error: {e}", file=sys.stderr)
