@@ -17,10 +17,19 @@ def _segments(pts):
     segs = [("O2", "A")]
     if "B" in pts:
         segs += [("A", "B"), ("O4", "B"), ("O4", "C")]
-    elif "O4" in pts:
-        segs += [("O4", "C")]  # the slotted lever, through the block at A
+    elif "O4" in pts:  # the slotted lever: from O4 through the crank-pin block at A to C, as far as the farther
+        far = "A" if np.hypot(*np.subtract(pts["A"], pts["O4"])) > np.hypot(*np.subtract(pts["C"], pts["O4"])) else "C"
+        segs += [("O4", far)]
     segs += [("C", "D")] if "D" in pts else [("A", "C")] if "O4" not in pts else []
     return [(a, b) for a, b in segs if a in pts and b in pts]
+
+
+def _block(ax, centre, angle, size, color, alpha):
+    """A sliding block (a square of side size, turned by angle rad) at centre."""
+    c, s = math.cos(angle), math.sin(angle)
+    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * size / 2
+    xy = corners @ np.array([[c, s], [-s, c]]) + np.asarray(centre)
+    ax.fill(xy[:, 0], xy[:, 1], facecolor="white", edgecolor=color, lw=1.5, alpha=alpha, zorder=3)
 
 
 def draw_mechanism(ax, m: Mechanism, theta2: float, color="k", alpha=1.0):
@@ -32,10 +41,19 @@ def draw_mechanism(ax, m: Mechanism, theta2: float, color="k", alpha=1.0):
         ground = k in ("O2", "O4")
         ax.plot(x, y, "s" if ground else "o", color=color, ms=7 if ground else 5, alpha=alpha)
         ax.annotate(k, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8, alpha=alpha)
+    scale = max(np.ptp([p[0] for p in pts.values()]), np.ptp([p[1] for p in pts.values()]), 1e-12)
+    if "O4" in pts and "B" not in pts:  # the crank-pin block in the slotted lever
+        lever = math.atan2(pts["A"][1] - pts["O4"][1], pts["A"][0] - pts["O4"][0])
+        _block(ax, pts["A"], lever, 0.06 * scale, color, alpha)
     if not isinstance(m, FourBar):
         slider = "D" if "D" in pts else "C"
         path = m.positions(np.linspace(0, 2 * math.pi, 361))
-        ax.plot(path.points[slider][:, 0], path.points[slider][:, 1], color="tab:blue", lw=3, alpha=0.4)
+        xs, ys = path.points[slider][:, 0], path.points[slider][:, 1]
+        ax.plot(xs, ys, color="tab:blue", lw=3, alpha=0.4)
+        if np.ptp(ys) <= 1e-9 * scale:  # a slide line: draw it and the slider block on it
+            pad = 0.15 * scale
+            ax.plot([xs.min() - pad, xs.max() + pad], [ys[0], ys[0]], color="0.5", lw=1, ls="-.", zorder=1)
+            _block(ax, pts[slider], 0.0, 0.08 * scale, color, alpha)
     ax.set_aspect("equal")
 
 
@@ -45,12 +63,15 @@ def cycle_figure(m: Mechanism, theta2: float = math.radians(60), omega2: float =
     ax0 = fig.add_subplot(1, 2, 1)
     draw_mechanism(ax0, m, theta2)
     ax0.set_title(f"{type(m).__name__} at theta2 = {math.degrees(theta2):.1f} deg")
+    ax0.set_xlabel("x [length]")
+    ax0.set_ylabel("y [length]")
     th = np.linspace(0, 2 * math.pi, n)
     mo = m.motion(th, omega2, alpha2)
     d = m.dead_centres()
     a, b = m.stroke_angles()
-    unit = "rad" if isinstance(m, FourBar) else ""
-    rows = [("x", mo.x, unit), ("v", mo.v, "/s"), ("a", mo.a, "/s^2")]
+    unit = "rad" if isinstance(m, FourBar) else "length"
+    names = ("theta4", "omega4", "alpha4") if isinstance(m, FourBar) else ("slider x", "slider v", "slider a")
+    rows = [(names[0], mo.x, unit), (names[1], mo.v, f"{unit}/s"), (names[2], mo.a, f"{unit}/s^2")]
     deg = np.degrees(th)
     for k, (name, y, u) in enumerate(rows):
         ax = fig.add_subplot(3, 2, 2 * k + 2)
@@ -60,21 +81,24 @@ def cycle_figure(m: Mechanism, theta2: float = math.radians(60), omega2: float =
         ax.grid(alpha=0.3)
         if k == 0:
             ax.plot(np.degrees([d.theta_max, d.theta_min]), [d.x_max, d.x_min], "kv", ms=6, label="dead centres")
-            ax.legend(loc="upper right", fontsize=8)
-    ax.set_xlabel("theta2 [deg]")
+            ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncol=3, fontsize=8, frameon=False)
+    ax.set_xlabel(f"theta2 [deg] (omega2 = {omega2:g} rad/s)")
+    travel = "swing" if isinstance(m, FourBar) else "stroke"
     fig.suptitle(
-        f"TR = {m.time_ratio():.4f}, stroke = {m.stroke():.4g}, gamma_min = {math.degrees(m.gamma_min().value):.2f} deg"
+        f"TR = {m.time_ratio():.4f}, {travel} = {m.stroke():.4g} {unit}, "
+        f"gamma_min = {math.degrees(m.gamma_min().value):.2f} deg, omega2 = {omega2:g} rad/s"
     )
     fig.tight_layout()
     return fig
 
 
 def _shade(ax, t_max, t_min, a, b, omega2):
-    # with omega2 > 0 the crank runs t_max -> t_min (counter-clockwise) in a, else in b
-    slow_from_max = (a > b) == (omega2 > 0)
+    # the crank arc t_max -> t_min (counter-clockwise) has length a and the other b; at constant |omega2| the
+    # longer arc takes longer whichever way the crank turns, so it is the working stroke for either sign of omega2
+    # (the sign only reverses which way the slider moves on it)
     spans = [(t_max, t_max + a), (t_min, t_min + b)]
     for k, (lo, hi) in enumerate(spans):
-        working = (k == 0) == slow_from_max
+        working = (k == 0) == (a >= b)
         for shift in (-2 * math.pi, 0.0):
             label = ("working stroke" if working else "return stroke") if shift == 0.0 else None
             ax.axvspan(

@@ -163,3 +163,36 @@ def test_infeasible_synth_json_is_strict(capsys, tmp_path):
     assert cli.main(["synth", str(tmp_path / "far.json"), "--json"]) == 1
     out = capsys.readouterr().out
     assert "NaN" not in out and json.loads(out)["status"] == "infeasible"
+
+
+def test_working_stroke_shading_is_the_slow_arc_for_either_sense_of_rotation():
+    import matplotlib.pyplot as plt
+
+    from qropt.examples import paper_mechanism
+    from qropt.plots import _shade
+
+    m = paper_mechanism()
+    d, (a, b) = m.dead_centres(), m.stroke_angles()
+    for omega2 in (1.0, -1.0):
+        fig, ax = plt.subplots()
+        _shade(ax, d.theta_max, d.theta_min, a, b, omega2)
+        spans = [p for p in ax.patches if p.get_label() == "working stroke"]
+        assert spans[0].get_width() == pytest.approx(math.degrees(max(a, b)))
+        plt.close(fig)
+
+
+def test_a_slotted_lever_is_drawn_through_its_crank_pin_block():
+    import matplotlib.pyplot as plt
+
+    from qropt import Whitworth
+    from qropt.plots import draw_mechanism
+
+    m = Whitworth(r1=0.1, r2=0.2, r5=0.12, r6=0.3)
+    for theta in np.linspace(0, 2 * math.pi, 13):
+        fig, ax = plt.subplots()
+        draw_mechanism(ax, m, theta)
+        p = {k: v[0] for k, v in m.positions(theta).points.items()}
+        lever = [line.get_xydata() for line in ax.lines if tuple(line.get_xydata()[0]) == tuple(p["O4"])]
+        reach = max(np.hypot(*(seg[-1] - seg[0])) for seg in lever)
+        assert reach >= np.hypot(*np.subtract(p["A"], p["O4"])) - 1e-12  # the lever reaches the block at A
+        plt.close(fig)
