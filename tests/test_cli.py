@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -148,7 +149,8 @@ def test_toml_and_json_problem_files_solve_like_the_python_one(capsys, tmp_path)
 
     (tmp_path / "task.json").write_text(paper_problem().to_json())
     (tmp_path / "bad.toml").write_text("mechanism = \n")
-    for f in ("problems/paper_task.toml", str(tmp_path / "task.json")):
+    root = Path(__file__).resolve().parent.parent
+    for f in (str(root / "problems" / "paper_task.toml"), str(tmp_path / "task.json")):
         assert cli.main(["synth", f, "--json"]) == 0
         out = json.loads(capsys.readouterr().out)
         assert out["params"]["r3"] == pytest.approx(0.2504281217548, abs=1e-12)

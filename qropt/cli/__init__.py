@@ -17,6 +17,7 @@ import numpy as np
 from qropt.errors import QroptError
 from qropt.mechanisms import REGISTRY, Mechanism, mechanism_type
 
+QUIET = False  # --quiet: no progress bars
 PARAM_NAMES = ("r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider")
 
 
@@ -202,6 +203,7 @@ def cmd_analyze(args):
 
 def parser() -> argparse.ArgumentParser:
     p = _Parser(prog="qropt", description="Quick-return mechanism analysis and synthesis.")
+    p.add_argument("--quiet", action="store_true", help="no progress bars on standard error")
     sub = p.add_subparsers(dest="command", required=True)
     a = sub.add_parser("analyze", help="exact TR, stroke, dead centres, gamma_min and slider state")
     a.add_argument("type", nargs="?", help="mechanism type: " + ", ".join(sorted(REGISTRY)))
@@ -262,29 +264,19 @@ def cmd_bench(argv):
     return bench_main(argv)
 
 
-class _Progress:
-    """A one-line progress count on standard error."""
+def progress_bar(what: str, total=None, unit="point"):
+    """A tqdm bar on standard error, silent when it is not a terminal or with --quiet."""
+    from tqdm import tqdm
 
-    def __init__(self, what):
-        self.what, self.n = what, 0
-
-    def __call__(self, k=1):
-        self.n += k
-        if self.n % 50 == 0:
-            sys.stderr.write(f"\r{self.what}: {self.n} points")
-            sys.stderr.flush()
-
-    def done(self):
-        sys.stderr.write(f"\r{self.what}: {self.n} points\n")
+    return tqdm(total=total, desc=what, unit=unit, disable=QUIET or not sys.stderr.isatty(), leave=False)
 
 
 def cmd_family(args):
     from qropt.family import family
 
     problem = load_problem(args.problem)
-    bar = _Progress("tracing")
-    fam = family(problem, along=args.along, progress=bar)
-    bar.done()
+    with progress_bar("tracing") as bar:
+        fam = family(problem, along=args.along, progress=bar.update)
     best = fam.best(problem.objective or "max_gamma_min")
     if args.json:
         out = {
@@ -311,13 +303,16 @@ def cmd_family(args):
             head = ["branch", "arclength", *problem.free, "theta_max_deg", "theta_min_deg", "time_ratio", "stroke",
                     "gamma_min_deg", "peak_accel", "grashof"]  # fmt: skip
             w.writerow(head)
+            bar = progress_bar("exact quantities", total=sum(map(len, fam.branches)))
             for b, pts in enumerate(fam.branches):
                 for p in pts:
+                    bar.update()
                     q = p.quantities
                     w.writerow([b + 1, f"{p.arclength:.12g}", *(f"{p.params[k]:.15g}" for k in problem.free),
                                 *(f"{math.degrees(t):.12g}" for t in p.theta), q.get("time_ratio"),
                                 q.get("stroke", q.get("swing")), math.degrees(q["gamma_min"]) if q else None,
                                 q.get("peak_accel"), q.get("grashof")])  # fmt: skip
+            bar.close()
     if args.plot:
         from qropt import plots
 
@@ -448,6 +443,8 @@ def main(argv=None) -> int:
         if argv[:1] == ["bench"]:
             return cmd_bench(argv[1:])
         args = parser().parse_args(argv)
+        global QUIET
+        QUIET = args.quiet
         if getattr(args, "plot", None):
             picture_path(args.plot)
         return args.run(args) or 0
