@@ -20,6 +20,9 @@ from qropt.certify import Certificate
 STATUSES = ("optimal", "local_optimum", "acceptable", "feasible", "infeasible", "failed")
 SOLUTION_PRESENT = ("optimal", "local_optimum", "acceptable", "feasible")
 NO_SOLUTION = ("infeasible", "failed")
+UNITS = {"angles": "rad (gamma_min, swing, theta)", "lengths": "the problem's length unit (stroke, size, params)",
+         "footprint": "length^2", "peak_accel": "length/s^2 at the problem's omega2", "time_ratio": "1 (slow/fast)",
+         "times": "s"}  # fmt: skip
 
 
 def _clean(v):
@@ -72,10 +75,14 @@ class Result:
     def _quantity_parts(self, sep: str) -> list[str]:
         q = self.quantities
         parts = [f"time_ratio{sep}{q['time_ratio']:.10g}"]
-        parts += [f"{k}{sep}{q[k]:.10g}" for k in ("stroke", "swing") if k in q]
+        if "stroke" in q:
+            parts.append(f"stroke{sep}{q['stroke']:.10g}")
+        if "swing" in q:
+            parts.append(f"swing{sep}{math.degrees(q['swing']):.6f} deg")
         parts.append(f"gamma_min{sep}{math.degrees(q['gamma_min']):.6f} deg")
         if q.get("peak_accel") is not None:
-            parts.append(f"peak_accel{sep}{q['peak_accel']:.6g}")
+            w = self.stats.get("omega2", 1.0)
+            parts.append(f"peak_accel{sep}{q['peak_accel']:.6g} length/s^2 at omega2 = {w:g} rad/s")
         return parts
 
     def __repr__(self):
@@ -115,6 +122,7 @@ class Result:
     def to_dict(self) -> dict:
         """Strict-JSON dictionary (no NaN: None); the mechanism as its type kind and parameters."""
         return _clean({
+            "units": UNITS,
             "status": self.status,
             "success": self.success,
             "message": self.message,
@@ -137,6 +145,7 @@ class Result:
         from qropt.mechanisms import mechanism_type
 
         try:
+            d = {k: v for k, v in d.items() if k != "units"}
             mech = mechanism_type(d["type"])(**d["params"]) if d.get("type") else None
             cert = Certificate(**d["certificate"]) if d.get("certificate") else None
             return cls(

@@ -223,7 +223,7 @@ class Solver:
         if plan.kind == "enumeration" and not extra and not good:  # the closed form missed: search instead
             return self.solve(problem, starts_n=starts_n, use_analytic=False, seed=seed, targets=targets,
                               max_rounds=max_rounds)  # fmt: skip
-        stats = {"starts": len(cands), "plan": plan.kind, "formulations": self.formulations,
+        stats = {"starts": len(cands), "plan": plan.kind, "omega2": problem.omega2, "formulations": self.formulations,
                  "ipopt_runs": sum(len(c.statuses) for c in cands if c.origin != "enumeration"),
                  "iterations_total": sum(c.iterations for c in cands),
                  "t_ipopt": sum(c.t_ipopt for c in cands)}  # fmt: skip

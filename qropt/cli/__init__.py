@@ -129,7 +129,10 @@ def print_report(r: dict, out=None):
         )
     d = r["dead_centres"]
     w(f"  time ratio        {r['time_ratio']:.10f}\n")
-    w(f"  stroke            {r['stroke']:.10g}\n")
+    if r["type"] == "four-bar":
+        w(f"  swing             {math.degrees(r['stroke']):.6f} deg\n")
+    else:
+        w(f"  stroke            {r['stroke']:.10g} (length units)\n")
     w(
         f"  dead centres      theta_max = {d['theta_max_deg']:.6f} deg ({out_name} = {d['x_max']:.10g}); "
         f"theta_min = {d['theta_min_deg']:.6f} deg ({d['x_min']:.10g})\n"
