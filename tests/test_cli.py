@@ -198,3 +198,16 @@ def test_a_slotted_lever_is_drawn_through_its_crank_pin_block():
         reach = max(np.hypot(*(seg[-1] - seg[0])) for seg in lever)
         assert reach >= np.hypot(*np.subtract(p["A"], p["O4"])) - 1e-12  # the lever reaches the block at A
         plt.close(fig)
+
+
+def test_reachable_sizes_the_adjustable_link_for_a_given_range(capsys):
+    assert cli.main(["reachable", "--adjust", "1.5", "2.5", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    lo, hi = out["adjustable"]["interval"]
+    assert lo == pytest.approx(0.2504281217548, abs=1e-9) and out["adjustable"]["worst_gamma_min_deg"] > 8
+    from qropt import DragLinkSlider
+
+    for r3, tr in ((lo, 1.5), (hi, 2.5)):
+        m = DragLinkSlider(r1=0.1, r2=0.225, r3=r3, r4=0.275, r5=0.15, r6=0.3)
+        assert m.time_ratio() == pytest.approx(tr, abs=1e-8)
+    assert cli.main(["reachable", "--adjust", "1.2", "2"]) == 2

@@ -242,6 +242,13 @@ def parser() -> argparse.ArgumentParser:
     r.add_argument("--free", default="r3", help="the adjustable parameter (default r3)")
     r.add_argument("--bounds", nargs=2, type=real, metavar=("LOW", "HIGH"), help="its interval")
     r.add_argument("--tr", type=real, action="append", default=[], help="count the designs for this TR")
+    r.add_argument(
+        "--adjust",
+        nargs=2,
+        type=real,
+        metavar=("TR_LOW", "TR_HIGH"),
+        help="size the adjustable link for this TR range (default: the whole reachable range)",
+    )
     r.add_argument("--json", action="store_true", help="print JSON")
     r.add_argument("--plot", help="PNG file: TR against the parameter (the paper's Fig. 5)")
     r.set_defaults(run=cmd_reachable)
@@ -336,13 +343,18 @@ def cmd_reachable(args):
         m = mechanism_type(args.type)(**given)
     r = reachable(m, args.free, tuple(args.bounds) if args.bounds else None)
     tmin, xmin, tmax, xmax = r.time_ratio_range
-    adj = r.adjustable(tmin, tmax)
+    low, high = args.adjust if args.adjust else (tmin, tmax)
+    if not tmin <= low <= high <= tmax:
+        raise CliError(f"--adjust {low:g} {high:g} must lie within the reachable TR {tmin:.6g}..{tmax:.6g}")
+    adj = r.adjustable(low, high)
     counts = {t: r.solutions(t) for t in args.tr}
     if args.json:
         out = {"free": args.free, "intervals": r.intervals, "time_ratio_range": r.time_ratio_range,
                "stroke_range": r.stroke_range, "solutions": {str(k): v for k, v in counts.items()},
-               "adjustable": {"interval": adj.interval, "explanation": adj.explanation}}  # fmt: skip
-        json.dump(out, sys.stdout, indent=2, default=float)
+               "adjustable": {"time_ratios": [low, high], "interval": adj.interval,
+                              "worst_gamma_min_deg": math.degrees(adj.gamma_min),
+                              "explanation": adj.explanation}}  # fmt: skip
+        json.dump(out, sys.stdout, indent=2, default=float, allow_nan=False)
         sys.stdout.write("\n")
     else:
         print(f"{type(m).__name__}: {args.free} varies, the rest as given")
