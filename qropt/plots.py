@@ -155,16 +155,20 @@ def family_figure(f, x=None, y=None, best=None, max_points=400):
     g = [math.degrees(p.quantities.get("gamma_min", float("nan"))) for p in shown]
     sc = ax.scatter([p.params[x] for p in shown], [p.params[y] for p in shown], c=g, cmap="viridis", s=12)
     fig.colorbar(sc, ax=ax, label="gamma_min [deg]")
-    for fold in f.folds:
-        ax.plot(fold[x], fold[y], "rx", ms=10, mew=2)
+    for k, fold in enumerate(f.folds):
+        label = f"fold ({x} turns back): {x} = {fold[x]:.6g}" if k == 0 else None
+        ax.plot(fold[x], fold[y], "rx", ms=10, mew=2, label=label)
     for k, e in enumerate(f.ends):
         ax.plot(e.params[x], e.params[y], "ks", ms=6)
-        ax.annotate(f"end {k + 1}", (e.params[x], e.params[y]), textcoords="offset points", xytext=(5, -10), fontsize=8)
+        why = e.reason.split(":")[0].replace("singularity at a ", "").split(" (")[0]
+        ax.annotate(f"end {k + 1}: {why}", (e.params[x], e.params[y]), textcoords="offset points", xytext=(6, -12),
+                    fontsize=8)  # fmt: skip
     if best is not None and best.success:
-        ax.plot(best.params[x], best.params[y], "*", color="tab:red", ms=16, label="best gamma_min")
-        ax.legend()
-    ax.set_xlabel(x)
-    ax.set_ylabel(y)
+        g = math.degrees(best.objective) if best.objective is not None else float("nan")
+        ax.plot(best.params[x], best.params[y], "*", color="tab:red", ms=16, label=f"best gamma_min {g:.2f} deg")
+    ax.legend(loc="best", fontsize=8)  # matplotlib's least-overlap place
+    ax.set_xlabel(f"{x} [length]")
+    ax.set_ylabel(f"{y} [length]")
     n = sum(len(b) for b in f.branches)
     ax.set_title(f"{f.problem.mechanism.__name__} family ({n} points, {len(f.folds)} fold(s))")
     ax.grid(alpha=0.3)
