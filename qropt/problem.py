@@ -267,10 +267,15 @@ class Problem:
 
     @classmethod
     def from_json(cls, text: str) -> Problem:
+        return cls._from_text(text, json.loads, json.JSONDecodeError, "JSON")
+
+    @classmethod
+    def _from_text(cls, text, loads, error, kind) -> Problem:
         try:
-            return cls.from_dict(json.loads(text))
-        except json.JSONDecodeError as e:
-            raise ProblemError(f"not a JSON problem: {e}") from None
+            d = loads(text)
+        except error as e:
+            raise ProblemError(f"not a {kind} problem: {e}") from None
+        return cls.from_dict(d)
 
     def to_toml(self) -> str:
         """TOML (an objective of None is written "none")."""
@@ -284,10 +289,7 @@ class Problem:
     def from_toml(cls, text: str) -> Problem:
         import tomllib
 
-        try:
-            return cls.from_dict(tomllib.loads(text))
-        except tomllib.TOMLDecodeError as e:
-            raise ProblemError(f"not a TOML problem: {e}") from None
+        return cls._from_text(text, tomllib.loads, tomllib.TOMLDecodeError, "TOML")
 
     def __eq__(self, other):
         return isinstance(other, Problem) and self.to_dict() == other.to_dict()

@@ -3,18 +3,15 @@ Monte Carlo against the exact per-mechanism analysis, bad input, and the command
 
 from __future__ import annotations
 
-import argparse
-import importlib.util
 import json
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import qropt
-from qropt.errors import InvalidParameter, QroptError
+from qropt import cli as qropt_cli
+from qropt.errors import InvalidParameter
 from qropt.examples import paper_mechanism
 from qropt.tolerance import allocate, sensitivities
 
@@ -210,27 +207,8 @@ def test_sensitivities_bad_input():
 
 # ---- command line ---------------------------------------------------------------------------------------
 def cli(argv, capsys):
-    """(exit code, stdout, stderr) of ``qropt tolerance ...``: through ``qropt.cli.main`` once the CLI is a
-    package, else through this command module with main's error handling (one line; exit 1 or 2)."""
-    import qropt.cli as package
-
-    if hasattr(package, "__path__"):
-        code = package.main(argv)
-    else:
-        path = Path(qropt.__file__).parent / "cli" / f"{argv[0]}.py"
-        spec = importlib.util.spec_from_file_location(f"qropt_cli_{argv[0]}", path)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        parser = argparse.ArgumentParser(prog=f"qropt {module.COMMAND}", exit_on_error=False)
-        module.add_arguments(parser)
-        try:
-            code = module.run(parser.parse_args(argv[1:]))
-        except argparse.ArgumentError as e:
-            print(f"qropt: error: {e}", file=sys.stderr)
-            code = 2
-        except QroptError as e:
-            print(f"qropt: {type(e).__name__}: {e}", file=sys.stderr)
-            code = 1
+    """(exit code, stdout, stderr) of ``qropt ...`` through ``qropt.cli.main`` (one line on error)."""
+    code = qropt_cli.main(argv)
     out = capsys.readouterr()
     return code, out.out, out.err
 
