@@ -10,18 +10,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from qropt.export import link_segments  # noqa: E402
 from qropt.mechanisms import FourBar, Mechanism  # noqa: E402
-
-
-def _segments(pts):
-    segs = [("O2", "A")]
-    if "B" in pts:
-        segs += [("A", "B"), ("O4", "B"), ("O4", "C")]
-    elif "O4" in pts:  # the slotted lever: from O4 through the crank-pin block at A to C, as far as the farther
-        far = "A" if np.hypot(*np.subtract(pts["A"], pts["O4"])) > np.hypot(*np.subtract(pts["C"], pts["O4"])) else "C"
-        segs += [("O4", far)]
-    segs += [("C", "D")] if "D" in pts else [("A", "C")] if "O4" not in pts else []
-    return [(a, b) for a, b in segs if a in pts and b in pts]
 
 
 def _block(ax, centre, angle, size, color, alpha):
@@ -35,7 +25,7 @@ def _block(ax, centre, angle, size, color, alpha):
 def draw_mechanism(ax, m: Mechanism, theta2: float, color="k", alpha=1.0):
     """Draw the links and joints of m at crank angle theta2 (rad), with the slider path, on an axis."""
     pts = {k: v[0] for k, v in m.positions(np.array([theta2])).points.items()}
-    for a, b in _segments(pts):
+    for a, b in link_segments(pts):
         ax.plot(*zip(pts[a], pts[b], strict=True), color=color, lw=2, alpha=alpha)
     for k, (x, y) in pts.items():
         ground = k in ("O2", "O4")

@@ -66,6 +66,12 @@ def picture_path(path: str) -> str:
 
 def build_mechanism(args) -> Mechanism:
     given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
+    if getattr(args, "design", None):
+        if given or args.type is not None:
+            raise CliError("--from reads the whole design: give no TYPE or parameters with it")
+        from qropt.export import load_design
+
+        return load_design(args.design)
     if args.type is None:
         if given:
             raise CliError("give the mechanism TYPE before its parameters (types: " + ", ".join(sorted(REGISTRY)) + ")")
@@ -202,6 +208,30 @@ def cmd_analyze(args):
         plots.save(plots.cycle_figure(m, args.theta2, args.omega2, args.alpha2), args.plot)
         if not args.json:
             print(f"  picture written to {args.plot}")
+    for path in export(args, m, args.theta2):
+        if not args.json:
+            print(f"  written: {path}")
+
+
+def _export_arguments(p):
+    p.add_argument("--dxf", help="DXF file: the design at --theta2 (0 for synth), one layer per kind of entity")
+    p.add_argument("--svg", help="SVG file: the same drawing")
+    p.add_argument("--save", help="JSON design file that qropt analyze --from reads back")
+
+
+def export(args, m, theta2: float = 0.0) -> list[str]:
+    """Write the drawings and the design file the command line asks for; the paths written."""
+    from qropt import export as ex
+
+    done = []
+    for flag, write in (("dxf", ex.to_dxf), ("svg", ex.to_svg)):
+        if getattr(args, flag, None):
+            write(m, getattr(args, flag), theta2)
+            done.append(getattr(args, flag))
+    if getattr(args, "save", None):
+        ex.save_design(m, args.save)
+        done.append(args.save)
+    return done
 
 
 def parser() -> argparse.ArgumentParser:
@@ -219,6 +249,8 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("--table", type=angle, help="full-cycle table step (deg, or rad with suffix)")
     a.add_argument("--csv", help="file for the full-cycle table ('-' for standard output)")
     a.add_argument("--plot", help="PNG file: mechanism at theta2 beside x, v, a over the cycle")
+    a.add_argument("--from", dest="design", help="a design file (qropt synth --save, or --json output) to analyse")
+    _export_arguments(a)
     a.set_defaults(run=cmd_analyze)
     s = sub.add_parser("synth", help="solve a synthesis problem file (build() -> Problem)")
     s.add_argument("problem", nargs="?", help="a problem file (default: the paper's design task, built in)")
@@ -227,6 +259,7 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--starts", type=int, default=8, help="space-filling multi-start points (default 8)")
     s.add_argument("--json", action="store_true", help="print the Result as JSON")
     s.add_argument("--plot", help="PNG file: the best design over its cycle")
+    _export_arguments(s)
     s.set_defaults(run=cmd_synth)
     f = sub.add_parser("family", help="trace the one-parameter family of a problem file")
     f.add_argument("problem", help="a problem file with one more free parameter than targets")
@@ -449,6 +482,8 @@ def cmd_synth(args):
         from qropt import plots
 
         plots.save(plots.cycle_figure(r.mechanism, omega2=problem.omega2), args.plot)
+    if r.mechanism is not None:
+        export(args, r.mechanism)
     return 0 if r.success else 1
 
 
