@@ -87,3 +87,18 @@ def test_bad_design_files_are_typed_errors(text, words, tmp_path):
 def test_wrong_suffix_is_an_error(tmp_path):
     with pytest.raises(InvalidParameter, match=".dxf"):
         export.to_dxf(paper_mechanism(), tmp_path / "m.txt")
+
+
+def test_animation_is_a_gif_of_one_turn(tmp_path):
+    from PIL import Image
+
+    from qropt.animation import animate
+
+    f = tmp_path / "m.gif"
+    animate(qropt.SliderCrank(r2=0.1, r3=0.35, e=0.06), f, omega2=-2.0)
+    im = Image.open(f)
+    assert im.format == "GIF" and im.n_frames == 72
+    with pytest.raises(InvalidParameter, match="frames"):
+        animate(paper_mechanism(), tmp_path / "x.gif", frames=10)
+    with pytest.raises(InvalidParameter, match=".gif"):
+        animate(paper_mechanism(), tmp_path / "x.png")

@@ -214,6 +214,7 @@ def cmd_analyze(args):
 
 
 def _export_arguments(p):
+    p.add_argument("--animate", help="GIF file: the design over one turn (72 frames)")
     p.add_argument("--dxf", help="DXF file: the design at --theta2 (0 for synth), one layer per kind of entity")
     p.add_argument("--svg", help="SVG file: the same drawing")
     p.add_argument("--save", help="JSON design file that qropt analyze --from reads back")
@@ -224,6 +225,11 @@ def export(args, m, theta2: float = 0.0) -> list[str]:
     from qropt import export as ex
 
     done = []
+    if getattr(args, "animate", None):
+        from qropt.animation import animate
+
+        animate(m, args.animate, omega2=getattr(args, "omega2", None) or 1.0)
+        done.append(args.animate)
     for flag, write in (("dxf", ex.to_dxf), ("svg", ex.to_svg)):
         if getattr(args, flag, None):
             write(m, getattr(args, flag), theta2)
