@@ -1,0 +1,23 @@
+"""``qropt report``: one self-contained HTML report of the paper's project, or of a problem file's design."""
+
+from __future__ import annotations
+
+import argparse
+
+COMMAND = "report"
+HELP = "one self-contained HTML report: the paper's whole project, or a problem file's design"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("problem", nargs="?", help="a problem file (.py, .toml, .json); default: the paper's project")
+    parser.add_argument("-o", "--output", default="report.html", help="the HTML file (default report.html)")
+
+
+def run(args) -> int:
+    from qropt.cli import load_problem
+    from qropt.report import render
+
+    problem = load_problem(args.problem) if args.problem else None
+    render(problem, args.output)
+    print(f"report written to {args.output}")
+    return 0
