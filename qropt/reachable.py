@@ -176,11 +176,13 @@ def _edge(base, free, good, bad):
     return good
 
 
-def reachable(mechanism: Mechanism, free: str = "r3", bounds: tuple | None = None, n: int = 301) -> Reachable:
+def reachable(mechanism: Mechanism, free: str = "r3", bounds: tuple | None = None, n: int = 301,
+              progress=None) -> Reachable:  # fmt: skip
     """TR and stroke reachable by varying ``free`` (the mechanism supplies the other parameters).
 
-    bounds: the parameter's interval; without it a four-bar link's interval follows from the type's
-    Grashof class. TR extremes are refined (bounded Brent) and interval ends located by bisection.
+    bounds: the parameter's interval; without it the interval the type's rules leave it (e.g. its Grashof
+    class); progress: callable() once per scanned point. TR extremes are refined (bounded Brent) and interval
+    ends located by bisection.
     """
     if not isinstance(mechanism, Mechanism):
         raise InvalidParameter(
@@ -201,7 +203,8 @@ def reachable(mechanism: Mechanism, free: str = "r3", bounds: tuple | None = Non
     if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
         raise InvalidParameter(f"empty interval for {free}: ({lo:g}, {hi:g})")
     grid = np.linspace(lo, hi, n)
-    vals = np.array([_evaluate(mechanism, free, x) for x in grid])
+    tick = progress if callable(progress) else (lambda k=1: None)
+    vals = np.array([(_evaluate(mechanism, free, x), tick())[0] for x in grid])
     ok = np.isfinite(vals[:, 0])
     intervals = []
     i = 0

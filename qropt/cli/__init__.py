@@ -81,7 +81,7 @@ def build_mechanism(args) -> Mechanism:
     return mechanism_type(args.type)(**given)
 
 
-def report(m: Mechanism, theta2: float, omega2: float, alpha2: float) -> dict:
+def analysis_report(m: Mechanism, theta2: float, omega2: float, alpha2: float) -> dict:
     """Every analysed quantity as plain JSON-ready values (angles in degrees, suffix _deg)."""
     d, g = m.dead_centres(), m.gamma_min()
     a, b = m.stroke_angles()
@@ -152,7 +152,10 @@ def print_report(r: dict, out=None):
     w(f"  gamma_min         {g['value_deg']:.6f} deg at theta2 = {g['theta2_deg']:.6f} deg, joint {g['joint']}\n")
     s = r["state"]
     w(f"  at theta2 = {s['theta2_deg']:g} deg, omega2 = {s['omega2']:g} rad/s, alpha2 = {s['alpha2']:g} rad/s^2:\n")
-    w(f"    {out_name}: x = {s['x']:.6g}, v = {s['v']:.6g}, a = {s['a']:.6g}\n")
+    if r["type"] == "four-bar":
+        w(f"    follower: theta4 = {s['x']:.6g} rad, omega4 = {s['v']:.6g} rad/s, alpha4 = {s['a']:.6g} rad/s^2\n")
+    else:
+        w(f"    slider: x = {s['x']:.6g} length, v = {s['v']:.6g} length/s, a = {s['a']:.6g} length/s^2\n")
     for k, v in s["links"].items():
         w(
             f"    {k:7s} = {v['angle_deg']:11.5f} deg   omega = {v['omega']:11.5g} rad/s   "
@@ -192,7 +195,7 @@ def cmd_analyze(args):
     if args.json and args.table is not None and args.csv in (None, "-"):
         raise CliError("--json prints JSON on standard output: give the table a file with --csv FILE")
     m = build_mechanism(args)
-    r = report(m, args.theta2, args.omega2, args.alpha2)
+    r = analysis_report(m, args.theta2, args.omega2, args.alpha2)
     if args.json:
         json.dump(r, sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")
@@ -380,7 +383,8 @@ def cmd_reachable(args):
         raise CliError("give the mechanism TYPE before its parameters")
     else:
         m = mechanism_type(args.type)(**given)
-    r = reachable(m, args.free, tuple(args.bounds) if args.bounds else None)
+    with progress_bar(f"scanning {args.free}", total=301) as bar:
+        r = reachable(m, args.free, tuple(args.bounds) if args.bounds else None, progress=bar.update)
     tmin, xmin, tmax, xmax = r.time_ratio_range
     low, high = args.adjust if args.adjust else (tmin, tmax)
     if not tmin <= low <= high <= tmax:
