@@ -30,7 +30,7 @@ def animate(m: Mechanism, path, *, omega2: float = 1.0, frames: int = 72, fps: i
     box = m.bounding_box()
     span = max(box.x_max - box.x_min, box.y_max - box.y_min)
     pad = 0.08 * span
-    fig, ax = plt.subplots(figsize=(7, 5))
+    fig, ax = plt.subplots(figsize=(6, 4.3))
     ax.set_xlim(box.x_min - pad, box.x_max + pad)
     ax.set_ylim(box.y_min - pad, box.y_max + pad)
     ax.set_aspect("equal")
@@ -67,7 +67,7 @@ def animate(m: Mechanism, path, *, omega2: float = 1.0, frames: int = 72, fps: i
         return [*lines, joints, label, slider]
 
     anim = FuncAnimation(fig, draw, frames=frames, blit=False)
-    anim.save(str(path), writer=PillowWriter(fps=fps), dpi=80)
+    anim.save(str(path), writer=PillowWriter(fps=fps), dpi=72)
     plt.close(fig)
 
 
