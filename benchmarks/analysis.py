@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import math
 import statistics
+import sys
 import time
 
 import numpy as np
+from tqdm import tqdm
 
 from qropt.mechanisms import TYPES
 from qropt.ops import JET, NUMPY, Jet
@@ -44,7 +46,7 @@ def run(samples: int = SAMPLES):
     th = 2 * np.pi * np.arange(samples) / samples
     th_list = th.tolist()
     rows = []
-    for cls in TYPES:
+    for cls in tqdm(TYPES, desc="types", disable=not sys.stderr.isatty(), leave=False):
         _, m = random_mechanisms(cls.KIND, 1, seed=11)[0]
         p = m.params
         t_pos = median_ms(lambda m=m, p=p: m.loop(NUMPY, th, p))

@@ -11,9 +11,11 @@ from __future__ import annotations
 
 import math
 import statistics
+import sys
 import time
 
 import numpy as np
+from tqdm import tqdm
 
 import qropt
 from benchmarks.methods import local_solve, local_starts
@@ -63,18 +65,26 @@ def analysis(params):
 def main(repeat: int = 21):
     problem = paper_problem()
     qropt.solve(problem)  # build the NLPs and compile the kinematics once
+    bar = tqdm(total=7, desc="synthesis benchmark", disable=not sys.stderr.isatty(), leave=False)
     t_floor, m_floor = timed(closed_form, repeat)
+    bar.update()
     t_default, res = timed(lambda: qropt.solve(problem), repeat)
+    bar.update()
     t_analytic, res0 = timed(lambda: qropt.solve(problem, starts_n=0), repeat)
+    bar.update()
     t_slsqp, best = timed(lambda: slsqp(problem), max(3, repeat // 4))
+    bar.update()
     r3_slsqp = best["r3"] if best else float("nan")
     g_slsqp = DragLinkSlider(r1=R1, r2=R2, r3=r3_slsqp, r4=R4, r5=best["r5"], r6=R6).gamma_min().value
     params = dict(paper_mechanism().params)
     t_ana, _ = timed(lambda: analysis(params), 200)
+    bar.update()
     t_peak, _ = timed(lambda: DragLinkSlider(**params).peak_acceleration(10.0), 200)
+    bar.update()
     m = DragLinkSlider(**params)
     theta = np.linspace(0.0, 2 * math.pi, 3600, endpoint=False)
     t_motion, _ = timed(lambda: m.motion(theta, 10.0), 200)
+    bar.close()
     rows = [
         ("closed form (eqs. 7-13 + exact gamma_min)", t_floor, m_floor.params["r3"], m_floor.gamma_min().value),
         ("qropt solve(), defaults", t_default, res.params["r3"], res.objective),
