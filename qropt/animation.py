@@ -12,9 +12,10 @@ from qropt.export import link_segments
 from qropt.mechanisms import FourBar, Mechanism
 
 
-def animate(m: Mechanism, path, *, omega2: float = 1.0, frames: int = 72, fps: int = 24):
+def animate(m: Mechanism, path, *, omega2: float = 1.0, frames: int = 72, fps: int = 24, progress: bool = False):
     """Write a GIF of m over one turn (``frames`` >= 72 crank angles, in the sense of omega2's sign): links and
-    joints, the slider's path with the working (slow) stroke green and the return red, and the crank angle."""
+    joints, the slider's path with the working (slow) stroke green and the return red, and the crank angle.
+    progress: a tqdm bar on standard error (when it is a terminal)."""
     import matplotlib.pyplot as plt
     from matplotlib.animation import FuncAnimation, PillowWriter
 
@@ -67,7 +68,12 @@ def animate(m: Mechanism, path, *, omega2: float = 1.0, frames: int = 72, fps: i
         return [*lines, joints, label, slider]
 
     anim = FuncAnimation(fig, draw, frames=frames, blit=False)
-    anim.save(str(path), writer=PillowWriter(fps=fps), dpi=72)
+    import sys
+
+    from tqdm import tqdm
+
+    with tqdm(total=frames, desc="frames", disable=not progress or not sys.stderr.isatty(), leave=False) as bar:
+        anim.save(str(path), writer=PillowWriter(fps=fps), dpi=72, progress_callback=lambda i, n: bar.update())
     plt.close(fig)
 
 

@@ -79,7 +79,7 @@ def _table5(m) -> list[float]:
             s.alpha["theta6"][0], s.x[0] - m.params["r1"], s.v[0], s.a[0]]  # fmt: skip
 
 
-def _paper() -> str:
+def _paper(tick) -> str:
     from qropt import family, plots, reachable, solve
     from qropt.examples import paper_mechanism, paper_problem
     from qropt.problem import Problem
@@ -100,11 +100,13 @@ def _paper() -> str:
         m = p.build({"r3": s.r3, "r5": 0.15}, {"sigma": -1.0, "sigma_slider": 1.0})
         rows.append((s.r3, math.degrees(s.theta2a), math.degrees(g_tdc), math.degrees(g_bdc),
                      math.degrees(m.gamma_min().value)))  # fmt: skip
+    tick()
     parts.append(
         "<p>Eqs. (7)-(13) give every coupler for the time ratio; eqs. (14)-(17) evaluate the transmission angle at "
         "the dead centres only, while gamma_min is the smallest over the whole turn:</p>"
         + _table(["r3 [m]", "theta2a [deg]", "eq. 14-17 at TDC [deg]", "at BDC [deg]", "true gamma_min [deg]"], rows)
     )
+    tick()
     reach = reachable(paper_mechanism(), "r3")
     adj = reach.adjustable(1.5, 2.5)
     t = reach.time_ratio_range
@@ -118,6 +120,7 @@ def _paper() -> str:
     )
     fam_problem = Problem("DragLinkSlider", fixed={"r2": 0.225, "r4": 0.275, "r5": 0.15, "r6": 0.3},
                           free={"r1": (0.02, 0.2), "r3": (0.05, 0.6)}, targets={"time_ratio": 1.5})  # fmt: skip
+    tick()
     fam = family(fam_problem)
     best = fam.best("max_gamma_min")
     fold = fam.folds[0]["r1"] if fam.folds else float("nan")
@@ -130,6 +133,7 @@ def _paper() -> str:
         f"{math.degrees(best.objective):.4f} deg at r1 = {best.params['r1']:.6g}, r3 = {best.params['r3']:.6g} m.</p>"
         + _png(plots.family_figure(fam, best=best))
     )
+    tick()
     m = r.mechanism
     rounded = type(m)(**{**m.params, "r3": round(m.params["r3"], 4)})  # the r3 the paper's GNLINK run was given
     exact, table4 = _table5(m), _table5(rounded)
@@ -140,6 +144,7 @@ def _paper() -> str:
         "the exact r3, and with the r3 = 0.2504 m of the paper's Table 4, which reproduces every printed digit.</p>"
         + _table(["quantity", "paper (printed)", "exact r3", "r3 = 0.2504", "difference (0.2504)"], rows)
     )
+    tick()
     th = np.radians(np.arange(0, 360, 30))
     mo = m.motion(th, 10.0)
     rows = [(f"{math.degrees(a):.0f}", x, v, acc) for a, x, v, acc in zip(th, mo.x, mo.v, mo.a, strict=True)]
@@ -171,13 +176,16 @@ def _problem(problem) -> str:
     )
 
 
-def render(problem=None, path=None) -> str:
-    """The report's HTML (also written to ``path`` if given): the paper's project, or the given problem's design."""
+def render(problem=None, path=None, progress=None) -> str:
+    """The report's HTML (also written to ``path`` if given): the paper's project, or the given problem's design.
+
+    progress: callable() after each section."""
     from qropt.problem import Problem
 
     if problem is not None and not isinstance(problem, Problem):
         raise InvalidParameter(f"render takes a qropt.Problem or None, got {type(problem).__name__}")
-    body = _paper() if problem is None else _problem(problem)
+    tick = progress if callable(progress) else (lambda: None)
+    body = _paper(tick) if problem is None else _problem(problem)
     title = "qropt report" if problem is None else f"qropt report: {problem.name or problem.mechanism.__name__}"
     head = f"<meta charset='utf-8'><title>{html.escape(title)}</title><style>{CSS}</style>"
     text = f"<!DOCTYPE html><html><head>{head}</head><body>{body}</body></html>\n"

@@ -231,7 +231,7 @@ def export(args, m, theta2: float = 0.0) -> list[str]:
     if getattr(args, "animate", None):
         from qropt.animation import animate
 
-        animate(m, args.animate, omega2=getattr(args, "omega2", None) or 1.0)
+        animate(m, args.animate, omega2=getattr(args, "omega2", None) or 1.0, progress=not QUIET)
         done.append(args.animate)
     for flag, write in (("dxf", ex.to_dxf), ("svg", ex.to_svg)):
         if getattr(args, flag, None):

@@ -14,10 +14,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args) -> int:
-    from qropt.cli import load_problem
+    from qropt.cli import load_problem, progress_bar
     from qropt.report import render
 
     problem = load_problem(args.problem) if args.problem else None
-    render(problem, args.output)
+    with progress_bar("report sections", unit="section") as bar:
+        render(problem, args.output, progress=bar.update)
     print(f"report written to {args.output}")
     return 0
