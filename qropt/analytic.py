@@ -271,7 +271,7 @@ def warm_starts(problem) -> WarmStarts:
 
     Each start is verified later by the solver; a start that does not build is dropped there.
     """
-    from qropt.mechanisms import CrankShaper, DragLinkSlider, FourBar, SliderCrank, Whitworth
+    from qropt.mechanisms import CrankShaper, DragLinkSlider, FourBar, FourBarSlider, SliderCrank, Whitworth
 
     cls, fixed, free, tg = problem.mechanism, problem.fixed, problem.free, problem.targets
     val = {**fixed, **{k: 0.5 * (lo + hi) for k, (lo, hi) in free.items()}}
@@ -280,14 +280,15 @@ def warm_starts(problem) -> WarmStarts:
     out = []
 
     def emit(**set_):
-        if all(k in free for k in set_):
-            v = {**val, **set_}
+        if all(k in free for k in set_) or issubclass(cls, FourBarSlider):
+            v = {**val, **{k: x for k, x in set_.items() if k in free}}
             out.append({k: v[k] for k in free})
 
     def result(kind, how):
         return WarmStarts(out, kind if out else "none", how if out else "no closed form applies")
 
-    if cls is DragLinkSlider and tr is not None and "r3" in free and fixed.get("h", 0.0) == 0.0:
+    lifted = {"r2", "r4", "r5"} <= set(free)  # every link of the four-bar and the arm free: the generic starts
+    if cls is DragLinkSlider and tr is not None and "r3" in free and fixed.get("h", 0.0) == 0.0 and not lifted:
         r5 = {"r5": stroke / 2} if stroke is not None and "r5" in free else {}
         for s in drag_link_r3(tr, val["r1"], val["r2"], val["r4"]):
             emit(r3=s.r3, **r5)
@@ -341,4 +342,28 @@ def warm_starts(problem) -> WarmStarts:
                 emit(**{k: getattr(d, k) for k in ("r2", "r3", "r4") if k in free})
         how = "the classical crank-rocker construction (O2 on the circle that sees the rocker chord under phi)"
         return result("family" if family else "partial", how)
+    if (
+        issubclass(cls, FourBarSlider)
+        and tr is not None
+        and stroke is not None
+        and {"r2", "r3", "r4", "r5"} <= set(free)
+    ):
+        # the four-bar from its closed form, the slide line through the pivots (h = 0), the output arm r5 sized
+        # for the stroke and a rod twice as long: starts near the targets for every other free parameter
+        r1 = stroke if "r1" in free else val["r1"]
+        arm = {"h": 0.0} if "h" in free else {}
+        if cls is DragLinkSlider:
+            for k2, k4 in ((2.0, 2.5), (3.0, 3.5), (2.5, 4.0)):
+                for d in drag_link_r3(tr, r1, k2 * r1, k4 * r1):
+                    emit(**{"r1": r1, "r2": k2 * r1, "r3": d.r3, "r4": k4 * r1, "r5": stroke / 2, "r6": stroke, **arm})
+            how = "eqs. (7)-(13) give r3 for a few drag-links; r5 = stroke/2, h = 0"
+        else:
+            for swing in np.radians([40.0, 60.0, 80.0]):
+                for pos in (0.15, 0.3):
+                    d = crank_rocker_design(tr, float(swing), r1, pos)
+                    if d is not None:
+                        r5 = stroke / (2 * math.sin(swing / 2))
+                        emit(**{"r1": r1, "r2": d.r2, "r3": d.r3, "r4": d.r4, "r5": r5, "r6": 2 * r5, **arm})
+            how = "the classical crank-rocker construction at swings 40-80 deg; r5 from the stroke, h = 0"
+        return result("partial", how)
     return result("none", "")

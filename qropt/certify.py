@@ -11,6 +11,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from qropt import criteria
+from qropt.criteria import better, objective_of, objective_value
 from qropt.errors import AssemblyError, QroptError
 from qropt.mechanisms import FourBar
 
@@ -71,42 +73,21 @@ def build(problem, values, branch):
 
 
 def quantities(problem, m) -> dict:
-    """Exact quantities of a mechanism for a Result (angles in rad, lengths in the problem's units;
-    peak_accel at the problem's omega2 over its ``accel_over`` span)."""
+    """Exact quantities of a mechanism for a Result (angles in rad, lengths in the problem's units; peak_accel
+    at the problem's omega2 over its ``accel_over`` span, peak_velocity at omega2 over the working stroke with
+    the peak crank torque per newton of cutting force; footprint in length^2; size by the problem's measure)."""
     q = {"time_ratio": m.time_ratio(), "gamma_min": m.gamma_min().value}
-    q["swing" if isinstance(m, FourBar) else "stroke"] = m.stroke()
-    q["peak_accel"] = None if isinstance(m, FourBar) else m.peak_acceleration(problem.omega2, problem.accel_over).value
+    slider = not isinstance(m, FourBar)
+    q["swing" if not slider else "stroke"] = m.stroke()
+    q["peak_accel"] = m.peak_acceleration(problem.omega2, problem.accel_over).value if slider else None
+    pv = m.peak_velocity(problem.omega2) if slider else None
+    q["peak_velocity"] = pv.value if slider else None
+    q["torque_per_newton"] = pv.torque_per_newton if slider else None
     q["grashof"] = m.grashof().kind if hasattr(m, "grashof") else None
     q["size"] = m.size(problem.size)
+    q["footprint"] = m.footprint()
     q["working_direction"] = m.working_direction(problem.omega2)
     return q
-
-
-def objective_of(problem, m) -> float | None:
-    """The problem's objective of a mechanism, exactly: gamma_min (rad), size, or peak |a|; None without one."""
-    if problem.objective == "max_gamma_min":
-        return m.gamma_min().value
-    if problem.objective == "min_size":
-        return m.size(problem.size)
-    if problem.objective == "min_peak_accel":
-        return m.peak_acceleration(problem.omega2, problem.accel_over).value
-    return None
-
-
-def objective_value(problem, q) -> float | None:
-    """The problem's objective read from a quantities dict."""
-    return {"max_gamma_min": q["gamma_min"], "min_size": q["size"], "min_peak_accel": q["peak_accel"]}.get(
-        problem.objective
-    )
-
-
-def better(problem, a, b) -> bool:
-    """Whether objective value a beats b for this problem (None loses)."""
-    if b is None:
-        return a is not None
-    if a is None:
-        return False
-    return a > b if problem.objective == "max_gamma_min" else a < b
 
 
 def angle_gap(a, b):
@@ -155,12 +136,14 @@ def _certify(problem, range_target, m, th, z, f, gap_tol, feas_tol):
             vs = np.concatenate([ex.maxima[1], ex.minima[1]])
             worst = [float(a) for a, b in sorted(zip(ts, vs, strict=True), key=lambda q: -abs(q[1])) if abs(b) > z[0]]
             if problem.accel_over == "working":
-                lo, length = m.working_arc()
-                frac += [((a - lo) % TWO_PI) / length for a in worst if (a - lo) % TWO_PI <= length] or [
-                    ((peak.theta2 - lo) % TWO_PI) / length
-                ]
+                frac += _working_fractions(m, ex, z[0]) or _working_fractions(m, None, peak.theta2)
             else:
                 add += worst or [peak.theta2]
+    elif obj == "min_peak_velocity":
+        pv, w = m.peak_velocity(1.0), abs(problem.omega2)
+        info.update(nlp=z[0] * w, certified=pv.value * w, gap=(pv.value - z[0]) * w)
+        if pv.value - z[0] > gap_tol:  # every local extreme of the velocity in the working stroke above the bound
+            frac += _working_fractions(m, m.velocity_extremes(), z[0]) or _working_fractions(m, None, pv.theta2)
     elif obj == "min_size" and problem.size == "footprint":
         box = m.bounding_box()
         exact = (box.x_max - box.x_min) * (box.y_max - box.y_min)
@@ -171,15 +154,39 @@ def _certify(problem, range_target, m, th, z, f, gap_tol, feas_tol):
     elif obj == "min_size":
         exact = m.size(problem.size)
         info.update(nlp=f, certified=exact, gap=abs(exact - f) if f is not None else 0.0)
-    bound = problem.conditions.get("gamma_min")
-    if bound is not None and g.value < bound - feas_tol:
-        add.append(g.theta2)
+    for key, v in criteria.violations(problem, m).items():  # a bound the samples missed: add where it is exceeded
+        if v <= feas_tol:
+            continue
+        if key.startswith("gamma_min"):
+            add.append(g.theta2)
+        elif key.startswith("max_footprint"):
+            add += list(m.bounding_box().angles)
+        elif key.startswith("max_peak_velocity"):
+            frac += _working_fractions(m, None, m.peak_velocity().theta2)
+        elif key.startswith("max_peak_accel"):
+            t = m.peak_acceleration(1.0, problem.accel_over).theta2
+            if problem.accel_over == "working":
+                frac += _working_fractions(m, None, t)
+            else:
+                add.append(t)
     return m, info, add, frac
 
 
+def _working_fractions(m, extremes, above):
+    """Fractions of the working arc: of the extremes whose |value| exceeds ``above`` (extremes given), or of the
+    crank angle ``above`` (extremes None)."""
+    lo, length = m.working_arc()
+    if extremes is None:
+        return [((above - lo) % TWO_PI) / length]
+    ts = np.concatenate([extremes.maxima[0], extremes.minima[0]])
+    vs = np.concatenate([extremes.maxima[1], extremes.minima[1]])
+    order = np.argsort(-np.abs(vs))
+    return [((ts[i] - lo) % TWO_PI) / length for i in order if abs(vs[i]) > above and (ts[i] - lo) % TWO_PI <= length]
+
+
 def residuals(problem, violations: dict, m, targets) -> dict:
-    """Named violations (>= 0): the NLP rows but its objective's own (epigraphs, lifted extremes), and the targets
-    and gamma bound evaluated exactly."""
+    """Named violations (>= 0): the NLP rows but the criteria's epigraphs and lifted extremes, and the targets and
+    bound conditions evaluated exactly."""
     res = {k: v for k, v in violations.items() if not k.startswith(("epigraph", "lifted"))}
     if m is not None:
         try:
@@ -188,8 +195,10 @@ def residuals(problem, violations: dict, m, targets) -> dict:
             q = dict.fromkeys(("time_ratio", "stroke", "swing"), math.inf)
         for k, v in targets.items():
             res[f"{k} (exact)"] = abs(q[k] - v)
-        if "gamma_min" in problem.conditions:
-            res["gamma_min bound (exact)"] = max(0.0, problem.conditions["gamma_min"] - m.gamma_min().value)
+        try:
+            res.update(criteria.violations(problem, m))
+        except QroptError:
+            res["bounds (exact)"] = math.inf
     return res
 
 

@@ -8,7 +8,7 @@ its last Newton step is below 1e-10 rad, it stays inside its bracket and the cur
 extreme's sign; any other bracket is refined by the safeguarded Newton/false-position iteration
 of ``cycle.stationary`` on the same exact derivatives. Three groups of quantities are compiled
 on demand: ``cycle`` (output x, squared transmission cosines, assembly margins), ``accel``
-(d2x/dtheta2, refined with exact third and fourth derivatives) and ``coords`` (every joint
+(d2x/dtheta2, refined with exact third and fourth derivatives), ``velocity`` (dx/dtheta2) and ``coords`` (every joint
 coordinate, for bounding boxes).
 
 Kernels are pure functions of (type, parameter names): building one twice gives the same
@@ -120,7 +120,7 @@ class Kernel:
 
     def group(self, name: str) -> list[_Quantity]:
         """'cycle': x, cos^2 of each varying joint (precise value: its transmission angle), margins;
-        'accel': d2x/dtheta2; 'coords': every joint coordinate. Compiled on first use."""
+        'accel': d2x/dtheta2; 'velocity': dx/dtheta2; 'coords': every joint coordinate. Compiled on first use."""
         g = self._groups.get(name)
         if g is None:
             t, P, lp = self._t, self._P, self._lp
@@ -132,6 +132,9 @@ class Kernel:
             elif name == "accel":
                 a = casadi.jacobian(casadi.jacobian(lp.x, t), t)
                 pairs = [(a, a)]
+            elif name == "velocity":
+                v = casadi.jacobian(lp.x, t)
+                pairs = [(v, v)]
             else:
                 pairs = [
                     (c, c) for pt in lp.points.values() for c in (casadi.SX(pt[0]) + 0 * t, casadi.SX(pt[1]) + 0 * t)
@@ -259,11 +262,13 @@ def resolved(q) -> bool:
     return bool(np.all(tail <= RESOLVED * scale))
 
 
-def second_derivative_on_grid(x):
-    """d2x/dtheta2 on a uniform periodic grid by spectral differentiation (used for bracketing only)."""
+def derivative_on_grid(x, order: int):
+    """d^order x/dtheta2^order on a uniform periodic grid by spectral differentiation (for bracketing only)."""
     c = np.fft.rfft(x)
     k = np.arange(c.size)
-    return np.fft.irfft(-(k * k) * c, x.size)
+    if order % 2 and x.size % 2 == 0:
+        k[-1] = 0  # the Nyquist mode has no odd derivative on the grid
+    return np.fft.irfft((1j * k) ** order * c, x.size)
 
 
-__all__ = ["kernel", "Kernel", "Extremes", "discrete_extremes", "resolved", "second_derivative_on_grid"]
+__all__ = ["kernel", "Kernel", "Extremes", "discrete_extremes", "resolved", "derivative_on_grid"]

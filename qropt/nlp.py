@@ -22,6 +22,7 @@ import casadi
 import numpy as np
 
 from qropt.closures import RIGHT_ANGLE, transmission_cos
+from qropt.criteria import BOUNDS, measured
 from qropt.mechanisms import FourBar, FourBarSlider
 from qropt.ops import CASADI
 
@@ -127,42 +128,43 @@ class Formulation:
             if k in tgt:
                 rows.append(Row(k, travel - tgt[k], 0.0, 0.0))
         rows += self._conditions(params, problem)
-        # sample angles: absolute, or fractions of the working arc for the working-stroke acceleration
-        working = problem.objective == "min_peak_accel" and problem.accel_over == "working"
+        # sample angles: absolute, or fractions of the working arc (working-stroke acceleration, velocity)
         start = TH[0] if orientation > 0 else TH[1]
         length = span if orientation > 0 else TWO_PI - span
-        sampled = [at(S[k]) for k in range(self.n_samples)]
-        exact = [at(a) for a in (0.0, math.pi)]
-        self.z_names, epi = self._objective(problem, params, sampled, exact, n_exact, at, start, length, working)
+        self._sampled = [at(S[k]) for k in range(self.n_samples)]
+        self._exact = [at(a) for a in (0.0, math.pi)]
+        self._working = None
+        self._at, self._start, self._length, self._n_exact, self._params = at, start, length, n_exact, params
+        # criteria: the objective's epigraph group first (z[0]...), then those of the bound conditions
+        self.z_names, self._groups, epi = [], {}, []
+        obj = None if range_target else problem.objective
+        if obj:
+            self._group(measured(obj, problem.size), epi)
+        self.bounds_used = [k for k in BOUNDS if k in problem.conditions]
+        for k in self.bounds_used:
+            self._group(BOUNDS[k][0], epi)
         Z = casadi.SX.sym("z", len(self.z_names))
         # peak acceleration: the largest extremes are lifted like the dead centres (d3x/dtheta3 = 0 there)
-        self.n_lift = LIFTED if problem.objective == "min_peak_accel" and not range_target else 0
+        self.n_lift = LIFTED if obj == "min_peak_accel" else 0
         PHI = casadi.SX.sym("phi", self.n_lift)
         for k in range(self.n_lift):
             out = at(PHI[k])
             rows.append(Row("lifted acceleration extreme: stationary", out[6], 0.0, 0.0))
             epi += [(0, out[2]), (0, -out[2])]
-            if working:
+            if problem.accel_over == "working":
                 rows.append(Row("lifted acceleration extreme: in the working stroke", (PHI[k] - start) / length, 0, 1))
         for zi, e in epi:
             rows.append(Row(f"epigraph {self.z_names[zi]}", e - Z[zi], -casadi.inf, 0.0))
-        g_min = problem.conditions.get("gamma_min")
-        cos_lb = math.cos(g_min) if g_min is not None else None
-        for k, out in enumerate(sampled):
+        for k in range(self.n_samples):
             for m in range(len(margins)):
-                rows.append(Row(f"rod assembly at sample {k}", out[4][m], 0.0, casadi.inf))
-            if cos_lb is not None:
-                for j, name in enumerate(self.sampled_joints):
-                    c = out[3][n_exact + j]
-                    rows.append(Row(f"gamma_min >= bound at joint {name}", c, -cos_lb, cos_lb))
-        if cos_lb is not None:
-            for out in exact:
-                for j, name in enumerate(self.exact_joints):
-                    rows.append(Row(f"gamma_min >= bound at joint {name}", out[3][j], -cos_lb, cos_lb))
-        f = self._objective_value(problem, params, Z, travel, span)
+                rows.append(Row(f"rod assembly at sample {k}", self._sampled[k][4][m], 0.0, casadi.inf))
+        PB = casadi.SX.sym("pb", len(self.bounds_used))
+        for i, k in enumerate(self.bounds_used):
+            rows.append(Row(f"{k} bound", self._measure(BOUNDS[k][0], Z) - PB[i], -casadi.inf, 0.0))
+        f = self._objective_value(problem, Z, travel, span)
         self.rows = rows
         w = casadi.vertcat(X, TH, Z, PHI)
-        p = casadi.vertcat(PF, PT, S, W)
+        p = casadi.vertcat(PF, PT, S, W, PB)
         g = casadi.vertcat(*[r.expr for r in rows])
         self.w_sym, self.p_sym, self.g_sym = w, p, g
         self.solver = casadi.nlpsol("qropt", "ipopt", {"x": w, "p": p, "f": f, "g": g}, {**IPOPT, **(ipopt or {})})
@@ -194,50 +196,73 @@ class Formulation:
             rows.append(Row(f"ratio {num}/{den} <= {hi:g}", params[num] - hi * params[den], -casadi.inf, 0.0))
         return rows
 
-    def _objective(self, problem, params, sampled, exact, n_exact, at, start, length, working):
-        obj = None if self.range_target else problem.objective
-        epi = []
-        if obj == "max_gamma_min":
+    def _group(self, quantity, epi):
+        """The epigraph variables of one criterion (created once): z >= each sampled |value|."""
+        kind = {"sum": None, "footprint": "box"}.get(quantity, quantity)
+        if kind is None or kind in self._groups:
+            return
+        i0 = self._groups[kind] = len(self.z_names)
+        n_exact, sampled, exact = self._n_exact, self._sampled, self._exact
+        if kind == "gamma_min":
+            self.z_names.append("max |cos gamma|")
+            if not n_exact and not self.sampled_joints:  # every joint at a right angle (cos 0)
+                epi.append((i0, casadi.SX(0)))
             for out in exact:
-                for j in range(n_exact):
-                    epi += [(0, out[3][j]), (0, -out[3][j])]
+                epi += [e for j in range(n_exact) for e in ((i0, out[3][j]), (i0, -out[3][j]))]
             for out in sampled:
-                for j in range(len(self.sampled_joints)):
-                    epi += [(0, out[3][n_exact + j]), (0, -out[3][n_exact + j])]
-            return ["max |cos gamma|"], epi
-        if obj == "min_peak_accel":
-            outs = [at(start + (self._fraction(k) * length)) for k in range(self.n_samples)] if working else sampled
-            for out in outs:
-                epi += [(0, out[2]), (0, -out[2])]
-            return ["peak |d2x/dtheta2|"], epi
-        if obj == "min_size" and problem.size == "longest":
-            lengths = [params[k] for k in problem.mechanism.LENGTHS if k in params]
-            return ["longest link"], [(0, r) for r in lengths]
-        if obj == "min_size" and problem.size == "footprint":
+                epi += [e for j in range(len(self.sampled_joints))
+                        for e in ((i0, out[3][n_exact + j]), (i0, -out[3][n_exact + j]))]  # fmt: skip
+        elif kind == "peak_accel":
+            self.z_names.append("peak |d2x/dtheta2|")
+            outs = self._working_outs() if self.problem.accel_over == "working" else sampled
+            epi += [e for out in outs for e in ((i0, out[2]), (i0, -out[2]))]
+        elif kind == "peak_velocity":
+            self.z_names.append("peak working |dx/dtheta2|")
+            epi += [e for out in self._working_outs() for e in ((i0, out[1]), (i0, -out[1]))]
+        elif kind == "longest":
+            self.z_names.append("longest link")
+            epi += [(i0, self._params[k]) for k in self.problem.mechanism.LENGTHS if k in self._params]
+        else:  # the bounding box of every joint's path
+            self.z_names += ["x_max", "-x_min", "y_max", "-y_min"]
             for out in sampled + exact:
                 xy = out[5]
                 for i in range(xy.shape[0] // 2):
-                    epi += [(0, xy[2 * i]), (1, -xy[2 * i]), (2, xy[2 * i + 1]), (3, -xy[2 * i + 1])]
-            return ["x_max", "-x_min", "y_max", "-y_min"], epi
-        return [], []
+                    epi += [(i0, xy[2 * i]), (i0 + 1, -xy[2 * i]), (i0 + 2, xy[2 * i + 1]), (i0 + 3, -xy[2 * i + 1])]
 
-    def _fraction(self, k):
-        return self._W[k]
+    def _working_outs(self):
+        if self._working is None:
+            self._working = [self._at(self._start + self._W[k] * self._length) for k in range(self.n_samples)]
+        return self._working
 
-    def _objective_value(self, problem, params, Z, travel, span):
+    def _measure(self, quantity, Z):
+        """A criterion in the NLP's terms: cos gamma_min, size, |d2x/dtheta2|, |dx/dtheta2| (omega2 = 1)."""
+        if quantity == "sum":
+            return sum(self._params[k] for k in self.problem.mechanism.LENGTHS if k in self._params)
+        if quantity == "footprint":
+            i = self._groups["box"]
+            return (Z[i] + Z[i + 1]) * (Z[i + 2] + Z[i + 3])
+        return Z[self._groups[quantity]]
+
+    def _objective_value(self, problem, Z, travel, span):
         if self.range_target == "time_ratio":
             tr = span / (TWO_PI - span) if self.orientation > 0 else (TWO_PI - span) / span
             return self.sense * tr
         if self.range_target in ("stroke", "swing"):
             return self.sense * travel
-        obj = problem.objective
-        if obj in ("max_gamma_min", "min_peak_accel") or (obj == "min_size" and problem.size == "longest"):
-            return Z[0]
-        if obj == "min_size" and problem.size == "footprint":
-            return (Z[0] + Z[1]) * (Z[2] + Z[3])
-        if obj == "min_size":
-            return sum(params[k] for k in problem.mechanism.LENGTHS if k in params)
+        if problem.objective:
+            return self._measure(measured(problem.objective, problem.size), Z)
         return casadi.SX(0)
+
+    def bound_values(self, problem=None) -> np.ndarray:
+        """The bound conditions' values in the NLP's terms (cos of the gamma_min bound; accelerations and
+        velocities per omega2^2 and |omega2|)."""
+        problem = problem or self.problem
+        out = []
+        for k in self.bounds_used:
+            b = problem.conditions[k]
+            scale = {"gamma_min": None, "max_peak_accel": problem.omega2**2, "max_peak_velocity": abs(problem.omega2)}
+            out.append(math.cos(b) if k == "gamma_min" else b / scale.get(k, 1.0))
+        return np.array(out, float)
 
     # ---- numbers -------------------------------------------------------------
     def base_samples(self):
@@ -257,7 +282,7 @@ class Formulation:
         fixed = self.problem.fixed if fixed is None else fixed
         pf = [fixed[k] for k in self.fixed]
         pt = [targets[k] for k in self.targets]
-        return np.concatenate([pf, pt, samples, fractions]).astype(float)
+        return np.concatenate([pf, pt, samples, fractions, self.bound_values()]).astype(float)
 
     def epigraph_start(self, w0, p):
         """z values that make every epigraph row feasible at w0."""

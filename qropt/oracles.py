@@ -10,7 +10,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from qropt import QroptError, analytic
+from qropt import QroptError, analytic, criteria
 from qropt.certify import better, objective_value, quantities
 
 
@@ -26,8 +26,7 @@ def score(problem, values: dict):
         return None
     if m.dead_centres().reversals != 1:
         return None
-    bound = problem.conditions.get("gamma_min")
-    if bound is not None and q["gamma_min"] < bound - 1e-12:
+    if any(v > 1e-12 for v in criteria.violations(problem, m).values()):
         return None
     return objective_value(problem, q), q
 
@@ -46,7 +45,7 @@ def along(problem, design, lo, hi, n=400, boundary=None):
     """Dense grid along a 1-D family ``design(t) -> params or None`` for t in [lo, hi], refined by bounded Brent
     around the best grid point; if ``boundary(t)`` is given (>= 0 where the design is acceptable, e.g. a
     gamma_min margin), sign changes of it are refined by brentq and included."""
-    sign = -1.0 if problem.objective == "max_gamma_min" else 1.0
+    sign = -1.0 if criteria.maximises(problem.objective) else 1.0
 
     def f(t):
         d = design(t)

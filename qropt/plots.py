@@ -180,3 +180,116 @@ def family_mechanisms(f, count=4):
         ax.set_title(free, fontsize=9)
     fig.tight_layout()
     return fig
+
+
+def _criteria_text(c: dict) -> str:
+    return "\n".join([f"gamma_min {math.degrees(c['gamma_min']):.1f} deg", f"footprint {c['footprint']:.3g} length^2",
+                      f"peak accel {c['peak_accel']:.3g} length/s^2",
+                      f"peak working v {c['peak_velocity']:.3g} length/s"])  # fmt: skip
+
+
+def comparison_figure(cmp):
+    """The designs of a type comparison side by side at one scale, each with its criteria; with the fronts of
+    every type in a last panel when they were computed."""
+    rows = list(cmp.rows)
+    extra = 1 if cmp.fronts else 0
+    n = len(rows) + extra
+    cols = min(n, 4)
+    nrows = math.ceil(n / cols)
+    fig, axes = plt.subplots(nrows, cols, figsize=(4.2 * cols, 4.6 * nrows), squeeze=False)
+    axes = axes.ravel()
+    boxes = [r.result.mechanism.bounding_box() for r in rows if r.success]
+    span = max((max(b.x_max - b.x_min, b.y_max - b.y_min) for b in boxes), default=1.0) * 1.15
+    for ax, r in zip(axes, rows, strict=False):
+        if not r.success:
+            ax.text(0.5, 0.5, "no design:\n" + _wrap(r.reason, 40), transform=ax.transAxes, ha="center",
+                    va="center", fontsize=8)  # fmt: skip
+            ax.set_title(r.type)
+            ax.set_axis_off()
+            continue
+        m = r.result.mechanism
+        draw_mechanism(ax, m, m.working_arc()[0] + 0.5 * m.working_arc()[1])
+        b = m.bounding_box()
+        cx, cy = (b.x_min + b.x_max) / 2, (b.y_min + b.y_max) / 2
+        ax.set_xlim(cx - span / 2, cx + span / 2)
+        ax.set_ylim(cy - span / 2, cy + span / 2)
+        ax.set_title(r.type, fontsize=10)
+        ax.text(0.02, 0.02, _criteria_text(r.criteria), transform=ax.transAxes, fontsize=7.5, va="bottom",
+                bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "0.8"})  # fmt: skip
+        ax.tick_params(labelsize=7)
+    if cmp.fronts:
+        ax = axes[len(rows)]
+        for k, front in cmp.fronts.items():
+            va, vb = np.array(front.values).T if front.values else ([], [])
+            ax.plot(*_front_xy(front, va, vb), "o-", ms=3, label=k)
+        a, b = next(iter(cmp.fronts.values())).criteria
+        ax.set_xlabel(_label(a))
+        ax.set_ylabel(_label(b))
+        ax.set_title("trade-off fronts")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    for ax in axes[n:]:
+        ax.set_axis_off()
+    fig.suptitle(f"TR {cmp.time_ratio:g}, stroke {cmp.stroke:g}: best by {cmp.objective} first (one scale; "
+                 f"omega2 = {cmp.omega2:g} rad/s)")  # fmt: skip
+    fig.tight_layout()
+    return fig
+
+
+def _wrap(text, width):
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, width)[:8])
+
+
+def _label(q):
+    units = {"gamma_min": "deg", "sum": "length", "longest": "length", "footprint": "length^2",
+             "peak_accel": "length/s^2", "peak_velocity": "length/s"}  # fmt: skip
+    return f"{q} [{units[q]}]"
+
+
+def _front_xy(front, va, vb):
+    a, b = front.criteria
+    x = np.degrees(va) if a == "gamma_min" else np.asarray(va)
+    y = np.degrees(vb) if b == "gamma_min" else np.asarray(vb)
+    return x, y
+
+
+def front_figure(front, designs: int = 3):
+    """The front in its two criteria (left) and the designs at ``designs`` points along it (right)."""
+    fig = plt.figure(figsize=(5.5 + 3.2 * designs, 5))
+    gs = fig.add_gridspec(1, 1 + designs, width_ratios=[1.7] + [1] * designs)
+    ax = fig.add_subplot(gs[0])
+    va, vb = np.array(front.values).T if front.values else (np.zeros(0), np.zeros(0))
+    x, y = _front_xy(front, va, vb)
+    ax.plot(x, y, "o-", color="tab:blue", ms=4, label=f"non-dominated ({len(front.points)} points)")
+    picks = np.linspace(0, len(front.points) - 1, designs).round().astype(int) if front.points else []
+    colors = plt.cm.viridis(np.linspace(0.0, 0.85, designs))
+    for k, i in enumerate(picks):
+        ax.plot(x[i], y[i], "s", color=colors[k], ms=9, mec="k")
+        ax.annotate(f"{k + 1}", (x[i], y[i]), textcoords="offset points", xytext=(6, 6))
+    ax.plot([], [], "x", color="tab:red", label=f"removed: {len(front.removed)} (dominated or none)")
+    a, b = front.criteria
+    ax.set_xlabel(_label(a))
+    ax.set_ylabel(_label(b))
+    ax.set_title(f"{front.problem.mechanism.__name__}: {front.objectives[0]} vs {front.objectives[1]}")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    boxes = [front.points[i].mechanism.bounding_box() for i in picks]
+    span = max((max(bx.x_max - bx.x_min, bx.y_max - bx.y_min) for bx in boxes), default=1.0) * 1.15
+    for k, i in enumerate(picks):
+        axm = fig.add_subplot(gs[1 + k])
+        m = front.points[i].mechanism
+        draw_mechanism(axm, m, m.working_arc()[0] + 0.5 * m.working_arc()[1], color=colors[k])
+        bx = m.bounding_box()
+        cx, cy = (bx.x_min + bx.x_max) / 2, (bx.y_min + bx.y_max) / 2
+        axm.set_xlim(cx - span / 2, cx + span / 2)
+        axm.set_ylim(cy - span / 2, cy + span / 2)
+        axm.set_title(f"{k + 1}: {_short(a, va[i])}, {_short(b, vb[i])}", fontsize=9)
+        axm.tick_params(labelsize=7)
+    fig.tight_layout()
+    return fig
+
+
+def _short(q, v):
+    return f"{q} {math.degrees(v):.1f} deg" if q == "gamma_min" else f"{q} {v:.3g}"

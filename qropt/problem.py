@@ -13,12 +13,11 @@ from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Any
 
+from qropt.criteria import BOUNDS, OBJECTIVES, SIZES, SLIDER_ONLY
 from qropt.errors import ProblemError
 from qropt.mechanisms import FourBar, FourBarSlider, Mechanism, mechanism_type
 from qropt.mechanisms.base import REQUIRED
 
-OBJECTIVES = (None, "max_gamma_min", "min_size", "min_peak_accel")
-SIZES = ("sum", "longest", "footprint")
 BRANCHES = ("sigma", "sigma_slider")
 
 
@@ -37,10 +36,12 @@ class Problem:
 
     mechanism: class or type name; fixed: name -> value; free: name -> (lower, upper);
     targets: 'time_ratio', 'stroke' (sliders) or 'swing' (FourBar, rad);
-    conditions: 'grashof' ('drag-link' | 'crank-rocker'), 'gamma_min' (lower bound, rad),
-    'linear' [(coefficients, lower, upper)], 'ratio' [(numerator, denominator, lower, upper)];
-    objective: 'max_gamma_min', 'min_size' (with ``size``), 'min_peak_accel' (at ``omega2``,
-    over the 'cycle' or the 'working' stroke) or None; branches: name -> allowed signs.
+    conditions: 'grashof' ('drag-link' | 'crank-rocker'), 'gamma_min' (lower bound, rad), upper bounds
+    'max_sum', 'max_longest' (length), 'max_footprint' (length^2), 'max_peak_accel' (length/s^2),
+    'max_peak_velocity' (length/s), 'linear' [(coefficients, lower, upper)], 'ratio' [(numerator,
+    denominator, lower, upper)]; objective: 'max_gamma_min', 'min_size' (with ``size``), 'min_peak_accel'
+    (at ``omega2``, over the 'cycle' or the 'working' stroke), 'min_peak_velocity' (at ``omega2``, over the
+    working stroke) or None (see ``qropt.criteria``); branches: name -> allowed signs.
     """
 
     mechanism: Any
@@ -165,7 +166,7 @@ class Problem:
 
     def _check_conditions(self):
         c = dict(self.conditions)
-        known = {"grashof", "gamma_min", "linear", "ratio"}
+        known = {"grashof", "linear", "ratio", *BOUNDS}
         for k in c:
             if k not in known:
                 raise self._err(f"unknown condition {k!r}; conditions are {sorted(known)}")
@@ -183,6 +184,13 @@ class Problem:
         g = c.get("gamma_min")
         if g is not None and not (_number(g) and 0 <= g < math.pi / 2):
             raise self._err(f"gamma_min bound must be in [0, pi/2) rad, a number; got {g!r}")
+        for k in BOUNDS:
+            if k != "gamma_min" and k in c:
+                if not (_number(c[k]) and c[k] > 0):
+                    raise self._err(f"{k} is an upper bound, a positive number; got {c[k]!r}")
+                c[k] = float(c[k])
+                if k in SLIDER_ONLY and self.mechanism is FourBar:
+                    raise self._err(f"FourBar has no slider: {k} does not apply")
         linear = []
         for row in c.get("linear", ()):
             if not (isinstance(row, (list, tuple)) and len(row) == 3 and isinstance(row[0], Mapping)
@@ -223,8 +231,8 @@ class Problem:
             raise self._err(f"accel_over is 'cycle' or 'working', got {self.accel_over!r}")
         if not (_number(self.omega2) and self.omega2 != 0):
             raise self._err(f"omega2 is the crank speed in rad/s, a nonzero finite number; got {self.omega2!r}")
-        if self.objective == "min_peak_accel" and self.mechanism is FourBar:
-            raise self._err("FourBar has no slider: min_peak_accel does not apply")
+        if self.objective in SLIDER_ONLY and self.mechanism is FourBar:
+            raise self._err(f"FourBar has no slider: {self.objective} does not apply")
 
     # ---- equality and serialisation (angles in radians, lengths in the problem's units) -------------
     def to_dict(self) -> dict:

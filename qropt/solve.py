@@ -18,6 +18,7 @@ import numpy as np
 
 from qropt import starts as starts_
 from qropt.certify import Certificate, Designs, better, certify, objective_of, objective_value, quantities, residuals
+from qropt.criteria import BOUNDS, SIZES, maximises, violations
 from qropt.errors import ProblemError, QroptError
 from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, TWO_PI, Formulation
 from qropt.problem import Problem
@@ -26,6 +27,7 @@ from qropt.result import Result
 TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
 ACCEPTABLE = "Solved_To_Acceptable_Level"
 MIN_WAY = 3  # space-filling starts tried in each way of meeting the TR equality, at least
+RESTARTS = 2  # IPOPT runs continued from their last iterate when they hit the iteration limit
 
 
 @dataclass
@@ -83,7 +85,7 @@ class Solver:
         """The NLP of this problem structure, built once: fixed values, targets and samples are CasADi
         parameters, and the free bounds are read from the problem at solve time."""
         c = problem.conditions
-        cond = (c.get("grashof"), c.get("gamma_min"), repr(c.get("linear")), repr(c.get("ratio")))
+        cond = (c.get("grashof"), tuple(k for k in BOUNDS if k in c), repr(c.get("linear")), repr(c.get("ratio")))
         key = (problem.mechanism, tuple(problem.free), tuple(problem.fixed), tuple(problem.targets), cond,
                problem.objective, problem.size, problem.accel_over, tuple(sorted(branch.items())), orientation,
                range_target, sense)  # fmt: skip
@@ -117,7 +119,7 @@ class Solver:
         w = form.epigraph_start(form.pack(values0, th0, phi=_peaks(problem, values0, branch, designs)), p)
         c = Candidate(False, dict(values0), branch, orientation)
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
-        st, g, info, m = {}, None, {}, None
+        st, g, info, m, restarts = {}, None, {}, None, 0
         while c.rounds < max_rounds:
             c.rounds += 1
             w, f, g, st = form.solve(w, p)
@@ -127,6 +129,9 @@ class Solver:
             c.values = dict(zip(form.free, w[: form.nx].tolist(), strict=True))
             th, z = w[form.nx : form.nx + 2], w[form.nx + 2 : form.nx + 2 + form.nz]
             m, info, add, frac = certify(problem, range_target, c.values, branch, th, z, f, gap_tol, feas_tol, designs)
+            if st.get("return_status") == "Maximum_Iterations_Exceeded" and restarts < RESTARTS and not range_target:
+                restarts += 1  # IPOPT's iteration budget ran out on the way: go on from where it stopped
+                continue
             if not _converged(st) and not range_target:
                 break
             if not add and not frac:
@@ -231,7 +236,7 @@ class Solver:
             for c in good:
                 c.q = quantities(problem, c.mechanism)
             best_first = sorted(_distinct(good), key=lambda c: objective_value(problem, c.q) or 0.0,
-                                reverse=problem.objective == "max_gamma_min")  # fmt: skip
+                                reverse=maximises(problem.objective))  # fmt: skip
             k = len(best_first)
             claim = claim or f"best of {k} distinct local optima from {len(cands)} starts"
             stats.update(t_total=time.perf_counter() - t0, local_optima=k)
@@ -271,10 +276,14 @@ class Solver:
     def _family_starts(self, problem, plan, designs):
         """The best local optima of the objective along the closed-form family (exact evaluation), per branch."""
         out = []
+        bounded = any(k in problem.conditions for k in BOUNDS)
         for br in starts_.branches(problem):
-            scores = [_score(problem, v, br, designs) for v in plan.analytic]
-            out += [("family", plan.analytic[i], br) for i in starts_.local_best(scores, problem.objective
-                                                                                == "max_gamma_min")]  # fmt: skip
+            scored = [_score(problem, v, br, designs) for v in plan.analytic]
+            best = starts_.local_best([s for s, _ in scored], maximises(problem.objective))
+            if bounded:  # and the point nearest to meeting the bounds, where the best may lie on a bound
+                near = starts_.local_best([v if v else None for _, v in scored], False, keep=1)
+                best += [i for i in near if i not in best]
+            out += [("family", plan.analytic[i], br) for i in best]
         return out
 
     def _check(self, problem, targets, extra_starts, starts_n, seed, max_rounds):
@@ -343,6 +352,10 @@ class Solver:
     def _diagnose(self, problem, cands, targets, starts_n, seed, stats, t0):
         """No certified design: say why (a target out of its reachable range, or nothing meets all together)."""
         reasons = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
+        beyond = self._bound_out_of_reach(problem, targets, starts_n, seed)
+        if beyond:
+            stats["t_total"] = time.perf_counter() - t0
+            return Result("infeasible", beyond[0], stats=stats, reachable=beyond[1])
         reach, msgs = {}, []
         for k, v in targets.items():
             lo, hi = self.target_range(problem, k, targets, starts_n=starts_n, seed=seed)
@@ -365,6 +378,29 @@ class Solver:
         why = "; ".join(r for r in reasons[:3] if r)
         return Result("failed", f"no start converged to a certified design ({why}); " + "; ".join(msgs),
                       stats=stats, reachable=reach)  # fmt: skip
+
+    def _bound_out_of_reach(self, problem, targets, starts_n, seed):
+        """(message, {quantity: (low, high)}) if a bound condition is beyond what any design meeting the targets
+        and the other conditions reaches (its best value, from a solve optimising it), else None."""
+        for key, (quantity, sense) in BOUNDS.items():
+            bound = problem.conditions.get(key)
+            if bound is None:
+                continue
+            objective = "max_gamma_min" if quantity == "gamma_min" else "min_size" if quantity in SIZES else (
+                f"min_{quantity}")  # fmt: skip
+            sub = problem.replace(objective=objective, size=quantity if quantity in SIZES else problem.size,
+                                  conditions={k: v for k, v in problem.conditions.items() if k != key})  # fmt: skip
+            r = self.solve(sub, targets=targets, starts_n=starts_n, seed=seed)
+            if r.status not in ("optimal", "acceptable"):
+                continue
+            best = r.objective
+            if (best < bound) if sense == "lower" else (best > bound):
+                span = (0.0, best) if sense == "lower" else (best, math.inf)
+                word = "largest" if sense == "lower" else "smallest"
+                msg = (f"{key} {bound:.6g} is beyond reach: the {word} {quantity} of a design meeting the targets "
+                       f"and the other conditions is {best:.6g} ({r.certificate.global_claim})")  # fmt: skip
+                return msg, {quantity: span}
+        return None
 
     # ---- reachable range of one target ---------------------------------------------------------------
     def target_range(self, problem, target, targets=None, *, starts_n=None, seed=None):
@@ -422,11 +458,14 @@ def _real(name, v) -> float:
 
 
 def _nlp_value(problem, info) -> float:
-    """A certified objective in the NLP's terms (what IPOPT minimises): cos gamma_min, peak |d2x/dtheta2|, size."""
+    """A certified objective in the NLP's terms (what IPOPT minimises): cos gamma_min, peak |d2x/dtheta2|,
+    peak working |dx/dtheta2|, size."""
     if problem.objective == "max_gamma_min":
         return math.cos(info["certified"])
     if problem.objective == "min_peak_accel":
         return info["certified"] / problem.omega2**2
+    if problem.objective == "min_peak_velocity":
+        return info["certified"] / abs(problem.omega2)
     return info["certified"]
 
 
@@ -440,17 +479,18 @@ def _converged(stats) -> bool:
 
 
 def _score(problem, values, branch, build):
-    """The exact objective of a design that builds and meets the gamma_min bound, else None."""
+    """(objective, 0.0) of a design that builds and meets every bound condition, (None, total violation) of one
+    that builds and does not, (None, None) of one that does not build or turn once."""
     try:
         m = build(problem, values, branch)
         if m.dead_centres().reversals != 1:
-            return None
-        bound = problem.conditions.get("gamma_min")
-        if bound is not None and m.gamma_min().value < bound:
-            return None
-        return objective_of(problem, m) if problem.objective else 0.0
+            return None, None
+        excess = sum(violations(problem, m).values())
+        if excess > 0:
+            return None, excess
+        return (objective_of(problem, m) if problem.objective else 0.0), 0.0
     except QroptError:
-        return None
+        return None, None
 
 
 def _peaks(problem, values, branch, build):

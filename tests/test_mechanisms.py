@@ -169,6 +169,23 @@ def test_peak_acceleration_matches_brute_force(kind):
         assert (w.theta2 - start) % (2 * np.pi) <= length + 1e-12
 
 
+@pytest.mark.parametrize("kind", [k for k in KINDS if k != "four-bar"])
+def test_peak_working_velocity_matches_brute_force(kind):
+    for p, m in random_mechanisms(kind, 20, seed=5):
+        start, length = m.working_arc(2.0)
+        th = start + length * np.linspace(0.0, 1.0, 20001)
+
+        def v(t, p=p):
+            return np.imag(brute.output(kind, p, t + 1j * brute.STEP)) / brute.STEP
+
+        brute_peak = _grid_peak(v, th)
+        pv = m.peak_velocity(-2.0)
+        assert abs(pv.torque_per_newton - brute_peak) <= 1e-9 * max(1.0, brute_peak), (p, pv, brute_peak)
+        assert pv.value == pytest.approx(2.0 * pv.torque_per_newton, rel=1e-15)
+        assert (pv.theta2 - start) % (2 * np.pi) <= length + 1e-12
+        assert abs(abs(m.motion(pv.theta2, 2.0).v[0]) - pv.value) <= 1e-12 * max(1.0, pv.value)
+
+
 @pytest.mark.parametrize("kind", KINDS)
 def test_bounding_box_matches_brute_force(kind):
     for p, m in random_mechanisms(kind, 20, seed=4):

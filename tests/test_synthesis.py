@@ -229,7 +229,12 @@ def test_gamma_min_condition_is_respected():
     assert r.params["r3"] == pytest.approx(max(s.r3 for s in analytic.drag_link_r3(1.5, 0.1, 0.225, 0.275)), abs=1e-9)
     # 30 deg: both designs with TR 1.5 and stroke 0.3 (27.0 and 9.1 deg) fall short
     r = solve(p.replace(conditions={"gamma_min": math.radians(30)}))
-    assert r.status == "infeasible" and "meeting the targets and conditions together" in r.message
+    best = max(
+        p.build({"r3": s.r3, "r5": 0.15}, {"sigma": -1.0, "sigma_slider": 1.0}).gamma_min().value
+        for s in analytic.drag_link_r3(1.5, 0.1, 0.225, 0.275)
+    )
+    assert r.status == "infeasible" and "gamma_min 0.523599 is beyond reach" in r.message
+    assert r.reachable["gamma_min"][1] == pytest.approx(best, abs=1e-9) and math.degrees(best) < 30
 
 
 def test_solver_failure_is_a_status_not_an_exception():

@@ -20,7 +20,7 @@ import numpy as np
 from qropt import cycle
 from qropt.closures import transmission_angle
 from qropt.errors import AssemblyError, DegenerateMechanism, InvalidParameter, NoDeadCentres
-from qropt.kernel import kernel, resolved, second_derivative_on_grid
+from qropt.kernel import derivative_on_grid, kernel, resolved
 from qropt.ops import JET, NUMPY, Jet
 
 REQUIRED = object()
@@ -131,6 +131,15 @@ class PeakAcceleration(NamedTuple):
 
     value: float
     theta2: float
+
+
+class PeakVelocity(NamedTuple):
+    """Largest |slider velocity| (length/s) over the working stroke at a constant omega2, the crank angle (rad)
+    where it occurs, and the peak crank torque per newton of a constant cutting force (length: N m per N)."""
+
+    value: float
+    theta2: float
+    torque_per_newton: float
 
 
 class AccelerationExtremes(NamedTuple):
@@ -453,18 +462,47 @@ class Mechanism:
 
     @cached_property
     def _acceleration_extremes(self) -> AccelerationExtremes:
-        # bracketed on the coarsest grid whose spectral second derivative is resolved (exactly evaluated
-        # on the finest grid otherwise), refined with exact third and fourth derivatives
+        return AccelerationExtremes(*self._derivative_extremes("accel", 2))
+
+    def velocity_extremes(self) -> AccelerationExtremes:
+        """Local maxima and minima of dx/dtheta2 over a turn (length/rad), exact."""
+        self._require_full_turn()
+        return self._velocity_extremes
+
+    @cached_property
+    def _velocity_extremes(self) -> AccelerationExtremes:
+        return AccelerationExtremes(*self._derivative_extremes("velocity", 1))
+
+    def _derivative_extremes(self, group: str, order: int):
+        # bracketed on the coarsest grid whose spectral derivative is resolved (exactly evaluated on the
+        # finest grid otherwise), refined by Newton with exact higher derivatives
         k, p = self._kernel, self._kernel.vector(self.params)
         for n in cycle.GRIDS:
             x = self._grid[0] if self._grid.shape[1] == n else k.grid_values(self.params, cycle.grid(n))[0]
-            a = second_derivative_on_grid(x)
-            if resolved(a[None, :]):
+            d = derivative_on_grid(x, order)
+            if resolved(d[None, :]):
                 break
         else:
-            a = k.group("accel")[0].at(cycle.grid(), p)[0]
-        mx, mn = k.refine("accel", a[None, :], [(0, "max"), (0, "min")], p)
-        return AccelerationExtremes((mx.theta, mx.value), (mn.theta, mn.value))
+            d = k.group(group)[0].at(cycle.grid(), p)[0]
+        mx, mn = k.refine(group, d[None, :], [(0, "max"), (0, "min")], p)
+        return (mx.theta, mx.value), (mn.theta, mn.value)
+
+    def peak_velocity(self, omega2: float = 1.0) -> PeakVelocity:
+        """Largest |slider velocity| over the working (slow) stroke at constant omega2 (rad/s), exact, with the
+        crank angle and the peak crank torque per newton of a constant cutting force, |dx/dtheta2| (length)."""
+        omega2 = _finite("omega2", omega2)
+        lo, length = self.working_arc(omega2)
+        ex = self.velocity_extremes()
+        ts = np.concatenate([ex.maxima[0], ex.minima[0]])
+        vs = np.concatenate([ex.maxima[1], ex.minima[1]])
+        inside = (ts - lo) % cycle.TWO_PI <= length
+        if not inside.any():  # no interior extreme: the largest of a fine grid over the arc (not expected)
+            ts = lo + length * np.linspace(0.0, 1.0, 721)
+            vs = self._kernel.group("velocity")[0].at(ts, self._kernel.vector(self.params))[0]
+            inside = np.ones(ts.size, bool)
+        i = np.flatnonzero(inside)[np.argmax(np.abs(vs[inside]))]
+        v = abs(float(vs[i]))
+        return PeakVelocity(v * abs(omega2), float(ts[i]) % cycle.TWO_PI, v)
 
     def working_arc(self, omega2: float = 1.0) -> tuple[float, float]:
         """The crank interval of the working (slow) stroke as (counter-clockwise start, length), rad."""

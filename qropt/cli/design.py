@@ -1,0 +1,80 @@
+"""``qropt design``: one task (time ratio, stroke) solved for every quick-return type and compared."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+COMMAND = "design"
+HELP = "type synthesis: the task solved for every quick-return type, compared criterion by criterion"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from qropt.cli import angle, real
+    from qropt.criteria import OBJECTIVES
+    from qropt.design import TYPES
+
+    parser.add_argument("--tr", type=real, required=True, help="time ratio (slow/fast, >= 1)")
+    parser.add_argument("--stroke", type=real, required=True, help="slider stroke [length]")
+    parser.add_argument("--objective", default="max_gamma_min", choices=[o for o in OBJECTIVES if o])
+    parser.add_argument("--size", default="footprint", choices=["sum", "longest", "footprint"],
+                        help="size measure of min_size (default footprint)")  # fmt: skip
+    parser.add_argument("--types", nargs="+", metavar="TYPE", help="types (default all): " + ", ".join(TYPES))
+    parser.add_argument("--gamma-min", type=angle, help="lower bound on gamma_min (e.g. 40deg)")
+    parser.add_argument("--max-footprint", type=real, help="upper bound on the footprint [length^2]")
+    parser.add_argument("--max-sum", type=real, help="upper bound on the sum of link lengths [length]")
+    parser.add_argument("--max-longest", type=real, help="upper bound on the longest link [length]")
+    parser.add_argument("--max-peak-accel", type=real, help="upper bound on the peak acceleration [length/s^2]")
+    parser.add_argument("--max-peak-velocity", type=real, help="upper bound on the peak working velocity [length/s]")
+    parser.add_argument("--omega2", type=real, default=1.0, help="crank speed [rad/s] (default 1)")
+    parser.add_argument("--pareto", nargs=2, metavar=("A", "B"), help="also each type's front between two objectives")
+    parser.add_argument("--n", type=int, default=12, help="front points per type with --pareto (default 12)")
+    parser.add_argument("--csv", metavar="FILE", help="write the comparison table as CSV")
+    parser.add_argument("--json", action="store_true", help="print the comparison as JSON")
+    parser.add_argument("--plot", metavar="FILE", help="draw the designs side by side (.png, .pdf, .svg)")
+
+
+def conditions_of(args) -> dict:
+    """The bound conditions given on the command line."""
+    c = {} if args.gamma_min is None else {"gamma_min": args.gamma_min}
+    for k in ("max_footprint", "max_sum", "max_longest", "max_peak_accel", "max_peak_velocity"):
+        if getattr(args, k) is not None:
+            c[k] = getattr(args, k)
+    return c
+
+
+def run(args) -> int:
+    from qropt.cli import picture_path, progress_bar
+    from qropt.design import TYPES, design
+
+    plot = picture_path(args.plot) if args.plot else None
+    n_types = len(args.types or TYPES)
+    with progress_bar("types", total=n_types, unit="type") as bar:
+        cmp = design(args.tr, args.stroke, objective=args.objective, types=args.types, size=args.size,
+                     conditions=conditions_of(args), omega2=args.omega2,
+                     pareto=tuple(args.pareto) if args.pareto else None, n=args.n, progress=bar.update)  # fmt: skip
+    if args.csv:
+        cmp.to_csv(args.csv)
+    if plot:
+        cmp.plot(plot)
+    if args.json:
+        print(cmp.to_json())
+        return 0
+    print(f"TR {args.tr:g}, stroke {args.stroke:g}, omega2 {args.omega2:g} rad/s: best by {args.objective} first")
+    print(f"  {'type':20s} {'gamma_min':>10s} {'footprint':>11s} {'sum':>8s} {'peak accel':>11s} "
+          f"{'peak v':>9s} {'T/F':>8s}")  # fmt: skip
+    print(f"  {'':20s} {'[deg]':>10s} {'[length^2]':>11s} {'[length]':>8s} {'[l/s^2]':>11s} {'[l/s]':>9s} "
+          f"{'[l]':>8s}")  # fmt: skip
+    for r in cmp.rows:
+        if not r.success:
+            print(f"  {r.type:20s} no design: {r.reason}")
+            continue
+        c = r.criteria
+        print(f"  {r.type:20s} {math.degrees(c['gamma_min']):10.3f} {c['footprint']:11.4g} {c['sum']:8.4g} "
+              f"{c['peak_accel']:11.4g} {c['peak_velocity']:9.4g} {c['torque_per_newton']:8.4g}")  # fmt: skip
+    print("  (T/F: peak crank torque per newton of cutting force; l: the stroke's length unit)")
+    if args.csv:
+        print(f"table written to {args.csv}")
+    if plot:
+        print(f"picture written to {plot}")
+    return 0

@@ -1,0 +1,49 @@
+"""``qropt pareto``: the trade-off front between two objectives of a problem file."""
+
+from __future__ import annotations
+
+import argparse
+import math
+
+COMMAND = "pareto"
+HELP = "the trade-off front between two objectives (epsilon-constraint, every point certified)"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from qropt.pareto import OBJECTIVES
+
+    parser.add_argument("problem", help="a problem file (.py, .toml, .json)")
+    parser.add_argument("--objectives", nargs=2, required=True, metavar=("A", "B"),
+                        help="two objectives: " + ", ".join(OBJECTIVES))  # fmt: skip
+    parser.add_argument("--n", type=int, default=20, help="points along the front, ends included (default 20)")
+    parser.add_argument("--csv", metavar="FILE", help="write the front as CSV")
+    parser.add_argument("--plot", metavar="FILE", help="draw the front and designs along it (.png, .pdf, .svg)")
+
+
+def run(args) -> int:
+    from qropt.cli import load_problem, picture_path, progress_bar
+    from qropt.pareto import pareto
+
+    plot = picture_path(args.plot) if args.plot else None
+    problem = load_problem(args.problem)
+    with progress_bar("front points", total=max(args.n - 2, 0)) as bar:
+        front = pareto(problem, tuple(args.objectives), n=args.n, progress=bar.update)
+    a, b = front.criteria
+    print(f"{problem.name or args.problem}: {front.objectives[0]} vs {front.objectives[1]}, "
+          f"{len(front.points)} non-dominated points")  # fmt: skip
+    for va, vb in front.values:
+        print(f"  {_show(a, va)}   {_show(b, vb)}")
+    for eps, why in front.removed:
+        print(f"  removed (bound {eps if eps is None else format(eps, '.6g')}): {why}")
+    if args.csv:
+        front.to_csv(args.csv)
+        print(f"front written to {args.csv}")
+    if plot:
+        front.plot(plot)
+        print(f"picture written to {plot}")
+    return 0
+
+
+def _show(q, v):
+    units = {"gamma_min": "deg", "footprint": "length^2", "peak_accel": "length/s^2", "peak_velocity": "length/s"}
+    return f"{q} {math.degrees(v):.4f} deg" if q == "gamma_min" else f"{q} {v:.6g} {units.get(q, 'length')}"

@@ -1,0 +1,201 @@
+"""Type synthesis: one task (time ratio, stroke) solved for every quick-return type, compared criterion by criterion.
+
+Each type's problem has bounds that scale with the stroke s (every length in [s/20, 5 s], offsets in
+[-5 s, 5 s]) and its own conditions (the Grashof class of the four-bar types). Every row is a certified solve;
+every criterion of a row is evaluated exactly on its design. Lengths in the stroke's unit, angles in radians.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from dataclasses import dataclass, field
+
+from qropt import criteria
+from qropt.errors import ProblemError, QroptError
+from qropt.problem import Problem
+from qropt.result import SOLUTION_PRESENT, Result
+
+# type name -> (mechanism kind, free lengths, free offsets, fixed values)
+TYPES = {
+    "slider-crank": ("slider-crank", ("r2", "r3"), ("e",), {}),
+    "crank-shaper": ("crank-shaper", ("r1", "r2", "r4"), (), {}),
+    "crank-shaper-rod": ("crank-shaper", ("r1", "r2", "r4", "r6"), ("h",), {}),
+    "whitworth": ("whitworth", ("r1", "r2", "r5", "r6"), ("h",), {}),
+    "crank-rocker-slider": ("crank-rocker-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}),
+    "drag-link-slider": ("drag-link-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}),
+}
+CRITERIA = ("gamma_min", "footprint", "sum", "peak_accel", "peak_velocity", "torque_per_newton")
+
+
+def type_problem(kind: str, time_ratio: float, stroke: float, *, objective="max_gamma_min", bounds=None,
+                 conditions=None, omega2: float = 1.0, size: str = "footprint") -> Problem:  # fmt: skip
+    """The task as a Problem of one type: default bounds scaled by the stroke, ``bounds`` (name -> (lo, hi))
+    overriding those the type has, ``conditions`` added to the type's own."""
+    if kind not in TYPES:
+        raise ProblemError(f"unknown type {kind!r}; types are {list(TYPES)}")
+    mech, lengths, offsets, fixed = TYPES[kind]
+    s = stroke
+    free = {k: (s / 20, 5 * s) for k in lengths} | {k: (-5 * s, 5 * s) for k in offsets}
+    for k, b in (bounds or {}).items():
+        if k in free:
+            free[k] = b
+    return Problem(mechanism=mech, fixed=fixed, free=free, targets={"time_ratio": time_ratio, "stroke": stroke},
+                   conditions=dict(conditions or {}), objective=objective, omega2=omega2, size=size,
+                   name=f"{kind} TR {time_ratio:g} stroke {stroke:g}")  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Row:
+    """One type's answer: its Result, every criterion of its design evaluated exactly (None where the type
+    has no design), and why not when it has none."""
+
+    type: str
+    result: Result
+    criteria: dict = field(default_factory=dict)
+    reason: str = ""
+
+    @property
+    def success(self) -> bool:
+        return self.result.status in SOLUTION_PRESENT
+
+    def record(self) -> dict:
+        """Flat, JSON-ready: type, status, objective, each criterion, the parameters, the reason."""
+        d = {"type": self.type, "status": self.result.status, "objective": self.result.objective}
+        d |= {k: self.criteria.get(k) for k in CRITERIA}
+        d["params"] = dict(self.result.params)
+        d["reason"] = self.reason
+        return d
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """The task solved for several types: ``rows`` best first by the objective, types without a design last."""
+
+    time_ratio: float
+    stroke: float
+    objective: str
+    omega2: float
+    rows: tuple
+    fronts: dict = field(default_factory=dict)
+
+    def __repr__(self):
+        lines = [f"Comparison(TR {self.time_ratio:g}, stroke {self.stroke:g}, {self.objective}):"]
+        for r in self.rows:
+            if r.success:
+                c = r.criteria
+                lines.append(f"  {r.type:20s} gamma_min {math.degrees(c['gamma_min']):6.2f} deg  footprint "
+                             f"{c['footprint']:.4g}  peak accel {c['peak_accel']:.4g}  peak velocity "
+                             f"{c['peak_velocity']:.4g}")  # fmt: skip
+            else:
+                lines.append(f"  {r.type:20s} no design: {r.reason}")
+        return "\n".join(lines)
+
+    def table(self) -> list[dict]:
+        """One dict per row (Row.record), best first."""
+        return [r.record() for r in self.rows]
+
+    def to_json(self) -> str:
+        d = {"time_ratio": self.time_ratio, "stroke": self.stroke, "objective": self.objective,
+             "omega2": self.omega2, "units": criteria.UNITS, "rows": self.table()}  # fmt: skip
+        return json.dumps(_clean(d), indent=2, allow_nan=False)
+
+    def to_csv(self, path) -> None:
+        rows = self.table()
+        names = sorted({k for r in rows for k in r["params"]})
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["type", "status", "objective", *CRITERIA, *names, "reason"])
+            for r in rows:
+                w.writerow([r["type"], r["status"], _cell(r["objective"]), *(_cell(r[k]) for k in CRITERIA),
+                            *(_cell(r["params"].get(k)) for k in names), r["reason"]])  # fmt: skip
+
+    def plot(self, path) -> None:
+        """The designs side by side at one scale, each with its numbers (and the fronts, if computed)."""
+        from qropt.plots import comparison_figure, save
+
+        save(comparison_figure(self), path)
+
+
+def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min", types=None, bounds=None,
+           conditions=None, omega2: float = 1.0, size: str = "footprint", pareto=None, n: int = 12,
+           solver=None, progress=None) -> Comparison:  # fmt: skip
+    """Solve the task (TR, stroke) for every type (or ``types``) and compare; see the module docstring.
+
+    objective: as Problem.objective; conditions: bound conditions for every type (e.g. {'gamma_min': 0.7});
+    pareto: two objectives whose front is computed for every type (``n`` points each); progress: a callable
+    called once per finished type.
+    """
+    from qropt.solve import DEFAULT
+
+    solver = solver or DEFAULT
+    types = list(TYPES) if types is None else _types(types)
+    if not (_real(time_ratio) and time_ratio >= 1):
+        raise ProblemError(f"time_ratio is slow/fast >= 1, got {time_ratio!r}")
+    if not (_real(stroke) and stroke > 0):
+        raise ProblemError(f"stroke must be a positive number, got {stroke!r}")
+    if bounds is not None and not isinstance(bounds, dict):
+        raise ProblemError(f"bounds is a dict name -> (lower, upper), got {bounds!r}")
+    known = {k for t in types for k in TYPES[t][1] + TYPES[t][2]}
+    unknown = sorted(set(bounds or {}) - known)
+    if unknown:
+        raise ProblemError(f"bounds name {unknown}, which no type of {types} has (they have {sorted(known)})")
+    rows, fronts = [], {}
+    for kind in types:
+        p = type_problem(kind, time_ratio, stroke, objective=objective, bounds=bounds, conditions=conditions,
+                         omega2=omega2, size=size)  # fmt: skip
+        r = solver.solve(p)
+        rows.append(_row(kind, p, r))
+        if pareto is not None:
+            from qropt.pareto import pareto as front
+
+            fronts[kind] = front(p, pareto, n=n, solver=solver)
+        if progress:
+            progress(1)
+    maximise = criteria.maximises(objective)
+    ok = sorted((r for r in rows if r.success), key=lambda r: r.result.objective, reverse=maximise)
+    return Comparison(time_ratio, stroke, objective, omega2, tuple(ok + [r for r in rows if not r.success]), fronts)
+
+
+def _row(kind, problem, r: Result) -> Row:
+    if r.status not in SOLUTION_PRESENT:
+        return Row(kind, r, {}, r.message)
+    m, q = r.mechanism, r.quantities
+    c = {"gamma_min": q["gamma_min"], "footprint": q["footprint"], "sum": m.size("sum"),
+         "peak_accel": q["peak_accel"], "peak_velocity": q["peak_velocity"],
+         "torque_per_newton": q["torque_per_newton"]}  # fmt: skip
+    return Row(kind, r, c, "")
+
+
+def _types(types) -> list[str]:
+    if isinstance(types, str) or not hasattr(types, "__iter__"):
+        raise ProblemError(f"types is a list of type names from {list(TYPES)}, got {types!r}")
+    out = list(types)
+    for t in out:
+        if t not in TYPES:
+            raise ProblemError(f"unknown type {t!r}; types are {list(TYPES)}")
+    if not out or len(set(out)) != len(out):
+        raise ProblemError(f"types must name at least one type, each once; got {out}")
+    return out
+
+
+def _real(v) -> bool:
+    return criteria.finite(v)
+
+
+def _cell(v):
+    return "" if v is None else f"{v:.12g}" if isinstance(v, float) else v
+
+
+def _clean(v):
+    if isinstance(v, float):
+        return v if math.isfinite(v) else None
+    if isinstance(v, dict):
+        return {k: _clean(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_clean(x) for x in v]
+    return v
+
+
+__all__ = ["TYPES", "CRITERIA", "type_problem", "design", "Comparison", "Row", "QroptError"]

@@ -1,0 +1,160 @@
+"""Trade-off fronts between two objectives by the epsilon-constraint method.
+
+The front's ends are the two single-objective solves; between them objective ``a`` is optimised with the
+criterion of ``b`` bounded at values swept evenly between its values at the two ends. Each point is a certified
+solve warm-started from its neighbour (the full solve where the warm start fails); points another point
+dominates are removed, with the reason kept. Units as in ``qropt.criteria``.
+"""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from qropt import criteria
+from qropt.errors import ProblemError
+from qropt.problem import Problem
+from qropt.result import SOLUTION_PRESENT, Result
+
+OBJECTIVES = tuple(o for o in criteria.OBJECTIVES if o)
+MAX_POINTS = 1000
+
+
+@dataclass(frozen=True)
+class Front:
+    """points: the non-dominated Results in order along the front (from a's optimum to b's); values: their
+    (a criterion, b criterion) pairs; removed: (bound value, reason) of every sweep point left out."""
+
+    problem: Problem
+    objectives: tuple
+    criteria: tuple
+    points: tuple
+    values: tuple
+    removed: tuple = field(default_factory=tuple)
+
+    def __repr__(self):
+        a, b = self.criteria
+        lines = [f"Front({self.objectives[0]} vs {self.objectives[1]}: {len(self.points)} points, "
+                 f"{len(self.removed)} removed)"]  # fmt: skip
+        for va, vb in self.values[:6]:
+            lines.append(f"  {a} {va:.6g}  {b} {vb:.6g}")
+        if len(self.values) > 6:
+            lines.append("  ...")
+        return "\n".join(lines)
+
+    def table(self) -> list[dict]:
+        a, b = self.criteria
+        return [{a: va, b: vb, "status": r.status, **r.params} for r, (va, vb) in zip(self.points, self.values,
+                                                                                        strict=True)]  # fmt: skip
+
+    def to_csv(self, path) -> None:
+        rows = self.table()
+        names = list(rows[0]) if rows else []
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(names)
+            for r in rows:
+                w.writerow([f"{r[k]:.12g}" if isinstance(r[k], float) else r[k] for k in names])
+
+    def plot(self, path) -> None:
+        """The front in the two criteria, with the designs drawn at a few points."""
+        from qropt.plots import front_figure, save
+
+        save(front_figure(self), path)
+
+
+def pareto(problem: Problem, objectives=("max_gamma_min", "min_peak_accel"), n: int = 20, *, solver=None,
+           progress=None) -> Front:  # fmt: skip
+    """The trade-off front between two objectives of ``problem`` (its own objective is replaced); see the
+    module docstring. n: sweep points including the two ends (>= 2)."""
+    from qropt.solve import DEFAULT
+
+    solver = solver or DEFAULT
+    a, b = _check(problem, objectives, n)
+    qa, qb = criteria.measured(a, problem.size), criteria.measured(b, problem.size)
+    bound_b = criteria.bound_of(b, problem.size)
+    base = problem.replace(conditions={k: v for k, v in problem.conditions.items() if k != bound_b})
+    end_a = solver.solve(base.replace(objective=a))
+    end_b = solver.solve(base.replace(objective=b))
+    for end, name in ((end_a, a), (end_b, b)):
+        if end.status not in SOLUTION_PRESENT:
+            raise ProblemError(f"no front: the problem has no design for {name} ({end.status}: {end.message})")
+    lo, hi = _value(problem, qb, end_a), _value(problem, qb, end_b)
+    runs = [(None, end_a)]
+    prev = end_a
+    for eps in np.linspace(lo, hi, n)[1:-1]:
+        p = base.replace(objective=a, conditions={**base.conditions, bound_b: float(eps)})
+        r = solver.solve(p, extra_starts=[_free(p, prev)], starts_n=0, use_analytic=False)
+        if r.status not in SOLUTION_PRESENT:  # the neighbour's basin ended here: the full solve
+            r = solver.solve(p)
+        runs.append((float(eps), r))
+        if r.status in SOLUTION_PRESENT:
+            prev = r
+        if progress:
+            progress(1)
+    runs.append((None, end_b))
+    return _front(problem, (a, b), (qa, qb), runs)
+
+
+def _front(problem, objectives, names, runs) -> Front:
+    sa, sb = (1.0 if q == "gamma_min" else -1.0 for q in names)  # both maximised after the sign
+    pts, removed = [], []
+    for eps, r in runs:
+        if r.status not in SOLUTION_PRESENT:
+            removed.append((eps, f"no certified design ({r.status}: {r.message})"))
+            continue
+        pts.append((eps, r, (_value(problem, names[0], r), _value(problem, names[1], r))))
+    keep = []
+    for i, (eps, r, (va, vb)) in enumerate(pts):
+        by = next((j for j, (_, _, (wa, wb)) in enumerate(pts) if j != i and _dominates(sa * wa, sb * wb, sa * va,
+                                                                                        sb * vb)), None)  # fmt: skip
+        if by is not None:
+            removed.append((eps, f"dominated by the point with {names[0]} {pts[by][2][0]:.6g}, {names[1]} "
+                                 f"{pts[by][2][1]:.6g}"))  # fmt: skip
+        elif (
+            keep
+            and abs(keep[-1][2][0] - va) <= 1e-9 * max(1, abs(va))
+            and abs(keep[-1][2][1] - vb) <= 1e-9 * max(1, abs(vb))
+        ):
+            removed.append((eps, "the same design as its neighbour"))
+        else:
+            keep.append((eps, r, (va, vb)))
+    return Front(problem, tuple(objectives), tuple(names), tuple(r for _, r, _ in keep),
+                 tuple(v for _, _, v in keep), tuple(removed))  # fmt: skip
+
+
+def _dominates(a1, b1, a2, b2, tol=1e-9) -> bool:
+    """(a1, b1) dominates (a2, b2), both to be maximised: no worse in both, better in one beyond tol."""
+    ta, tb = tol * max(1.0, abs(a2)), tol * max(1.0, abs(b2))
+    return a1 >= a2 - ta and b1 >= b2 - tb and (a1 > a2 + ta or b1 > b2 + tb)
+
+
+def _value(problem, quantity, r: Result) -> float:
+    return criteria.value(problem, quantity, r.mechanism)
+
+
+def _free(problem, r: Result) -> dict:
+    return {k: r.params[k] for k in problem.free}
+
+
+def _check(problem, objectives, n):
+    if not isinstance(problem, Problem):
+        raise ProblemError(f"pareto takes a qropt.Problem, got {type(problem).__name__}")
+    if isinstance(objectives, str) or not hasattr(objectives, "__len__") or len(objectives) != 2:
+        raise ProblemError(f"objectives is a pair of objective names from {OBJECTIVES}, got {objectives!r}")
+    a, b = objectives
+    for o in (a, b):
+        if o not in OBJECTIVES:
+            raise ProblemError(f"unknown objective {o!r}; objectives are {OBJECTIVES}")
+    if criteria.measured(a, problem.size) == criteria.measured(b, problem.size):
+        raise ProblemError(f"the two objectives must differ, got {a!r} twice")
+    if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= MAX_POINTS:
+        raise ProblemError(f"n is the number of front points, an integer in [2, {MAX_POINTS}]; got {n!r}")
+    problem.replace(objective=a)  # the type supports both (a slider for the acceleration and velocity)
+    problem.replace(objective=b)
+    return a, b
+
+
+__all__ = ["Front", "pareto", "OBJECTIVES"]

@@ -1,0 +1,298 @@
+"""Type synthesis (qropt.design), bound conditions on every criterion, and trade-off fronts (qropt.pareto).
+
+Oracles: the slider-crank's closed-form family swept densely (every design of a TR and stroke lies on it),
+and, for every type, an independent search with the brute-force simulator: random shapes scaled to the
+stroke exactly (TR and gamma_min do not depend on scale), those near the TR kept and evaluated exactly.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import qropt
+from qropt import QroptError, criteria, oracles, problem_bases
+from qropt.design import TYPES, design, type_problem
+from qropt.pareto import pareto
+from tests import brute
+
+TR, STROKE = 1.5, 0.3
+BRUTE_KIND = {"crank-shaper-rod": "crank-shaper"}
+
+
+@pytest.fixture(scope="module")
+def comparison():
+    return design(TR, STROKE)
+
+
+def _family(problem):
+    return oracles.along(problem, oracles.slider_crank_family(problem.targets["time_ratio"], STROKE),
+                         problem.free["r2"][0] + 1e-6, STROKE / 2 - 1e-6, n=600)  # fmt: skip
+
+
+# ---- the new criterion and the bounds ------------------------------------------------------------------------
+def test_min_peak_velocity_matches_the_closed_form_family():
+    p = problem_bases.slider_crank(objective="min_peak_velocity", omega2=2.0)
+    r = qropt.solve(p)
+    o = problem_bases.slider_crank_oracle(p)
+    assert r.status == "optimal" and r.certificate.exact
+    assert r.objective == pytest.approx(o["objective"], rel=1e-7)
+    assert r.quantities["torque_per_newton"] == pytest.approx(r.objective / 2.0, rel=1e-15)
+    assert r.quantities["peak_velocity"] == r.objective
+
+
+BOUNDS = [("max_peak_velocity", 0.26), ("max_peak_accel", 0.8), ("max_sum", 0.4), ("max_footprint", 0.15),
+          ("gamma_min", math.radians(36))]  # fmt: skip
+
+
+@pytest.mark.parametrize(("key", "bound"), BOUNDS)
+def test_a_bound_on_each_criterion_matches_the_family_with_that_bound(key, bound):
+    objective = "min_peak_velocity" if key == "gamma_min" else "max_gamma_min"
+    p = problem_bases.slider_crank(objective=objective, omega2=2.0, conditions={key: bound})
+    quantity, sense = criteria.BOUNDS[key]
+    free = qropt.solve(p.replace(conditions={}))
+    assert criteria.violations(p, free.mechanism)[f"{key} bound (exact)"] > 1e-3  # the bound binds
+
+    def margin(t):
+        d = oracles.slider_crank_family(1.3, STROKE)(t)
+        s = oracles.score(p.replace(conditions={}), d) if d else None
+        if s is None:
+            return -1.0
+        v = criteria.value(p, quantity, p.build({k: d[k] for k in p.free}, {"sigma_slider": 1.0}))
+        return v - bound if sense == "lower" else bound - v
+
+    o = problem_bases.slider_crank_oracle(p, boundary=margin)
+    r = qropt.solve(p)
+    assert r.status == "optimal", r.message
+    assert r.objective == pytest.approx(o["objective"], rel=1e-7, abs=1e-9)
+    assert r.residuals[f"{key} bound (exact)"] <= 1e-8
+    got = criteria.value(p, quantity, r.mechanism)
+    assert got == pytest.approx(bound, rel=1e-7)  # active at the optimum
+
+
+def test_bounds_on_a_four_bar_slider_hold_exactly():
+    p = problem_bases.crank_rocker_slider(objective="max_gamma_min", omega2=3.0)
+    free = qropt.solve(p)
+    cap = 0.97 * free.quantities["peak_accel"]
+    r = qropt.solve(p.replace(conditions={**p.conditions, "max_peak_accel": cap}))
+    assert r.status == "optimal" and r.certificate.exact
+    assert r.quantities["peak_accel"] <= cap * (1 + 1e-9) and r.objective <= free.objective + 1e-12
+    brute_a = max(abs(r.mechanism.motion(brute.TH, 3.0).a))
+    assert brute_a <= cap * (1 + 1e-6)
+
+
+def test_a_bound_no_design_meets_says_how_far_it_can_go():
+    p = problem_bases.slider_crank(objective="max_gamma_min", omega2=2.0)
+    least = qropt.solve(p.replace(objective="min_peak_velocity")).objective
+    r = qropt.solve(p.replace(conditions={"max_peak_velocity": 0.9 * least}))
+    assert r.status == "infeasible" and "max_peak_velocity" in r.message and "beyond reach" in r.message
+    assert r.reachable["peak_velocity"][0] == pytest.approx(least, rel=1e-7)
+
+
+def test_bound_conditions_are_validated():
+    p = problem_bases.slider_crank()
+    for bad in ({"max_peak_accel": -1.0}, {"max_sum": "big"}, {"max_footprint": float("nan")}, {"max_size": 1.0}):
+        with pytest.raises(qropt.ProblemError):
+            p.replace(conditions=bad)
+    with pytest.raises(qropt.ProblemError, match="no slider"):
+        problem_bases.classic_crank_rocker(objective="min_peak_velocity")
+    q = p.replace(conditions={"max_peak_velocity": 0.3})
+    assert qropt.Problem.from_json(q.to_json()) == q and qropt.Problem.from_toml(q.to_toml()) == q
+
+
+# ---- type synthesis -------------------------------------------------------------------------------------------
+def test_every_type_has_a_certified_row_best_first(comparison):
+    rows = comparison.rows
+    assert sorted(r.type for r in rows) == sorted(TYPES)
+    values = [r.result.objective for r in rows if r.success]
+    assert values == sorted(values, reverse=True) and len(values) == len(TYPES)
+    for r in rows:
+        m = r.result.mechanism
+        kind = BRUTE_KIND.get(r.type, r.type)
+        p = dict(m.params)
+        t_max, t_min, x_max, x_min = brute.dead_centres(kind, p)
+        assert brute.time_ratio(t_max, t_min) == pytest.approx(TR, abs=1e-9)
+        assert x_max - x_min == pytest.approx(STROKE, abs=1e-9)
+        assert r.criteria["gamma_min"] == pytest.approx(brute.gamma_min(kind, p), abs=1e-9)
+        assert r.result.certificate.exact and r.result.status == "optimal"
+        for k, (lo, hi) in type_problem(r.type, TR, STROKE).free.items():
+            assert lo - 1e-12 <= p[k] <= hi + 1e-12
+
+
+def test_the_slider_crank_row_is_its_closed_form_familys_best(comparison):
+    row = next(r for r in comparison.rows if r.type == "slider-crank")
+    p = type_problem("slider-crank", TR, STROKE)
+    o = oracles.along(p, oracles.slider_crank_family(TR, STROKE), STROKE / 20 + 1e-9, STROKE / 2 - 1e-9, n=800)
+    assert row.result.objective == pytest.approx(o["objective"], rel=1e-8)
+
+
+def test_the_crank_shaper_with_a_yoke_transmits_at_right_angles(comparison):
+    row = next(r for r in comparison.rows if r.type == "crank-shaper")
+    assert row.criteria["gamma_min"] == pytest.approx(math.pi / 2, abs=1e-12)
+
+
+def _type_rules(kind, v, fixed):
+    """Each type's definition, written independently: Whitworth r2 > r1, crank-shaper r2 < r1, the four-bar
+    types Grashof with the crank (crank-rocker) or the ground (drag-link) shortest."""
+    g = {**fixed, **v}
+    if kind == "whitworth":
+        return g["r2"] > g["r1"]
+    if kind.startswith("crank-shaper"):
+        return g["r2"] < g["r1"]
+    if kind in ("crank-rocker-slider", "drag-link-slider"):
+        links = np.stack([g["r1"], g["r2"], g["r3"], g["r4"]])
+        s, ell = links.min(axis=0), links.max(axis=0)
+        grashof = s + ell <= links.sum(axis=0) - s - ell
+        return grashof & (links[1 if kind == "crank-rocker-slider" else 0] == s)
+    return np.ones_like(next(iter(v.values())), bool)
+
+
+def _sampled(kind, n=60000, seed=7, window=0.1, keep=3):
+    """The ``keep`` designs of largest gamma_min (brute force) among random shapes of a type scaled to the stroke
+    exactly, inside the design bounds, whose exact TR is within ``window`` of the task's: (gamma_min, TR, params)."""
+    p = type_problem(kind, TR, STROKE)
+    bk = BRUTE_KIND.get(kind, kind)
+    rng = np.random.default_rng(seed)
+    th = np.linspace(0.0, 2 * np.pi, 360, endpoint=False)
+    cand = []
+    for _ in range(n // 5000):
+        shape = {}
+        for k, (lo, hi) in p.free.items():
+            shape[k] = lo * (hi / lo) ** rng.random(5000) if k.startswith("r") else rng.uniform(lo, hi, 5000)
+        short = {"crank-rocker-slider": "r2", "drag-link-slider": "r1"}.get(kind)
+        if short:  # the shortest link of the class, drawn below the others
+            others = [shape[k] for k in ("r1", "r2", "r3", "r4") if k != short]
+            shape[short] = np.minimum.reduce(others) * rng.uniform(0.05, 1.0, 5000)
+        vals = {**p.fixed, **{k: v[:, None] for k, v in shape.items()}, "sigma": -1.0, "sigma_slider": 1.0}
+        with np.errstate(invalid="ignore", divide="ignore"):
+            x = np.real(brute.output(bk, vals, th[None, :]))
+            ok = np.isfinite(x).all(axis=1) & _type_rules(kind, shape, p.fixed)
+            d = np.sign(np.diff(x, axis=1, append=x[:, :1]))
+            ok &= np.count_nonzero(d != np.roll(d, -1, axis=1), axis=1) == 2
+            scale = STROKE / np.where(ok, np.ptp(x, axis=1), 1.0)
+            a = (th[np.argmin(x, axis=1)] - th[np.argmax(x, axis=1)]) % (2 * np.pi)
+            tr = np.maximum(a, 2 * np.pi - a) / np.minimum(a, 2 * np.pi - a)
+        ok &= np.abs(tr - TR) < window + 0.05
+        for i in np.flatnonzero(ok):
+            v = {k: float(shape[k][i] * scale[i]) for k in shape}
+            if all(lo <= v[k] <= hi for k, (lo, hi) in p.free.items()):
+                cand.append(v)
+    out = []
+    for v in cand:
+        q = {**p.fixed, **v, "sigma": -1.0, "sigma_slider": 1.0}
+        t_max, t_min, x_max, x_min = brute.dead_centres(bk, q)
+        t = brute.time_ratio(t_max, t_min)
+        if abs(t - TR) <= window:
+            k = STROKE / (x_max - x_min)  # exact stroke: TR and gamma_min do not change with scale
+            v = {name: x * k for name, x in v.items()}
+            if all(lo <= v[name] <= hi for name, (lo, hi) in p.free.items()):
+                out.append((brute.gamma_min(bk, q), t, v))
+    return sorted(out, key=lambda c: -c[0])[:keep]
+
+
+@pytest.mark.parametrize("kind", ["crank-shaper-rod", "whitworth", "crank-rocker-slider", "drag-link-slider"])
+def test_no_sampled_design_beats_the_solve_at_its_time_ratio(comparison, kind):
+    """The best sampled designs near the task's TR, each against qropt's solve of the task at its own exact TR."""
+    found = _sampled(kind)
+    assert found, kind  # the search found designs of the task
+    for gamma, tr, v in found:
+        r = qropt.solve(type_problem(kind, TR, STROKE), targets={"time_ratio": tr})
+        assert r.status == "optimal" and r.objective >= gamma - 1e-9, (kind, tr, v, gamma, r.objective)
+
+
+def test_the_table_csv_json_and_picture(comparison, tmp_path):
+    import csv
+    import json
+
+    t = comparison.table()
+    assert [r["type"] for r in t] == [r.type for r in comparison.rows]
+    comparison.to_csv(tmp_path / "c.csv")
+    with open(tmp_path / "c.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert float(rows[0]["gamma_min"]) == pytest.approx(t[0]["gamma_min"], rel=1e-11)
+    d = json.loads(comparison.to_json())
+    assert d["rows"][0]["type"] == t[0]["type"] and d["units"]["peak_velocity"] == "length/s"
+    comparison.plot(tmp_path / "c.png")
+    assert (tmp_path / "c.png").stat().st_size > 10_000
+    assert len(repr(comparison).splitlines()) == len(TYPES) + 1
+
+
+def test_a_type_that_cannot_do_the_task_says_why():
+    c = design(TR, STROKE, types=["slider-crank", "whitworth"], conditions={"gamma_min": math.radians(80)})
+    by = {r.type: r for r in c.rows}
+    assert by["whitworth"].success and not by["slider-crank"].success
+    assert "beyond reach" in by["slider-crank"].reason and c.rows[-1].type == "slider-crank"
+
+
+def test_design_rejects_bad_input():
+    for kw in ({"types": ["bogus"]}, {"types": "slider-crank"}, {"types": []}, {"objective": "max_speed"},
+               {"bounds": {"q7": (0, 1)}}, {"conditions": {"max_sum": -1}}):  # fmt: skip
+        with pytest.raises(QroptError):
+            design(TR, STROKE, **kw)
+    for tr, stroke in ((0.5, 0.3), (1.5, -1.0), (float("nan"), 0.3), ("1.5", 0.3)):
+        with pytest.raises(QroptError):
+            design(tr, stroke)
+
+
+# ---- trade-off fronts ----------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def front():
+    return pareto(problem_bases.slider_crank(omega2=2.0), ("max_gamma_min", "min_peak_accel"), n=8)
+
+
+def test_front_ends_are_the_single_objective_solves(front):
+    p = problem_bases.slider_crank(omega2=2.0)
+    a = qropt.solve(p.replace(objective="max_gamma_min"))
+    b = qropt.solve(p.replace(objective="min_peak_accel"))
+    assert front.values[0][0] == pytest.approx(a.objective, rel=1e-9)
+    assert front.values[-1][1] == pytest.approx(b.objective, rel=1e-9)
+
+
+def test_every_front_point_is_certified_and_non_dominated(front):
+    assert len(front.points) == 8 and not front.removed
+    for r in front.points:
+        assert r.status == "optimal" and r.certificate.exact and max(r.residuals.values()) <= 1e-8
+    g = [v[0] for v in front.values]
+    acc = [v[1] for v in front.values]
+    assert all(x > y for x, y in zip(g, g[1:], strict=False)) and all(x > y for x, y in zip(acc, acc[1:], strict=False))
+
+
+def test_an_interior_front_point_matches_the_family_with_its_bound(front):
+    r = front.points[3]
+    bound = front.values[3][1]
+    p = problem_bases.slider_crank(omega2=2.0, conditions={"max_peak_accel": bound})
+
+    def margin(t):
+        d = oracles.slider_crank_family(1.3, STROKE)(t)
+        if d is None or oracles.score(p.replace(conditions={}), d) is None:
+            return -1.0
+        return bound - p.build({k: d[k] for k in p.free}, {"sigma_slider": 1.0}).peak_acceleration(2.0).value
+
+    o = problem_bases.slider_crank_oracle(p, boundary=margin)
+    assert r.objective == pytest.approx(o["objective"], rel=1e-7)
+
+
+def test_a_dominated_point_is_removed_with_its_reason():
+    from qropt.pareto import _front
+
+    p = problem_bases.slider_crank(omega2=2.0)
+    r1 = qropt.solve(p)
+    r2 = qropt.solve(p.replace(objective="min_peak_accel"))
+    f = _front(p, ("max_gamma_min", "min_peak_accel"), ("gamma_min", "peak_accel"), [(None, r1), (0.8, r1),
+                                                                                     (None, r2)])  # fmt: skip
+    assert len(f.points) == 2 and f.removed[0][1] == "the same design as its neighbour"
+
+
+def test_pareto_rejects_bad_input():
+    p = problem_bases.slider_crank()
+    for objectives, n in ((("max_gamma_min", "max_gamma_min"), 5), (("max_gamma_min", "max_fun"), 5),
+                          (("max_gamma_min",), 5), (("max_gamma_min", "min_peak_accel"), 1),
+                          (("max_gamma_min", "min_peak_accel"), 2.5), ("max_gamma_min", 5)):  # fmt: skip
+        with pytest.raises(QroptError):
+            pareto(p, objectives, n=n)
+    with pytest.raises(QroptError, match="no slider"):
+        pareto(problem_bases.classic_crank_rocker(), ("max_gamma_min", "min_peak_accel"))
+    with pytest.raises(QroptError):
+        pareto({"mechanism": "slider-crank"}, ("max_gamma_min", "min_size"))
