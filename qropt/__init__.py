@@ -1,6 +1,7 @@
 """qropt: optimisation-based dimensional synthesis of quick-return mechanisms."""
 
 from qropt.certify import Certificate
+from qropt.design import Comparison, design
 from qropt.errors import (
     AssemblyError,
     DegenerateMechanism,
@@ -21,6 +22,7 @@ from qropt.mechanisms import (
     grashof,
     mechanism_type,
 )
+from qropt.pareto import Front, pareto
 from qropt.problem import Problem
 from qropt.reachable import Reachable, reachable
 from qropt.result import STATUSES, Result
@@ -47,6 +49,10 @@ __all__ = [
     "reachable",
     "Reachable",
     "target_range",
+    "design",
+    "Comparison",
+    "pareto",
+    "Front",
     "mechanism_type",
     "QroptError",
     "InvalidParameter",

@@ -86,7 +86,7 @@ def pareto(problem: Problem, objectives=("max_gamma_min", "min_peak_accel"), n: 
     prev = end_a
     for eps in np.linspace(lo, hi, n)[1:-1]:
         p = base.replace(objective=a, conditions={**base.conditions, bound_b: float(eps)})
-        r = solver.solve(p, extra_starts=[_free(p, prev)], starts_n=0, use_analytic=False)
+        r = solver.solve(p, extra_starts=[_free(p, prev)], starts_n=0, use_analytic=False, diagnose=False)
         if r.status not in SOLUTION_PRESENT:  # the neighbour's basin ended here: the full solve
             r = solver.solve(p)
         runs.append((float(eps), r))

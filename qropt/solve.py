@@ -191,12 +191,14 @@ class Solver:
     # ---- the solve ---------------------------------------------------------------------------------
     def solve(self, problem: Problem, *, starts_n: int | None = None, use_analytic: bool = True,
               seed: int | None = None, targets: dict | None = None, max_rounds: int | None = None,
-              extra_starts=()) -> Result:  # fmt: skip
+              extra_starts=(), diagnose: bool = True) -> Result:  # fmt: skip
         """Solve a synthesis problem; returns a Result whatever happens (only invalid input raises).
 
         starts_n: Sobol points where no closed form enumerates the solutions (default the Solver's);
         use_analytic: use the closed forms; targets: new values for some targets (the NLP is not rebuilt);
-        extra_starts: more starting points (free-parameter dicts), tried first.
+        extra_starts: more starting points (free-parameter dicts), tried first; diagnose: on failure, find why
+        (the reachable range of each target or bound, more solves); without it a failure is 'failed' with
+        IPOPT's reasons.
         """
         t0 = time.perf_counter()
         problem, targets, extra, starts_n, seed, max_rounds = self._check(
@@ -227,7 +229,7 @@ class Solver:
             good = [c for c in cands if c.ok]
         if plan.kind == "enumeration" and not extra and not good:  # the closed form missed: search instead
             return self.solve(problem, starts_n=starts_n, use_analytic=False, seed=seed, targets=targets,
-                              max_rounds=max_rounds)  # fmt: skip
+                              max_rounds=max_rounds, diagnose=diagnose)  # fmt: skip
         stats = {"starts": len(cands), "plan": plan.kind, "omega2": problem.omega2, "formulations": self.formulations,
                  "ipopt_runs": sum(len(c.statuses) for c in cands if c.origin != "enumeration"),
                  "iterations_total": sum(c.iterations for c in cands),
@@ -243,6 +245,11 @@ class Solver:
             local = [self._result(problem, c, "local_optimum" if i else None, claim, stats)
                      for i, c in enumerate(best_first)]  # fmt: skip
             return self._result(problem, best_first[0], None, claim, stats, local)
+        if not diagnose:
+            stats["t_total"] = time.perf_counter() - t0
+            why = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
+            return Result("failed", f"no start gave a certified design ({'; '.join(w for w in why[:3] if w)}); "
+                          "not diagnosed", stats=stats)  # fmt: skip
         return self._diagnose(problem, cands, targets, starts_n, seed, stats, t0)
 
     def _run(self, problem, runs, targets, max_rounds, designs, both_ways):

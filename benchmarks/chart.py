@@ -1,0 +1,163 @@
+"""Design charts at scale, in one run: the built-in 40 x 19 crank-rocker chart (problems/chart_crank_rocker.py)
+in-process, on a 2-worker Dask LocalCluster, and as independent default solves at every cell (the baseline).
+
+Prints cells per second, the speedup of 2 workers over one process, the continuation's gain over independent
+solves, and how the chart would scale on a larger cluster (a schedule of the measured tile times);
+writes ``results/chart.md`` and ``results/chart.json`` (date, machine, versions, load).
+
+Run: ``python -m benchmarks.chart`` (from the repository root).
+"""
+
+from __future__ import annotations
+
+import heapq
+import importlib
+import logging
+import os
+import sys
+import time
+
+from tqdm import tqdm
+
+from benchmarks.report import RESULTS, environment, save
+from qropt import solve
+from qropt.chart import TILE, chart
+
+SAME = ("status", "objective", "params", "method", "why", "source", "jump", "switched")
+
+
+def makespan(tiles: list, workers: int, per_tile: float) -> float:
+    """Longest worker time when tiles (seconds, largest first) go to the worker free first (as Dask does)."""
+    free = [0.0] * workers
+    for t in sorted(tiles, reverse=True):
+        heapq.heapreplace(free, free[0] + t + per_tile)
+    return max(free)
+
+
+def tile_seconds(ch) -> list:
+    """Measured seconds of each tile (the sum of its cells' times)."""
+    out: dict = {}
+    for c in ch.cells:
+        key = (c.i // TILE[0], c.j // TILE[1])
+        out[key] = out.get(key, 0.0) + c.seconds
+    return list(out.values())
+
+
+def main() -> None:
+    from distributed import LocalCluster
+
+    problem_file = importlib.import_module("problems.chart_crank_rocker")
+    p, x, y = problem_file.build(), problem_file.X, problem_file.Y
+    cells = len(x[1]) * len(y[1])
+    load0 = os.getloadavg()
+    solve(p)  # builds the NLPs of this process once (not timed); workers build their own, timed
+    t = time.perf_counter()
+    here = chart(p, x, y)
+    t_here = time.perf_counter() - t
+    print(f"in-process: {cells} cells in {t_here:.2f} s ({cells / t_here:.1f} cells/s); {here!r}")
+
+    t = time.perf_counter()
+    local = chart(p, x, y, workers=2)
+    t_local = time.perf_counter() - t
+    print(f"scheduler='local', 2 workers (cluster start included): {t_local:.2f} s")
+    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0", silence_logs=logging.ERROR) as lc:
+        t = time.perf_counter()
+        cold = chart(p, x, y, scheduler=lc.scheduler_address)
+        t_cold = time.perf_counter() - t
+        t = time.perf_counter()
+        warm = chart(p, x, y, scheduler=lc.scheduler_address)
+        t_warm = time.perf_counter() - t
+    with LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=":0", silence_logs=logging.ERROR) as lc:
+        chart(p, x, y, scheduler=lc.scheduler_address, progress=False)  # builds the worker's NLPs
+        t = time.perf_counter()
+        chart(p, x, y, scheduler=lc.scheduler_address)
+        t_one = time.perf_counter() - t
+    same = all([getattr(a, k) for k in SAME] == [getattr(b, k) for k in SAME]
+               for ch in (local, cold, warm) for a, b in zip(here.cells, ch.cells, strict=True))  # fmt: skip
+    print(f"2-worker cluster: {t_cold:.2f} s (workers building their NLPs), {t_warm:.2f} s warm; "
+          f"1-worker cluster {t_one:.2f} s warm; every cell equal to in-process: {same}")  # fmt: skip
+
+    t = time.perf_counter()
+    worse, better, diff = 0, 0, 0.0
+    for c in tqdm(here.cells, desc="independent solves", unit="cell", disable=not sys.stderr.isatty()):
+        r = solve(p, targets={x[0]: x[1][c.i], y[0]: y[1][c.j]})
+        diff = max(diff, abs(r.objective - c.objective))
+        worse += r.objective > c.objective + 1e-7
+        better += r.objective < c.objective - 1e-7
+    t_base = time.perf_counter() - t
+    load1 = os.getloadavg()
+    print(f"independent default solves: {t_base:.2f} s; the chart is {t_base / t_here:.2f}x faster; "
+          f"largest objective difference {diff:.1e} rad ({worse} cells better by an independent solve, "
+          f"{better} better in the chart)")  # fmt: skip
+
+    tiles = tile_seconds(here)
+    per_tile = max(0.0, t_warm - makespan(tiles, 2, 0.0)) / (len(tiles) / 2)  # Dask and transfer cost per tile
+    n_full = here.stats["full"]
+    t_full = sum(c.seconds for c in here.cells if c.method == "full") / n_full
+    t_cont = sum(c.seconds for c in here.cells if c.method == "continued") / max(1, here.stats["continued"])
+    big = 200 * 100  # a 200 x 100 chart: 200 tiles of 10 x 10
+    tile_big = 2 * t_full + 98 * t_cont
+    scale = {w: makespan([tile_big] * 200, w, per_tile) for w in (2, 8, 32, 128, 256)}
+    here_scale = {w: makespan(tiles, w, per_tile) for w in (1, 2, 4, 8)}
+    for w, s in scale.items():
+        print(f"  estimated 200 x 100 chart on {w} workers: {s:.1f} s ({big / s:.0f} cells/s)")
+    data = {
+        "problem": "problems/chart_crank_rocker.py", "cells": cells, "tile": list(TILE),
+        "tiles": here.stats["tiles"], "cpu_count": os.cpu_count(), "load_before": load0, "load_after": load1,
+        "in_process_s": t_here, "local_with_start_s": t_local, "cluster_cold_s": t_cold, "cluster_warm_s": t_warm,
+        "cluster_one_worker_s": t_one, "independent_s": t_base, "equal_results": same,
+        "speedup_two_workers": t_here / t_warm, "speedup_two_over_one_worker": t_one / t_warm,
+        "continuation_gain": t_base / t_here, "full_solves": n_full, "needed": here.stats["needed"],
+        "jumps": here.stats["jumps"], "switched": here.stats["switched"], "max_objective_difference": diff,
+        "independent_better": int(worse), "chart_better": int(better), "mean_full_s": t_full,
+        "mean_continued_s": t_cont, "dask_per_tile_s": per_tile,
+        "estimate_this_chart_s": here_scale, "estimate_200x100_s": scale,
+    }  # fmt: skip
+    save("chart.json", data)
+    (RESULTS / "chart.md").write_text(markdown(data, environment()))
+    print(f"wrote {RESULTS / 'chart.md'} and chart.json")
+
+
+def markdown(d: dict, env: dict) -> str:
+    v = env["versions"]
+    rows = [
+        ("in-process", d["in_process_s"], "1 process"),
+        ("2-worker LocalCluster, workers building their NLPs", d["cluster_cold_s"], "first chart on the cluster"),
+        ("2-worker LocalCluster, warm", d["cluster_warm_s"], "second chart on the same cluster"),
+        ("1-worker LocalCluster, warm", d["cluster_one_worker_s"], "the same, one worker"),
+        ("scheduler='local', workers=2", d["local_with_start_s"], "starting and stopping the cluster included"),
+        ("independent default solves", d["independent_s"], "solve() at every cell, in-process"),
+    ]
+    lines = [
+        "# Design charts: the 40 x 19 crank-rocker chart",
+        "",
+        f"{env['date']}, {env['machine']}, Python {env['python']}, qropt {v['qropt']}, casadi {v['casadi']}; "
+        f"{d['cpu_count']} cores, load average {d['load_before'][0]:.2f} before and {d['load_after'][0]:.2f} after "
+        "(shared with other work)",
+        "",
+        "| run | seconds | cells/s | note |",
+        "|---|---|---|---|",
+        *(f"| {name} | {s:.2f} | {d['cells'] / s:.1f} | {note} |" for name, s, note in rows),
+        "",
+        f"- speedup of 2 workers over one process: {d['speedup_two_workers']:.2f}x (over a 1-worker cluster: "
+        f"{d['speedup_two_over_one_worker']:.2f}x); every cell equal to the in-process chart: {d['equal_results']}",
+        f"- continuation's gain over independent default solves: {d['continuation_gain']:.2f}x "
+        f"({d['full_solves']} full solves of {d['cells']} cells, {d['needed']} needed; a full solve "
+        f"{1e3 * d['mean_full_s']:.1f} ms, a continued cell {1e3 * d['mean_continued_s']:.1f} ms on average)",
+        f"- agreement: largest objective difference to the independent solves {d['max_objective_difference']:.1e} rad; "
+        f"cells where an independent solve is better by 1e-7: {d['independent_better']}",
+        f"- {d['tiles']} tiles of {d['tile'][0]} x {d['tile'][1]}; Dask and transfer cost "
+        f"{1e3 * d['dask_per_tile_s']:.0f} ms a tile (measured on the warm 2-worker run)",
+        "",
+        "Estimated (a schedule of measured tile times, each worker taking the next tile when free, plus the "
+        "per-tile cost): this chart on " + ", ".join(f"{w} workers {s:.2f} s" for w, s in
+                                                       d["estimate_this_chart_s"].items()) +
+        " (8 tiles: more than 8 workers need smaller tiles); a 200 x 100 chart (200 tiles) on "
+        + ", ".join(f"{w} workers {s:.1f} s" for w, s in d["estimate_200x100_s"].items()) + ".",
+        "",
+    ]  # fmt: skip
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    main()

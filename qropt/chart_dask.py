@@ -1,0 +1,239 @@
+"""Tiles of a design chart (``qropt.chart``): continuation over a block of cells, and the tiles run in-process
+or on a Dask cluster.
+
+In a tile, cells are visited in a serpentine (each next to the last); a cell starts one local solve from the
+design of its best certified neighbour. The full default solve runs at the tile's first cell, at the centre of
+every ``check`` x ``check`` block (and the better of both designs stays), wherever the warm start fails or
+jumps branch, and where no neighbour has a design; a design better than the continuation's is carried to the
+cells around it while it stays better. A tile is plain numbers, so ``client.map`` sends it to a Dask worker,
+which builds its Solver once (IPOPT is not thread-safe: one thread per worker process).
+
+``'local'`` starts a ``dask.distributed.LocalCluster`` for the chart's duration; any other string is the
+address of a running scheduler (``dask scheduler`` and ``dask worker ADDRESS`` on the machines, or a
+dask-jobqueue cluster's ``scheduler_address``), which must answer within CONNECT_TIMEOUT seconds.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import inspect
+import json
+import logging
+import os
+import time
+
+from qropt import starts
+from qropt.certify import better
+from qropt.chart import Axis, Cell, ChartError, axis_kind, problem_at
+from qropt.errors import QroptError
+from qropt.problem import Problem
+from qropt.result import Result
+
+JUMP_FLOOR = 0.02  # a step moving the design by less (relative to its largest length) is never a jump
+JUMP_RATIO = 4.0  # a jump moves the design this many times faster than the step before it on the same line
+BETTER = 1e-7  # relative objective difference that counts as a better design
+CONNECT_TIMEOUT = 5  # s
+_SOLVERS: dict = {}  # per worker process: the Solver of each option set, built once
+
+
+def solve_tile(spec: dict, solver, progress=None) -> list[Cell]:
+    """Solve the block of cells a tile spec describes (plain numbers: ``problem`` as Problem.to_dict, ``x`` and
+    ``y`` as [name, values] or None, ``block`` [i0, i1, j0, j1], ``check``) with a Solver; cells in (j, i) order."""
+    return _Tile(spec, solver, progress).run()
+
+
+class _Tile:
+    def __init__(self, spec, solver, progress):
+        self.problem = Problem.from_dict(spec["problem"])
+        self.axes = [Axis(n, tuple(v), axis_kind(self.problem, n)) for n, v in (spec["x"], spec["y"] or ("", ())) if n]
+        self.i0, self.i1, self.j0, self.j1 = spec["block"]
+        self.check, self.solver, self.progress = spec["check"], solver, progress
+        self.quiet = {"diagnose": False} if "diagnose" in inspect.signature(solver.solve).parameters else {}
+        self.cells: dict[tuple, Cell] = {}
+
+    def run(self) -> list[Cell]:
+        for j in range(self.j0, self.j1):
+            row = range(self.i0, self.i1)
+            for i in row if (j - self.j0) % 2 == 0 else reversed(row):  # serpentine: every cell next to the last
+                self.solve_cell((i, j))
+                if self.progress:
+                    self.progress(1)
+        return [self.cells[(i, j)] for j in range(self.j0, self.j1) for i in range(self.i0, self.i1)]
+
+    def at(self, ij, towards=None) -> Problem:
+        """The problem at a cell (or halfway to the cell ``towards``)."""
+        values = [a.values[k] for a, k in zip(self.axes, ij, strict=False)]
+        if towards is not None:
+            values = [0.5 * (v + a.values[k]) for v, a, k in zip(values, self.axes, towards, strict=False)]
+        return problem_at(self.problem, self.axes, values)
+
+    def warm(self, problem, src: Cell) -> Result:
+        """One local solve from a certified neighbour's design (a failure is not explained: the full solve follows)."""
+        start = {k: src.params[k] for k in self.problem.free}
+        return self.solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=[start], **self.quiet)
+
+    def neighbours(self, ij):
+        i, j = ij
+        for n in ((i - 1, j), (i + 1, j), (i, j - 1), (i, j + 1)):
+            if self.i0 <= n[0] < self.i1 and self.j0 <= n[1] < self.j1:
+                yield n
+
+    def source(self, ij) -> tuple | None:
+        """The certified neighbour with the best objective (the first found on a tie)."""
+        best = None
+        for n in self.neighbours(ij):
+            c = self.cells.get(n)
+            if c is not None and c.success and (best is None or better(self.problem, c.objective, best.objective)):
+                best = c
+        return None if best is None else (best.i, best.j)
+
+    def beats(self, a: Result, b: Result) -> bool:
+        """Result a is certified and better than b by more than rounding."""
+        if not a.success:
+            return False
+        if not b.success:
+            return True
+        if a.objective is None or b.objective is None:
+            return False
+        tol = BETTER * max(1.0, abs(b.objective))
+        return better(self.problem, a.objective, b.objective + (tol if self.problem.objective == "max_gamma_min"
+                                                                 else -tol))  # fmt: skip
+
+    def solve_cell(self, ij):
+        t0 = time.perf_counter()
+        problem = self.at(ij)
+        if starts.plan(problem).kind == "enumeration":  # a closed form gives every solution: nothing to continue
+            self.cells[ij] = Cell.of(*ij, self.solver.solve(problem), "full", why="closed form",
+                                     seconds=time.perf_counter() - t0)  # fmt: skip
+            return
+        src = self.source(ij)
+        warm = self.warm(problem, self.cells[src]) if src else None
+        jump = bool(warm is not None and warm.success and self.jumped(ij, src, warm))
+        half = self.check // 2
+        check = ij[0] % self.check == half and (len(self.axes) == 1 or ij[1] % self.check == half)
+        if src is None:
+            why = "tile start" if ij == (self.i0, self.j0) else "no certified neighbour"
+        else:
+            why = "warm start failed" if not warm.success else "jump" if jump else "check" if check else ""
+        if not why:
+            self.cells[ij] = Cell.of(*ij, warm, "continued", source=src, seconds=time.perf_counter() - t0)
+            return
+        full = self.solver.solve(problem)
+        keep_warm = warm is not None and self.beats(warm, full)
+        switched = warm is not None and warm.success and self.beats(full, warm)
+        kept, method = (warm, "continued") if keep_warm else (full, "full")
+        self.cells[ij] = Cell.of(*ij, kept, method, why=why, source=src, jump=jump, switched=switched,
+                                 seconds=time.perf_counter() - t0)  # fmt: skip
+        if self.cells[ij].success and (switched or why in ("no certified neighbour", "warm start failed", "jump")):
+            self.spread(ij)
+
+    def spread(self, ij):
+        """Carry a design that did not come from its neighbours' branch to them, as long as it is better there."""
+        queue = [ij]
+        while queue:
+            u = queue.pop(0)
+            for v in self.neighbours(u):
+                old = self.cells.get(v)
+                if old is None or not old.success:  # unsolved: it starts from the best neighbour in its turn
+                    continue
+                t0 = time.perf_counter()
+                r = self.warm(self.at(v), self.cells[u])
+                if self.beats(r, old.result):
+                    self.cells[v] = Cell.of(*v, r, "continued", source=u, switched=True,
+                                            seconds=old.seconds + time.perf_counter() - t0)  # fmt: skip
+                    queue.append(v)
+
+    def jumped(self, ij, src, r: Result) -> bool:
+        """Whether the continuation from src to ij left src's branch: the design moves by more than JUMP_FLOOR of
+        its size and JUMP_RATIO times faster than on the step before src along the same line; with no such step,
+        the step is halved: a branch moves about half as far in each half."""
+        step = _distance(self.problem, r.params, self.cells[src].params)
+        if step <= JUMP_FLOOR:
+            return False
+        back = (2 * src[0] - ij[0], 2 * src[1] - ij[1])
+        b = self.cells.get(back)
+        if b is not None and b.success:
+            axis = 0 if back[1] == ij[1] else 1  # the line runs along x or along y
+            h1, h0 = (abs(self.axes[axis].values[p[axis]] - self.axes[axis].values[src[axis]]) for p in (ij, back))
+            before = _distance(self.problem, self.cells[src].params, b.params)
+            return step / h1 > JUMP_RATIO * before / h0
+        mid = self.warm(self.at(ij, towards=src), self.cells[src])
+        if not mid.success:
+            return True
+        halves = _distance(self.problem, mid.params, self.cells[src].params), _distance(self.problem, r.params,
+                                                                                       mid.params)  # fmt: skip
+        return max(halves) > 0.75 * step
+
+
+def _distance(problem, a: dict, b: dict) -> float:
+    """The largest change of a free parameter relative to the design's largest length."""
+    size = max(abs(b[k]) for k in problem.mechanism.LENGTHS if k in b)
+    return max(abs(a[k] - b[k]) for k in problem.free) / size
+
+
+# ---- running the tiles ------------------------------------------------------------------------------------
+def run_here(specs: list, solver, progress) -> list:
+    """Every tile in this process, in order."""
+    return [solve_tile(s, solver, progress) for s in specs]
+
+
+def solver_options(solver) -> dict:
+    """A Solver's options as plain values (what a worker needs to build the same Solver)."""
+    return {"tolerances": dict(solver.tolerances), "ipopt_options": dict(solver.ipopt_options),
+            "samples": solver.samples, "extra": solver.extra, "starts_n": solver.starts_n, "seed": solver.seed,
+            "max_rounds": solver.max_rounds}  # fmt: skip
+
+
+def worker_tile(spec: dict, options: dict) -> list[dict]:
+    """Run on a worker: one tile with this process's Solver for ``options``; the cells as dictionaries."""
+    from qropt.solve import Solver
+
+    key = json.dumps(options, sort_keys=True, default=str)
+    if key not in _SOLVERS:
+        _SOLVERS[key] = Solver(**options)
+    return [c.to_dict() for c in solve_tile(spec, _SOLVERS[key])]
+
+
+@contextlib.contextmanager
+def _client(mode: str, workers: int | None):
+    from distributed import Client, LocalCluster
+
+    if mode == "local":
+        n = workers or os.cpu_count() or 1
+        with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                          silence_logs=logging.ERROR) as cluster, Client(cluster) as client:  # fmt: skip
+            yield client, f"local cluster of {n} worker processes"
+        return
+    try:
+        client = Client(mode, timeout=CONNECT_TIMEOUT)
+    except (OSError, TimeoutError, ValueError, TypeError) as e:
+        first = str(e).splitlines()[0] if str(e) else ""
+        raise ChartError(f"cannot reach the Dask scheduler at {mode!r} within {CONNECT_TIMEOUT} s "
+                         f"({type(e).__name__}: {first})") from None  # fmt: skip
+    with client:
+        yield client, f"Dask cluster at {mode} ({len(client.scheduler_info().get('workers', {}))} workers)"
+
+
+def run_dask(specs: list, solver, mode: str, workers: int | None, progress) -> tuple[list, str]:
+    """Every tile on a Dask cluster, the largest first; (tiles of Cells in the order of specs, the cluster)."""
+    from distributed import as_completed
+
+    options = solver_options(solver)
+    order = sorted(range(len(specs)), key=lambda k: -_size(specs[k]))
+    with _client(mode, workers) as (client, where):
+        futures = {client.submit(worker_tile, specs[k], options, pure=False): k for k in order}
+        out: list = [None] * len(specs)
+        try:
+            for fut in as_completed(futures):
+                out[futures[fut]] = fut.result()
+                progress(_size(specs[futures[fut]]))
+        except QroptError:  # raised by a tile: as it is
+            raise
+        except Exception as e:  # noqa: BLE001 - a lost worker or a broken cluster: one line naming it
+            raise ChartError(f"the Dask cluster failed to solve a tile ({type(e).__name__}: {e})") from None
+    return [[Cell.from_dict(d) for d in tile] for tile in out], where
+
+
+def _size(spec) -> int:
+    i0, i1, j0, j1 = spec["block"]
+    return (i1 - i0) * (j1 - j0)
