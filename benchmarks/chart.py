@@ -13,16 +13,21 @@ from __future__ import annotations
 import heapq
 import importlib
 import logging
+import multiprocessing
 import os
+import statistics
 import sys
 import time
 
+import dask
 from tqdm import tqdm
 
 from benchmarks.report import RESULTS, environment, save
-from qropt import solve
+from qropt import Problem, solve
 from qropt.chart import TILE, chart
+from qropt.chart_dask import LOCAL_CONFIG
 
+REPEAT = 3
 SAME = ("status", "objective", "params", "method", "why", "source", "jump", "switched")
 
 
@@ -34,16 +39,26 @@ def makespan(tiles: list, workers: int, per_tile: float) -> float:
     return max(free)
 
 
-def tile_seconds(ch) -> list:
-    """Measured seconds of each tile (the sum of its cells' times)."""
-    out: dict = {}
-    for c in ch.cells:
-        key = (c.i // TILE[0], c.j // TILE[1])
-        out[key] = out.get(key, 0.0) + c.seconds
-    return list(out.values())
+def _tiles(args):
+    """A plain process solving every ``step``-th tile from the ``k``-th: the in-process chart (step 1, away from
+    the clusters' schedulers in the main process) or half of it (step 2: the ceiling for 2 workers, no Dask)."""
+    specs, k, step = args
+    from qropt import solve
+    from qropt.chart_dask import solve_tile
+    from qropt.solve import DEFAULT
+
+    solve(Problem.from_dict(specs[0]["problem"]))
+    seconds = []
+    for s in specs[k::step]:
+        t = time.perf_counter()
+        solve_tile(s, DEFAULT)
+        seconds.append(time.perf_counter() - t)
+    return seconds
 
 
 def main() -> None:
+    from concurrent.futures import ProcessPoolExecutor
+
     from distributed import LocalCluster
 
     problem_file = importlib.import_module("problems.chart_crank_rocker")
@@ -52,30 +67,39 @@ def main() -> None:
     load0 = os.getloadavg()
     solve(p)  # builds the NLPs of this process once (not timed); workers build their own, timed
     t = time.perf_counter()
-    here = chart(p, x, y)
-    t_here = time.perf_counter() - t
-    print(f"in-process: {cells} cells in {t_here:.2f} s ({cells / t_here:.1f} cells/s); {here!r}")
-
-    t = time.perf_counter()
     local = chart(p, x, y, workers=2)
     t_local = time.perf_counter() - t
-    print(f"scheduler='local', 2 workers (cluster start included): {t_local:.2f} s")
-    with LocalCluster(n_workers=2, threads_per_worker=1, dashboard_address=":0", silence_logs=logging.ERROR) as lc:
+    print(f"scheduler='local', 2 workers (cluster start and the workers' NLP builds included): {t_local:.2f} s")
+    heres, warms, ones, plains = [], [], [], []
+    specs = [{"problem": p.to_dict(), "x": [x[0], list(x[1])], "y": [y[0], list(y[1])],
+              "block": [i0, min(i0 + TILE[0], len(x[1])), j0, min(j0 + TILE[1], len(y[1]))], "check": 10}
+             for j0 in range(0, len(y[1]), TILE[1]) for i0 in range(0, len(x[1]), TILE[0])]  # fmt: skip
+    quiet = {"threads_per_worker": 1, "dashboard_address": ":0", "silence_logs": logging.ERROR}
+    with dask.config.set(LOCAL_CONFIG):
+        lc2, lc1 = LocalCluster(n_workers=2, **quiet), LocalCluster(n_workers=1, **quiet)
+    with lc2, lc1, ProcessPoolExecutor(2, mp_context=multiprocessing.get_context("spawn")) as pool:
         t = time.perf_counter()
-        cold = chart(p, x, y, scheduler=lc.scheduler_address)
+        cold = chart(p, x, y, scheduler=lc2.scheduler_address, progress=False)
         t_cold = time.perf_counter() - t
-        t = time.perf_counter()
-        warm = chart(p, x, y, scheduler=lc.scheduler_address)
-        t_warm = time.perf_counter() - t
-    with LocalCluster(n_workers=1, threads_per_worker=1, dashboard_address=":0", silence_logs=logging.ERROR) as lc:
-        chart(p, x, y, scheduler=lc.scheduler_address, progress=False)  # builds the worker's NLPs
-        t = time.perf_counter()
-        chart(p, x, y, scheduler=lc.scheduler_address)
-        t_one = time.perf_counter() - t
+        chart(p, x, y, scheduler=lc1.scheduler_address, progress=False)  # builds the 1-worker cluster's NLPs
+        here = chart(p, x, y, progress=False)  # the in-process answers, to compare every cell with
+        for _ in range(REPEAT):  # interleaved: a shared machine's speed drifts
+            tiles = pool.submit(_tiles, (specs, 0, 1)).result()  # the last run's tile times feed the estimates
+            heres.append(sum(tiles))
+            t = time.perf_counter()
+            warm = chart(p, x, y, scheduler=lc2.scheduler_address, progress=False)
+            warms.append(time.perf_counter() - t)
+            t = time.perf_counter()
+            chart(p, x, y, scheduler=lc1.scheduler_address, progress=False)
+            ones.append(time.perf_counter() - t)
+            plains.append(max(sum(half) for half in pool.map(_tiles, [(specs, 0, 2), (specs, 1, 2)])))
+    t_here, t_warm, t_one, t_plain = (statistics.median(v) for v in (heres, warms, ones, plains))
+    print(f"in-process: {cells} cells in {t_here:.2f} s ({cells / t_here:.1f} cells/s); {here!r}")
     same = all([getattr(a, k) for k in SAME] == [getattr(b, k) for k in SAME]
                for ch in (local, cold, warm) for a, b in zip(here.cells, ch.cells, strict=True))  # fmt: skip
-    print(f"2-worker cluster: {t_cold:.2f} s (workers building their NLPs), {t_warm:.2f} s warm; "
-          f"1-worker cluster {t_one:.2f} s warm; every cell equal to in-process: {same}")  # fmt: skip
+    print(f"2-worker cluster: {t_cold:.2f} s (workers building their NLPs), {t_warm:.2f} s warm "
+          f"({t_here / t_warm:.2f}x); 1-worker cluster {t_one:.2f} s; two plain processes with half the tiles "
+          f"each {t_plain:.2f} s ({t_here / t_plain:.2f}x, the ceiling); every cell as in-process: {same}")  # fmt: skip
 
     t = time.perf_counter()
     worse, better, diff = 0, 0, 0.0
@@ -90,11 +114,11 @@ def main() -> None:
           f"largest objective difference {diff:.1e} rad ({worse} cells better by an independent solve, "
           f"{better} better in the chart)")  # fmt: skip
 
-    tiles = tile_seconds(here)
     per_tile = max(0.0, t_warm - makespan(tiles, 2, 0.0)) / (len(tiles) / 2)  # Dask and transfer cost per tile
     n_full = here.stats["full"]
-    t_full = sum(c.seconds for c in here.cells if c.method == "full") / n_full
-    t_cont = sum(c.seconds for c in here.cells if c.method == "continued") / max(1, here.stats["continued"])
+    k = t_here / sum(c.seconds for c in here.cells)  # cell times from the main process, scaled to the clean run's
+    t_full = k * sum(c.seconds for c in here.cells if c.method == "full") / n_full
+    t_cont = k * sum(c.seconds for c in here.cells if c.method == "continued") / max(1, here.stats["continued"])
     big = 200 * 100  # a 200 x 100 chart: 200 tiles of 10 x 10
     tile_big = 2 * t_full + 98 * t_cont
     scale = {w: makespan([tile_big] * 200, w, per_tile) for w in (2, 8, 32, 128, 256)}
@@ -106,6 +130,7 @@ def main() -> None:
         "tiles": here.stats["tiles"], "cpu_count": os.cpu_count(), "load_before": load0, "load_after": load1,
         "in_process_s": t_here, "local_with_start_s": t_local, "cluster_cold_s": t_cold, "cluster_warm_s": t_warm,
         "cluster_one_worker_s": t_one, "independent_s": t_base, "equal_results": same,
+        "two_plain_processes_s": t_plain, "runs_in_process_s": heres, "runs_two_workers_s": warms,
         "speedup_two_workers": t_here / t_warm, "speedup_two_over_one_worker": t_one / t_warm,
         "continuation_gain": t_base / t_here, "full_solves": n_full, "needed": here.stats["needed"],
         "jumps": here.stats["jumps"], "switched": here.stats["switched"], "max_objective_difference": diff,
@@ -125,6 +150,7 @@ def markdown(d: dict, env: dict) -> str:
         ("2-worker LocalCluster, workers building their NLPs", d["cluster_cold_s"], "first chart on the cluster"),
         ("2-worker LocalCluster, warm", d["cluster_warm_s"], "second chart on the same cluster"),
         ("1-worker LocalCluster, warm", d["cluster_one_worker_s"], "the same, one worker"),
+        ("two plain processes, half the tiles each", d["two_plain_processes_s"], "no Dask: the ceiling"),
         ("scheduler='local', workers=2", d["local_with_start_s"], "starting and stopping the cluster included"),
         ("independent default solves", d["independent_s"], "solve() at every cell, in-process"),
     ]
@@ -140,7 +166,9 @@ def markdown(d: dict, env: dict) -> str:
         *(f"| {name} | {s:.2f} | {d['cells'] / s:.1f} | {note} |" for name, s, note in rows),
         "",
         f"- speedup of 2 workers over one process: {d['speedup_two_workers']:.2f}x (over a 1-worker cluster: "
-        f"{d['speedup_two_over_one_worker']:.2f}x); every cell equal to the in-process chart: {d['equal_results']}",
+        f"{d['speedup_two_over_one_worker']:.2f}x; two plain processes without Dask, the ceiling on this machine: "
+        f"{d['in_process_s'] / d['two_plain_processes_s']:.2f}x); every cell equal to the in-process chart: "
+        f"{d['equal_results']}; medians of {len(d['runs_in_process_s'])} interleaved runs",
         f"- continuation's gain over independent default solves: {d['continuation_gain']:.2f}x "
         f"({d['full_solves']} full solves of {d['cells']} cells, {d['needed']} needed; a full solve "
         f"{1e3 * d['mean_full_s']:.1f} ms, a continued cell {1e3 * d['mean_continued_s']:.1f} ms on average)",

@@ -75,7 +75,7 @@ def build(problem, values, branch):
 def quantities(problem, m) -> dict:
     """Exact quantities of a mechanism for a Result (angles in rad, lengths in the problem's units; peak_accel
     at the problem's omega2 over its ``accel_over`` span, peak_velocity at omega2 over the working stroke with
-    the peak crank torque per newton of cutting force; footprint in length^2; size by the problem's measure)."""
+    the peak crank torque per newton of cutting force; size by the problem's measure)."""
     q = {"time_ratio": m.time_ratio(), "gamma_min": m.gamma_min().value}
     slider = not isinstance(m, FourBar)
     q["swing" if not slider else "stroke"] = m.stroke()
@@ -85,7 +85,6 @@ def quantities(problem, m) -> dict:
     q["torque_per_newton"] = pv.torque_per_newton if slider else None
     q["grashof"] = m.grashof().kind if hasattr(m, "grashof") else None
     q["size"] = m.size(problem.size)
-    q["footprint"] = m.footprint()
     q["working_direction"] = m.working_direction(problem.omega2)
     return q
 

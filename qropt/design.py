@@ -162,7 +162,7 @@ def _row(kind, problem, r: Result) -> Row:
     if r.status not in SOLUTION_PRESENT:
         return Row(kind, r, {}, r.message)
     m, q = r.mechanism, r.quantities
-    c = {"gamma_min": q["gamma_min"], "footprint": q["footprint"], "sum": m.size("sum"),
+    c = {"gamma_min": q["gamma_min"], "footprint": m.footprint(), "sum": m.size("sum"),
          "peak_accel": q["peak_accel"], "peak_velocity": q["peak_velocity"],
          "torque_per_newton": q["torque_per_newton"]}  # fmt: skip
     return Row(kind, r, c, "")

@@ -1,14 +1,21 @@
 """Every ``qropt`` command the README shows, run as a subprocess of the installed executable from a directory
 outside the repository (holding a copy of ``problems/``, which the commands name): exit code 0, and every file
-the command names written and not empty. ``qropt bench`` and the ``python -m benchmarks`` lines are the
-benchmarks' own (minutes long, run from the repository root): they are not run here."""
+the command names written and not empty. A command that names a running Dask scheduler runs after the README's
+background lines (those ending in ``&``: the scheduler and its workers) are started as the README shows them.
+``qropt bench`` and the ``python -m benchmarks`` lines are the benchmarks' own (minutes long, run from the
+repository root): they are not run here."""
 
 from __future__ import annotations
 
+import contextlib
+import os
 import re
 import shlex
 import shutil
+import signal
+import socket
 import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -27,6 +34,37 @@ def readme_commands() -> list[str]:
         if command.startswith("qropt ") or command == "qropt":
             out.append(command)
     return out
+
+
+def background_commands() -> list[str]:
+    """The README's shell lines that end in ``&`` (services the next commands use), without the ``&``."""
+    text = (ROOT / "README.md").read_text()
+    lines = [line.strip() for block in re.findall(r"```sh\n(.*?)```", text, re.S) for line in block.splitlines()]
+    return [re.sub(r"\s*&\s*(#.*)?$", "", line) for line in lines if re.search(r"&\s*(#.*)?$", line)]
+
+
+@contextlib.contextmanager
+def services(cwd, address):
+    """The README's background lines running (in their own process groups) until the scheduler at ``address``
+    (tcp://host:port) answers and has workers; stopped afterwards."""
+    bindir = Path(shutil.which("qropt")).parent
+    env = {**os.environ, "PATH": f"{bindir}{os.pathsep}{os.environ['PATH']}"}
+    procs = [subprocess.Popen(c, shell=True, cwd=cwd, env=env, start_new_session=True, stdout=subprocess.DEVNULL,
+                              stderr=subprocess.DEVNULL) for c in background_commands()]  # fmt: skip
+    try:
+        host, port = address.removeprefix("tcp://").split(":")
+        for _ in range(120):
+            with contextlib.suppress(OSError), socket.create_connection((host, int(port)), timeout=1):
+                break
+            time.sleep(0.5)
+        time.sleep(5)  # the workers connect
+        yield
+    finally:
+        for p in procs:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(p.pid, signal.SIGTERM)
+        for p in procs:
+            p.wait(timeout=30)
 
 
 def outputs(command: str) -> list[str]:
@@ -56,7 +94,9 @@ def test_readme_command_runs(command, workdir):
     shell = command.replace("qropt ", f"{shlex.quote(exe)} ") if command != "qropt" else exe
     if command.startswith("qropt bench"):
         pytest.skip("the benchmark suite runs from the repository root and takes minutes")
-    r = subprocess.run(shell, shell=True, cwd=workdir, capture_output=True, text=True, timeout=240)
+    address = re.search(r"--scheduler (tcp://\S+)", command)
+    with services(workdir, address.group(1)) if address else contextlib.nullcontext():
+        r = subprocess.run(shell, shell=True, cwd=workdir, capture_output=True, text=True, timeout=240)
     assert r.returncode == 0, (command, r.stdout[-2000:], r.stderr[-2000:])
     for name in outputs(command):
         path = workdir / name
