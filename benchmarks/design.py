@@ -26,8 +26,8 @@ FRONTS = {
                                                        ("max_gamma_min", "min_peak_accel")),
     "slider_crank: max_gamma_min vs min_peak_velocity": (problem_bases.slider_crank(omega2=2.0),
                                                           ("max_gamma_min", "min_peak_velocity")),
-    "whitworth (TR 1.5, stroke 0.3): max_gamma_min vs min_size footprint": (
-        type_problem("whitworth", 1.5, 0.3), ("max_gamma_min", "min_size")),
+    "crank_rocker_slider: max_gamma_min vs min_size (sum)": (problem_bases.crank_rocker_slider(omega2=2.0),
+                                                              ("max_gamma_min", "min_size")),
 }  # fmt: skip
 
 

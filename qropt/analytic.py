@@ -207,6 +207,8 @@ def slider_crank_design(time_ratio: float, stroke: float, r2: float) -> list[Sli
     high = low + 2 * r2
     e = high * low * math.sin(phi) / stroke
     r3 = low + r2
+    if abs(e) >= r3 - r2:  # the crank would not turn fully (a slider-crank needs r3 >= r2 + |e|)
+        return []
     return [SliderCrankDesign(r2, r3, e), SliderCrankDesign(r2, r3, -e)]
 
 
@@ -297,6 +299,12 @@ def warm_starts(problem) -> WarmStarts:
     if cls is CrankShaper and tr is not None:
         ratio = crank_shaper_ratio(tr)
         lever = {"r4": stroke / (2 * ratio)} if stroke is not None and "r4" in free else {}
+        yoke = "r6" not in fixed and "r6" not in free
+        if yoke and stroke is not None and set(free) == {"r1", "r2", "r4"}:  # r1 walks the family, r4 fixed
+            for r1 in np.geomspace(max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1],
+                                   free["r2"][1] / ratio), FAMILY_POINTS):  # fmt: skip
+                emit(r1=float(r1), r2=float(ratio * r1), **lever)
+            return result("family", "sin(beta) = r2/r1 fixes the TR; stroke = 2 r4 r2/r1; r1 walks the family")
         if "r2" in free:
             emit(r2=ratio * val["r1"], **lever)
         elif "r1" in free:

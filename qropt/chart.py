@@ -461,7 +461,7 @@ def chart_figure(ch: Chart):
     how_ax.pcolormesh(gx, gy, code, cmap=colours, vmin=-0.5, vmax=3.5, shading="nearest")
     how_ax.set_xlim(xs.min(), xs.max())
     how_ax.set_ylim(ys.min(), ys.max())
-    labels = ["continued", "full solve (tile start, check)", "full solve needed", "no design"]
+    labels = ["continued", "full solve (tile start, check, closed form)", "full solve needed", "no design"]
     handles = [matplotlib.patches.Patch(color=colours(k), label=t) for k, t in enumerate(labels)]
     how_ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
     for ax in axes.flat[:n]:
@@ -474,7 +474,7 @@ def chart_figure(ch: Chart):
         ax.tick_params(labelsize=7)
     for ax in axes.flat[n:]:
         ax.set_visible(False)
-    fig.suptitle(f"{title}\n{how}; x: no design, red ring: branch change"
+    fig.suptitle(f"{title}\n{how}\nx: no design, red ring: branch change"
                  + ("; dashed: best " + ch.y.name + " for each " + ch.x.name if ridge is not None else ""),
                  fontsize=9)  # fmt: skip
     fig.tight_layout()

@@ -105,11 +105,17 @@ class _Tile:
         return better(self.problem, a.objective, b.objective + (tol if self.problem.objective == "max_gamma_min"
                                                                  else -tol))  # fmt: skip
 
+    def full(self, problem) -> Result:
+        """The default solve; a cell it cannot give a design is explained (a closed form that gives every design
+        proves it at once, otherwise the reachable ranges are found)."""
+        r = self.solver.solve(problem, **self.quiet)
+        return self.solver.solve(problem) if r.status == "failed" and self.quiet else r
+
     def solve_cell(self, ij):
         t0 = time.perf_counter()
         problem = self.at(ij)
         if starts.plan(problem).kind == "enumeration":  # a closed form gives every solution: nothing to continue
-            self.cells[ij] = Cell.of(*ij, self.solver.solve(problem), "full", why="closed form",
+            self.cells[ij] = Cell.of(*ij, self.full(problem), "full", why="closed form",
                                      seconds=time.perf_counter() - t0)  # fmt: skip
             return
         src = self.source(ij)
@@ -124,7 +130,7 @@ class _Tile:
         if not why:
             self.cells[ij] = Cell.of(*ij, warm, "continued", source=src, seconds=time.perf_counter() - t0)
             return
-        full = self.solver.solve(problem)
+        full = self.full(problem)
         keep_warm = warm is not None and self.beats(warm, full)
         switched = warm is not None and warm.success and self.beats(full, warm)
         kept, method = (warm, "continued") if keep_warm else (full, "full")

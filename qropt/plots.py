@@ -208,7 +208,7 @@ def comparison_figure(cmp):
             ax.set_axis_off()
             continue
         m = r.result.mechanism
-        draw_mechanism(ax, m, m.working_arc()[0] + 0.5 * m.working_arc()[1])
+        draw_mechanism(ax, m, _drawn_at(m))
         b = m.bounding_box()
         cx, cy = (b.x_min + b.x_max) / 2, (b.y_min + b.y_max) / 2
         ax.set_xlim(cx - span / 2, cx + span / 2)
@@ -280,7 +280,7 @@ def front_figure(front, designs: int = 3):
     for k, i in enumerate(picks):
         axm = fig.add_subplot(gs[1 + k])
         m = front.points[i].mechanism
-        draw_mechanism(axm, m, m.working_arc()[0] + 0.5 * m.working_arc()[1], color=colors[k])
+        draw_mechanism(axm, m, _drawn_at(m), color=colors[k])
         bx = m.bounding_box()
         cx, cy = (bx.x_min + bx.x_max) / 2, (bx.y_min + bx.y_max) / 2
         axm.set_xlim(cx - span / 2, cx + span / 2)
@@ -293,3 +293,9 @@ def front_figure(front, designs: int = 3):
 
 def _short(q, v):
     return f"{q} {math.degrees(v):.1f} deg" if q == "gamma_min" else f"{q} {v:.3g}"
+
+
+def _drawn_at(m) -> float:
+    """A crank angle that shows a design's links apart: 30% into its working stroke (rad)."""
+    start, length = m.working_arc()
+    return start + 0.3 * length

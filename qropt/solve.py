@@ -27,6 +27,7 @@ from qropt.result import Result
 TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
 ACCEPTABLE = "Solved_To_Acceptable_Level"
 MIN_WAY = 3  # space-filling starts tried in each way of meeting the TR equality, at least
+MANY_STARTS = 6  # more closed-form points than this are scored exactly and only the best few refined
 RESTARTS = 2  # IPOPT runs continued from their last iterate when they hit the iteration limit
 
 
@@ -171,6 +172,13 @@ class Solver:
             c.iterations += 1
             if np.max(np.abs(step)) <= 1e-14 * max(1.0, np.max(np.abs(w[:n]))):
                 break
+        inside = all(lo - 1e-12 <= x <= hi + 1e-12 for x, (lo, hi) in zip(w[: form.nx], problem.free.values(),
+                                                                          strict=True))  # fmt: skip
+        if not np.all(np.isfinite(w[:n])) or not inside:
+            c.info = {"ok": False, "reason": "Newton on the target equations leaves the bounds from the closed form's "
+                      "point (it meets the targets only approximately: no design there)"}  # fmt: skip
+            c.statuses = ["enumerated point (Newton)"]
+            return c
         # the closed form's own values where Newton only moved them by rounding (one design built, not two)
         free = [
             values0[k] if abs(w[i] - values0[k]) <= 4e-16 * abs(values0[k]) else w[i] for i, k in enumerate(form.free)
@@ -198,7 +206,7 @@ class Solver:
         use_analytic: use the closed forms; targets: new values for some targets (the NLP is not rebuilt);
         extra_starts: more starting points (free-parameter dicts), tried first; diagnose: on failure, find why
         (the reachable range of each target or bound, more solves); without it a failure is 'failed' with
-        IPOPT's reasons.
+        IPOPT's reasons, or 'infeasible' where a closed form that gives every design gives none that is valid.
         """
         t0 = time.perf_counter()
         problem, targets, extra, starts_n, seed, max_rounds = self._check(
@@ -220,14 +228,26 @@ class Solver:
                 f"best along a closed-form family that holds every solution ({plan.how}; {len(plan.analytic)} points)"
             )
         else:
-            runs += [("analytic", v) for v in plan.analytic]
+            if len(plan.analytic) > MANY_STARTS and not extra:  # a sweep of closed-form points: the best few
+                best = self._family_starts(problem, plan, designs)
+                runs += [("analytic", v, *b) for _, v, *b in best]
+            else:
+                runs += [("analytic", v) for v in plan.analytic]
             runs += [("multistart", v) for v in starts_.sobol(problem, starts_n, seed, designs)]
         cands += self._run(problem, runs, targets, max_rounds, designs, both_ways=False)
         good = [c for c in cands if c.ok]
         if not good and any(o == "multistart" for o, *_ in runs):  # the other way of meeting the TR equality
             cands += self._run(problem, [r for r in runs if r[0] == "multistart"], targets, max_rounds, designs, True)
             good = [c for c in cands if c.ok]
-        if plan.kind == "enumeration" and not extra and not good:  # the closed form missed: search instead
+        if plan.kind == "enumeration" and not extra and not good and not diagnose:  # every design, none valid
+            why = sorted({c.info.get("reason", "") or "it breaks a condition" for c in cands})
+            msg = f"no design: the closed form that gives every design ({plan.how}) gives "
+            msg += f"{plan.outside + len(cands)}" if plan.outside or cands else "none for these targets"
+            msg += f", {plan.outside} outside the bounds" if plan.outside else ""
+            msg += f"; {len(cands)} fail ({'; '.join(why[:3])})" if cands else ""
+            return Result("infeasible", msg, stats={"plan": plan.kind, "starts": len(cands),
+                                                    "t_total": time.perf_counter() - t0})  # fmt: skip
+        if plan.kind == "enumeration" and not extra and not good:  # or the closed form missed: search to be sure
             return self.solve(problem, starts_n=starts_n, use_analytic=False, seed=seed, targets=targets,
                               max_rounds=max_rounds, diagnose=diagnose)  # fmt: skip
         stats = {"starts": len(cands), "plan": plan.kind, "omega2": problem.omega2, "formulations": self.formulations,
@@ -404,8 +424,14 @@ class Solver:
             if (best < bound) if sense == "lower" else (best > bound):
                 span = (0.0, best) if sense == "lower" else (best, math.inf)
                 word = "largest" if sense == "lower" else "smallest"
-                msg = (f"{key} {bound:.6g} is beyond reach: the {word} {quantity} of a design meeting the targets "
-                       f"and the other conditions is {best:.6g} ({r.certificate.global_claim})")  # fmt: skip
+                unit = {"gamma_min": " rad", "sum": "", "longest": "", "footprint": " length^2",
+                        "peak_accel": " length/s^2", "peak_velocity": " length/s"}[quantity]  # fmt: skip
+
+                def show(v, unit=unit):
+                    return f"{v:.6g}{unit}" + (f" ({math.degrees(v):.2f} deg)" if unit == " rad" else "")
+
+                msg = (f"{key} {show(bound)} is beyond reach: the {word} {quantity} of a design meeting the "
+                       f"targets and the other conditions is {show(best)} ({r.certificate.global_claim})")  # fmt: skip
                 return msg, {quantity: span}
         return None
 

@@ -24,6 +24,7 @@ class Plan:
     analytic: tuple
     kind: str
     how: str
+    outside: int = 0  # closed-form points of an enumeration left out as outside the bounds
 
 
 def _build(problem, values, branch):
@@ -45,17 +46,23 @@ def plan(problem, use_analytic: bool = True) -> Plan:
     def clip(v):
         return {k: min(max(x, problem.free[k][0]), problem.free[k][1]) for k, x in v.items()}
 
+    if w.kind == "enumeration":  # every design: one outside the bounds is no start, it is not a design here
+        inside = [v for v in w.points if all(lo <= v[k] <= hi for k, (lo, hi) in problem.free.items())]
+        return Plan(tuple(inside), w.kind, w.how, len(w.points) - len(inside))
     return Plan(tuple(clip(v) for v in w.points), w.kind, w.how)
 
 
 def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
     """Up to n scrambled-Sobol points over the free bounds (log-spaced for lengths) whose mechanism turns fully
-    on the first branch; if none does among 8n, the first n points as they are."""
+    on the first branch; if none does among 8n, the first n points as they are. Where every length and offset
+    is free, each point is scaled to meet the stroke target (TR and angles do not change with scale) when the
+    scaled point stays inside the bounds."""
     if n <= 0:
         return []
     names = list(problem.free)
     points, kept = [], []
     branch = branches(problem)[0]
+    build = build or _build
     for row in qmc.Sobol(len(names), scramble=True, seed=seed).random(8 * n):
         v = {}
         for k, x in zip(names, row, strict=True):
@@ -63,10 +70,25 @@ def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
             v[k] = lo * (hi / lo) ** x if k in problem.mechanism.LENGTHS and lo > 0 else lo + (hi - lo) * x
         points.append(v)
         if orientation(problem, v, branch, build) is not None:
-            kept.append(v)
+            kept.append(_to_stroke(problem, v, branch, build))
             if len(kept) == n:
                 break
     return kept or points[:n]
+
+
+def _to_stroke(problem, values, branch, build) -> dict:
+    """The design scaled so that its stroke meets the target, if scaling is free and stays in bounds."""
+    stroke = problem.targets.get("stroke")
+    scalable = [k for k in problem.mechanism.PARAMS if k in problem.mechanism.LENGTHS or k in ("e", "h")]
+    if stroke is None or any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable):
+        return values
+    try:
+        k = stroke / build(problem, values, branch).stroke()
+    except QroptError:
+        return values
+    scaled = {name: x * k if name in scalable else x for name, x in values.items()}
+    inside = all(lo <= scaled[name] <= hi for name, (lo, hi) in problem.free.items())
+    return scaled if inside else values
 
 
 def orientation(problem, values, branch, build=None) -> int | None:

@@ -233,7 +233,7 @@ def test_gamma_min_condition_is_respected():
         p.build({"r3": s.r3, "r5": 0.15}, {"sigma": -1.0, "sigma_slider": 1.0}).gamma_min().value
         for s in analytic.drag_link_r3(1.5, 0.1, 0.225, 0.275)
     )
-    assert r.status == "infeasible" and "gamma_min 0.523599 is beyond reach" in r.message
+    assert r.status == "infeasible" and "gamma_min 0.523599 rad (30.00 deg) is beyond reach" in r.message
     assert r.reachable["gamma_min"][1] == pytest.approx(best, abs=1e-9) and math.degrees(best) < 30
 
 
