@@ -23,7 +23,6 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import NamedTuple
 
-import cvxpy as cp
 import numpy as np
 import scipy.optimize
 import scipy.sparse as sp
@@ -302,8 +301,10 @@ def _groups(g: _Grid, lim: dict, force: float, inertia: float):
     return groups, equal
 
 
-def _solve(problem: cp.Problem) -> str | None:
+def _solve(problem) -> str | None:
     """Solve with CLARABEL: the cvxpy status, or 'error: ...' if the solver raised."""
+    import cvxpy as cp  # imported on use: it takes a fraction of a second to import
+
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # an inaccurate solution is reported as status 'acceptable'
@@ -316,6 +317,8 @@ def _solve(problem: cp.Problem) -> str | None:
 def _diagnose(groups, equal, n: int) -> tuple[tuple, str]:
     """Phase one: relax each limit by a relative slack, minimise their sum; the limits whose rows carry
     dual weight conflict, and the slacks say by how much relaxing them would do."""
+    import cvxpy as cp  # imported on use: it takes a fraction of a second to import
+
     names = list(dict.fromkeys([name for name, _, _ in groups] + (["v_cut"] if equal is not None else [])))
     beta, s = cp.Variable(n, nonneg=True), cp.Variable(len(names), nonneg=True)
     cons, owner = [], []
@@ -374,6 +377,8 @@ def speed_profile(
     'min_cycle_time', or 'min_return_time' (then the shortest cycle among the fastest returns).
     Invalid input raises InvalidParameter; an infeasible set of limits returns status 'infeasible'.
     """
+    import cvxpy as cp  # imported on use: it takes a fraction of a second to import
+
     if not isinstance(mechanism, Mechanism):
         raise InvalidParameter(f"speed_profile needs a qropt mechanism, got {mechanism!r}")
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_CELLS <= n <= MAX_CELLS:

@@ -10,7 +10,6 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.stats import qmc
 
 from qropt import analytic
 from qropt.errors import QroptError
@@ -59,6 +58,8 @@ def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
     scaled point stays inside the bounds."""
     if n <= 0:
         return []
+    from scipy.stats import qmc  # imported here: scipy.stats takes a second to import
+
     names = list(problem.free)
     points, kept = [], []
     branch = branches(problem)[0]

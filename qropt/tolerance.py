@@ -16,7 +16,6 @@ import warnings
 from dataclasses import dataclass, field
 
 import casadi
-import cvxpy as cp
 import numpy as np
 from tqdm import tqdm
 
@@ -228,6 +227,8 @@ def allocate(mechanism: Mechanism, limits: dict, *, params=None, method: str = "
     limits: {quantity: E > 0} over time_ratio, stroke (length), gamma_min (rad), peak_acceleration
     (length/s^2, needs omega2); params: the toleranced names (default: lengths and offsets); weights:
     {param: w > 0} (default 1); bounds: {param: (low, high)} on t."""
+    import cvxpy as cp  # imported on use: it takes a fraction of a second to import
+
     names, omega2 = _names(mechanism, params), _omega2(omega2)
     if method not in METHODS:
         raise InvalidParameter(f"method must be one of {METHODS}, got {method!r}")
@@ -275,6 +276,8 @@ def allocate(mechanism: Mechanism, limits: dict, *, params=None, method: str = "
 def _convex(a, w, lo, hi, method):
     """maximise w . log u s.t. each row's stack-up of a u <= 1, lo <= u <= hi, with cvxpy (CLARABEL), then
     polished on the KKT equations of the active set. Returns (u or None, 'polished' or the cvxpy status)."""
+    import cvxpy as cp  # imported on use: it takes a fraction of a second to import
+
     u = cp.Variable(w.size, pos=True)
     cons = [(r @ u if method == "worst-case" else cp.norm(cp.multiply(r, u))) <= 1 for r in a] + [u >= lo]
     if np.isfinite(hi).any():

@@ -57,9 +57,10 @@ def run(args) -> int:
         cmp.to_csv(args.csv)
     if plot:
         cmp.plot(plot)
+    code = 0 if any(r.success for r in cmp.rows) else 1
     if args.json:
         print(cmp.to_json())
-        return 0
+        return code
     print(f"TR {args.tr:g}, stroke {args.stroke:g}, omega2 {args.omega2:g} rad/s: best by {args.objective} first")
     print(f"  {'type':20s} {'gamma_min':>10s} {'footprint':>11s} {'sum':>8s} {'peak accel':>11s} "
           f"{'peak v':>9s} {'T/F':>8s}")  # fmt: skip
@@ -77,4 +78,4 @@ def run(args) -> int:
         print(f"table written to {args.csv}")
     if plot:
         print(f"picture written to {plot}")
-    return 0
+    return code
