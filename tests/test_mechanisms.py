@@ -11,7 +11,7 @@ from qropt.ops import CASADI
 from tests import brute
 from tests.randmech import KINDS, random_mechanisms
 
-N_RANDOM = 200
+N_RANDOM = 120
 
 
 def _rel(a, b):

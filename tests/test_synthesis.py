@@ -15,7 +15,7 @@ from qropt import ProblemError, Solver, analytic, solve
 from tests import brute
 from tests.synth_tasks import TASKS
 
-N_TASKS = 12
+N_TASKS = 8
 
 
 def load(name):
