@@ -114,7 +114,9 @@ def main() -> None:
           f"largest objective difference {diff:.1e} rad ({worse} cells better by an independent solve, "
           f"{better} better in the chart)")  # fmt: skip
 
-    per_tile = max(0.0, t_warm - makespan(tiles, 2, 0.0)) / (len(tiles) / 2)  # Dask and transfer cost per tile
+    per_tile = max(0.0, t_warm - makespan(tiles, 2, 0.0)) / (
+        len(tiles) / 2
+    )  # the cluster's cost per tile over the clean tile times
     n_full = here.stats["full"]
     k = t_here / sum(c.seconds for c in here.cells)  # cell times from the main process, scaled to the clean run's
     t_full = k * sum(c.seconds for c in here.cells if c.method == "full") / n_full
@@ -174,8 +176,9 @@ def markdown(d: dict, env: dict) -> str:
         f"{1e3 * d['mean_full_s']:.1f} ms, a continued cell {1e3 * d['mean_continued_s']:.1f} ms on average)",
         f"- agreement: largest objective difference to the independent solves {d['max_objective_difference']:.1e} rad; "
         f"cells where an independent solve is better by 1e-7: {d['independent_better']}",
-        f"- {d['tiles']} tiles of {d['tile'][0]} x {d['tile'][1]}; Dask and transfer cost "
-        f"{1e3 * d['dask_per_tile_s']:.0f} ms a tile (measured on the warm 2-worker run)",
+        f"- {d['tiles']} tiles of {d['tile'][0]} x {d['tile'][1]}; the 2-worker run takes "
+        f"{1e3 * d['dask_per_tile_s']:.0f} ms a tile more than the single-process tile times add up to (Dask, "
+        "transfer, and two processes sharing the machine's two cores)",
         "",
         "Estimated (a schedule of measured tile times, each worker taking the next tile when free, plus the "
         "per-tile cost): this chart on " + ", ".join(f"{w} workers {s:.2f} s" for w, s in

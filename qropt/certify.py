@@ -154,10 +154,10 @@ def _certify(problem, range_target, m, th, z, f, gap_tol, feas_tol):
         exact = m.size(problem.size)
         info.update(nlp=f, certified=exact, gap=abs(exact - f) if f is not None else 0.0)
     for key, v in criteria.violations(problem, m).items():  # a bound the samples missed: add where it is exceeded
-        if v <= feas_tol:
+        if v <= feas_tol:  # (first: feasibility takes a free slot before the objective's angles)
             continue
         if key.startswith("gamma_min"):
-            add.append(g.theta2)
+            add.insert(0, g.theta2)
         elif key.startswith("max_footprint"):
             add += list(m.bounding_box().angles)
         elif key.startswith("max_peak_velocity"):

@@ -379,17 +379,21 @@ class Solver:
     def _diagnose(self, problem, cands, targets, starts_n, seed, stats, t0):
         """No certified design: say why (a target out of its reachable range, or nothing meets all together)."""
         reasons = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
-        beyond = self._bound_out_of_reach(problem, targets, starts_n, seed)
+        beyond, found = self._bound_out_of_reach(problem, targets, starts_n, seed)
         if beyond:
             stats["t_total"] = time.perf_counter() - t0
             return Result("infeasible", beyond[0], stats=stats, reachable=beyond[1])
+        if found:  # a design optimising a bounded criterion meets every bound: refine from it
+            r = self.solve(problem, targets=targets, starts_n=0, seed=seed, extra_starts=found, diagnose=False)
+            if r.success:
+                return r
         reach, msgs = {}, []
         for k, v in targets.items():
             lo, hi = self.target_range(problem, k, targets, starts_n=starts_n, seed=seed)
             reach[k] = (lo, hi)
             msgs.append(_range_message(problem, k, v, lo, hi))
         stats["t_total"] = time.perf_counter() - t0
-        outside = [m for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True) if not lo <= targets[k] <= hi]
+        outside = [m for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True) if not _inside(targets[k], lo, hi)]
         if outside:
             return Result("infeasible", "; ".join(outside), stats=stats, reachable=reach)
         if all(max(c.residuals.values(), default=0.0) > self.tolerances["feasibility"] or c.mechanism is None
@@ -401,14 +405,19 @@ class Solver:
             how = ", ".join(f"{n} {k}" for k, n in sorted(ends.items(), key=lambda kv: -kv[1]))
             msg = f"none of {len(cands)} starts reaches a design meeting the targets and conditions together "
             msg += f"(IPOPT: {how}), though each target alone can be met (" + "; ".join(msgs) + ")"
-            return Result("infeasible", msg, stats=stats, reachable=reach)
+            # IPOPT's own failures (invalid numbers, iteration limits) prove nothing: only converged or
+            # infeasible-detected runs make the problem infeasible
+            proved = any(k in ("Infeasible_Problem_Detected", "Solve_Succeeded", ACCEPTABLE) for k in ends)
+            return Result("infeasible" if proved else "failed", msg, stats=stats, reachable=reach)
         why = "; ".join(r for r in reasons[:3] if r)
         return Result("failed", f"no start converged to a certified design ({why}); " + "; ".join(msgs),
                       stats=stats, reachable=reach)  # fmt: skip
 
     def _bound_out_of_reach(self, problem, targets, starts_n, seed):
-        """(message, {quantity: (low, high)}) if a bound condition is beyond what any design meeting the targets
-        and the other conditions reaches (its best value, from a solve optimising it), else None."""
+        """((message, {quantity: (low, high)}) if a bound condition is beyond what any design meeting the targets
+        and the other conditions reaches (its best value, from a solve optimising it), else None; and the designs
+        of those solves that meet every bound, as starts)."""
+        found = []
         for key, (quantity, sense) in BOUNDS.items():
             bound = problem.conditions.get(key)
             if bound is None:
@@ -420,6 +429,9 @@ class Solver:
             r = self.solve(sub, targets=targets, starts_n=starts_n, seed=seed)
             if r.status not in ("optimal", "acceptable"):
                 continue
+            tol = self.tolerances["feasibility"]
+            found += [{k: o.params[k] for k in problem.free} for o in r.local_optima or (r,)
+                      if max(violations(problem, o.mechanism).values(), default=0.0) <= tol]  # fmt: skip
             best = r.objective
             if (best < bound) if sense == "lower" else (best > bound):
                 span = (0.0, best) if sense == "lower" else (best, math.inf)
@@ -432,8 +444,8 @@ class Solver:
 
                 msg = (f"{key} {show(bound)} is beyond reach: the {word} {quantity} of a design meeting the "
                        f"targets and the other conditions is {show(best)} ({r.certificate.global_claim})")  # fmt: skip
-                return msg, {quantity: span}
-        return None
+                return (msg, {quantity: span}), []
+        return None, found
 
     # ---- reachable range of one target ---------------------------------------------------------------
     def target_range(self, problem, target, targets=None, *, starts_n=None, seed=None):
@@ -576,11 +588,17 @@ def _distinct(cands):
     return out
 
 
+def _inside(v, lo, hi) -> bool:
+    """v within a found range, to 1e-6 relative: the range's ends are designs found, not proofs of an end."""
+    tol = 1e-6 * max(1.0, abs(v))
+    return lo - tol <= v <= hi + tol
+
+
 def _range_message(problem, k, v, lo, hi):
     bounds = ", ".join(f"{n} in [{a:g}, {b:g}]" for n, (a, b) in problem.free.items())
     if not math.isfinite(lo):
         return f"no design turns fully and meets the conditions for {bounds}"
-    where = "below" if v < lo else "above" if v > hi else "inside"
+    where = "inside" if _inside(v, lo, hi) else "below" if v < lo else "above"
     return f"{k} {v:g} is {where} the reachable {lo:.6g}..{hi:.6g} for {bounds}"
 
 

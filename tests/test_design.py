@@ -296,3 +296,20 @@ def test_pareto_rejects_bad_input():
         pareto(problem_bases.classic_crank_rocker(), ("max_gamma_min", "min_peak_accel"))
     with pytest.raises(QroptError):
         pareto({"mechanism": "slider-crank"}, ("max_gamma_min", "min_size"))
+
+
+def test_bad_command_lines_are_one_line(capsys):
+    from qropt.cli import main
+
+    file = str(__import__("pathlib").Path(__file__).resolve().parents[1] / "problems" / "slider_crank_gamma.py")
+    cases = [(["design", "--tr", "0.5", "--stroke", "0.3"], 1), (["design", "--tr", "1.5"], 2),
+             (["design", "--tr", "1.5", "--stroke", "0.3", "--types", "bogus"], 1),
+             (["design", "--tr", "1.5", "--stroke", "0.3", "--gamma-min", "forty"], 2),
+             (["design", "--tr", "1.5", "--stroke", "0.3", "--plot", "x.txt"], 2),
+             (["pareto", file, "--objectives", "max_gamma_min", "max_gamma_min"], 1),
+             (["pareto", file, "--objectives", "max_gamma_min", "min_peak_accel", "--n", "1"], 1),
+             (["pareto", file, "--objectives", "max_gamma_min"], 2)]  # fmt: skip
+    for args, code in cases:
+        assert main(args) == code, args
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == len(cases) and all(line.startswith("qropt:") for line in err), err
