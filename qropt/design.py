@@ -71,7 +71,8 @@ class Row:
 
 @dataclass(frozen=True)
 class Comparison:
-    """The task solved for several types: ``rows`` best first by the objective, types without a design last."""
+    """The task solved for several types: ``rows`` best first by the objective, types without a design last;
+    ``fronts``: type -> its Front, or why it has none (with ``design(..., pareto=(a, b))``)."""
 
     time_ratio: float
     stroke: float
@@ -124,7 +125,8 @@ def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min"
     """Solve the task (TR, stroke) for every type (or ``types``) and compare; see the module docstring.
 
     objective: as Problem.objective; conditions: bound conditions for every type (e.g. {'gamma_min': 0.7});
-    pareto: two objectives whose front is computed for every type (``n`` points each); progress: a callable
+    pareto: two objectives whose front is computed for every type (``n`` points each; a type without one gets
+    the reason in ``Comparison.fronts``); progress: a callable
     called once per finished type.
     """
     from qropt.solve import DEFAULT
@@ -150,7 +152,10 @@ def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min"
         if pareto is not None:
             from qropt.pareto import pareto as front
 
-            fronts[kind] = front(p, pareto, n=n, solver=solver)
+            try:
+                fronts[kind] = front(p, pareto, n=n, solver=solver)
+            except ProblemError as e:  # this type has no front (an end has no design): say why, keep the others
+                fronts[kind] = str(e)
         if progress:
             progress(1)
     maximise = criteria.maximises(objective)

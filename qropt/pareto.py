@@ -81,6 +81,9 @@ def pareto(problem: Problem, objectives=("max_gamma_min", "min_peak_accel"), n: 
     for end, name in ((end_a, a), (end_b, b)):
         if end.status not in SOLUTION_PRESENT:
             raise ProblemError(f"no front: the problem has no design for {name} ({end.status}: {end.message})")
+    # each end the best in the other criterion among its own optima (several designs can share an optimum)
+    end_a = _lexicographic(solver, base, end_a, a, b, problem.size)
+    end_b = _lexicographic(solver, base, end_b, b, a, problem.size)
     lo, hi = _value(problem, qb, end_a), _value(problem, qb, end_b)
     runs = [(None, end_a)]
     prev = end_a
@@ -96,6 +99,24 @@ def pareto(problem: Problem, objectives=("max_gamma_min", "min_peak_accel"), n: 
             progress(1)
     runs.append((None, end_b))
     return _front(problem, (a, b), (qa, qb), runs)
+
+
+LEXICOGRAPHIC = 1e-7  # relative give on an end's own optimum while the other criterion is optimised
+
+
+def _lexicographic(solver, base, end, first, second, size):
+    """The design optimising ``second`` among those within LEXICOGRAPHIC of ``end``'s optimum of ``first`` (the
+    end itself if that solve does not improve on it)."""
+    q1, q2 = criteria.measured(first, size), criteria.measured(second, size)
+    v1 = criteria.value(base, q1, end.mechanism)
+    give = LEXICOGRAPHIC * max(1.0, abs(v1))
+    bound = v1 - give if q1 == "gamma_min" else v1 + give
+    p = base.replace(objective=second, conditions={**base.conditions, criteria.bound_of(first, size): bound})
+    r = solver.solve(p, extra_starts=[_free(p, end)], starts_n=0, use_analytic=False, diagnose=False)
+    if r.status not in SOLUTION_PRESENT:
+        return end
+    better = criteria.better(p, criteria.value(base, q2, r.mechanism), criteria.value(base, q2, end.mechanism))
+    return r if better else end
 
 
 def _front(problem, objectives, names, runs) -> Front:

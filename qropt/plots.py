@@ -219,10 +219,14 @@ def comparison_figure(cmp):
         ax.tick_params(labelsize=7)
     if cmp.fronts:
         ax = axes[len(rows)]
-        for k, front in cmp.fronts.items():
-            va, vb = np.array(front.values).T if front.values else ([], [])
+        drawn = {k: f for k, f in cmp.fronts.items() if not isinstance(f, str) and f.values}
+        for k, front in drawn.items():
+            va, vb = np.array(front.values).T
             ax.plot(*_front_xy(front, va, vb), "o-", ms=3, label=k)
-        a, b = next(iter(cmp.fronts.values())).criteria
+        for k in cmp.fronts:
+            if k not in drawn:
+                ax.plot([], [], " ", label=f"{k}: no front")
+        a, b = next(iter(drawn.values())).criteria if drawn else ("gamma_min", "peak_accel")
         ax.set_xlabel(_label(a))
         ax.set_ylabel(_label(b))
         ax.set_title("trade-off fronts")
