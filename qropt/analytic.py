@@ -178,6 +178,39 @@ def crank_rocker_extremes(r1: float, r2: float, r3: float, r4: float, sigma: flo
     return RockerExtremes(t2e, t2f, t4e, t4f, abs(t4e - t4f), time_ratio_from_centres(t2e, t2f))
 
 
+def _roots(g, lo, hi, n):
+    """Every root of g on [lo, hi] that changes sign between n grid points, refined by brentq."""
+    from scipy.optimize import brentq
+
+    xs = np.linspace(lo, hi, n)
+    v = np.array([g(x) for x in xs])
+    return [brentq(g, xs[i], xs[i + 1], xtol=1e-15) for i in np.flatnonzero(np.sign(v[:-1]) != np.sign(v[1:]))]
+
+
+def crank_rocker_r3(time_ratio: float, r1: float, r2: float, r4: float, n: int = 160) -> list[float]:
+    """Every coupler r3 of a Grashof crank-rocker (crank r2 shortest; r1, r4 given) whose rocker has this TR:
+    the closed-form TR of ``crank_rocker_extremes`` on n values of r3, roots refined by brentq."""
+    lo, hi = max(r2, r4 - r1 + r2, r1 - r4 + r2) * (1 + 1e-9), (r1 + r4 - r2) * (1 - 1e-9)
+    if not lo < hi:
+        return []
+    return _roots(lambda r3: crank_rocker_extremes(r1, r2, r3, r4).time_ratio - time_ratio, lo, hi, n)
+
+
+def rocker_slider_r5(stroke: float, r1: float, r2: float, r3: float, r4: float, r6: float, n: int = 100) -> list[float]:
+    """Every output arm r5 of a crank-rocker slider with its slide line through the pivots (h = 0) and rod r6
+    giving this stroke: a slider that reverses once does so with the rocker, so the stroke is the slider's
+    travel between the rocker's limits."""
+    e = crank_rocker_extremes(r1, r2, r3, r4)
+
+    def travel(r5):
+        def x(t4):
+            return r5 * math.cos(t4) + math.sqrt(max(r6 * r6 - (r5 * math.sin(t4)) ** 2, 0.0))
+
+        return abs(x(e.theta4_extended) - x(e.theta4_folded)) - stroke
+
+    return _roots(travel, 1e-3 * r6, 0.95 * r6, n)
+
+
 # ---- synthesis families -----------------------------------------------------------------------
 class SliderCrankDesign(NamedTuple):
     """An offset slider-crank meeting a TR and stroke: r2, r3, e."""
@@ -273,7 +306,15 @@ def warm_starts(problem) -> WarmStarts:
 
     Each start is verified later by the solver; a start that does not build is dropped there.
     """
-    from qropt.mechanisms import CrankShaper, DragLinkSlider, FourBar, FourBarSlider, SliderCrank, Whitworth
+    from qropt.mechanisms import (
+        CrankRockerSlider,
+        CrankShaper,
+        DragLinkSlider,
+        FourBar,
+        FourBarSlider,
+        SliderCrank,
+        Whitworth,
+    )
 
     cls, fixed, free, tg = problem.mechanism, problem.fixed, problem.free, problem.targets
     val = {**fixed, **{k: 0.5 * (lo + hi) for k, (lo, hi) in free.items()}}
@@ -289,6 +330,15 @@ def warm_starts(problem) -> WarmStarts:
     def result(kind, how):
         return WarmStarts(out, kind if out else "none", how if out else "no closed form applies")
 
+    if cls is CrankRockerSlider and set(free) == {"r3", "r4", "r5"} and fixed.get("h", 0.0) == 0.0 and tr and stroke:
+        for k in (0, 1):  # each root of the rocker's TR in r3 is a branch of the family; r4 walks it
+            for r4 in np.linspace(*free["r4"], FAMILY_POINTS):
+                roots = crank_rocker_r3(tr, val["r1"], val["r2"], float(r4))
+                if len(roots) > k:
+                    for r5 in rocker_slider_r5(stroke, val["r1"], val["r2"], roots[k], float(r4), val["r6"]):
+                        emit(r3=roots[k], r4=float(r4), r5=r5)
+        how = "the rocker's TR gives r3 and the stroke r5 for each r4 (slide line through the pivots); r4 walks it"
+        return result("family", how)
     lifted = {"r2", "r4", "r5"} <= set(free)  # every link of the four-bar and the arm free: the generic starts
     if cls is DragLinkSlider and tr is not None and "r3" in free and fixed.get("h", 0.0) == 0.0 and not lifted:
         r5 = {"r5": stroke / 2} if stroke is not None and "r5" in free else {}
@@ -305,6 +355,13 @@ def warm_starts(problem) -> WarmStarts:
                                    free["r2"][1] / ratio), FAMILY_POINTS):  # fmt: skip
                 emit(r1=float(r1), r2=float(ratio * r1), **lever)
             return result("family", "sin(beta) = r2/r1 fixes the TR; stroke = 2 r4 r2/r1; r1 walks the family")
+        rod = "r6" in free and "h" not in free and stroke is not None and len(free) == 3 and "r4" in free
+        if rod and ("r2" in free) != ("r1" in free):  # the rod's slider reverses where the lever does
+            for r6 in np.geomspace(*free["r6"], FAMILY_POINTS):
+                crank = {"r2": ratio * val["r1"]} if "r2" in free else {"r1": val["r2"] / ratio}
+                emit(**crank, **lever, r6=float(r6))
+            return result("family", "sin(beta) = r2/r1 fixes the TR and stroke = 2 r4 r2/r1 for every rod (a slider "
+                          "reversing once does so with the lever); the rod r6 walks the family")  # fmt: skip
         if "r2" in free:
             emit(r2=ratio * val["r1"], **lever)
         elif "r1" in free:

@@ -93,17 +93,8 @@ def slider_crank_family(tr, stroke):
 
 
 def crank_rocker_r3(tr, r1, r2, r4):
-    """Every r3 of a crank-rocker (r1, r2, r4 given) whose rocker TR is tr (closed form + brentq)."""
-    lo, hi = max(r2, r4 - r1 + r2, r1 - r4 + r2) * (1 + 1e-9), (r1 + r4 - r2) * (1 - 1e-9)
-    if not lo < hi:
-        return []
-
-    def g(r3):
-        return analytic.crank_rocker_extremes(r1, r2, r3, r4).time_ratio - tr
-
-    xs = np.linspace(lo, hi, 400)
-    v = np.array([g(x) for x in xs])
-    return [brentq(g, xs[i], xs[i + 1], xtol=1e-15) for i in np.flatnonzero(np.sign(v[:-1]) != np.sign(v[1:]))]
+    """Every r3 of a crank-rocker (r1, r2, r4 given) whose rocker TR is tr, on a finer grid than the starts'."""
+    return analytic.crank_rocker_r3(tr, r1, r2, r4, n=400)
 
 
 def crank_rocker_slider_family(tr, stroke, r1, r2, r6, pick):

@@ -247,6 +247,9 @@ class Solver:
             msg += f"; {len(cands)} fail ({'; '.join(why[:3])})" if cands else ""
             return Result("infeasible", msg, stats={"plan": plan.kind, "starts": len(cands),
                                                     "t_total": time.perf_counter() - t0})  # fmt: skip
+        if plan.kind == "family" and not extra and not good:  # no point of the family refines: search instead
+            return self.solve(problem, starts_n=starts_n, use_analytic=False, seed=seed, targets=targets,
+                              max_rounds=max_rounds, diagnose=diagnose)  # fmt: skip
         if plan.kind == "enumeration" and not extra and not good:  # or the closed form missed: search to be sure
             return self.solve(problem, starts_n=starts_n, use_analytic=False, seed=seed, targets=targets,
                               max_rounds=max_rounds, diagnose=diagnose)  # fmt: skip
