@@ -323,8 +323,8 @@ def warm_starts(problem) -> WarmStarts:
     out = []
 
     def emit(**set_):
-        if all(k in free for k in set_) or issubclass(cls, FourBarSlider):
-            v = {**val, **{k: x for k, x in set_.items() if k in free}}
+        if all(k in free for k in set_):
+            v = {**val, **set_}
             out.append({k: v[k] for k in free})
 
     def result(kind, how):
@@ -416,11 +416,14 @@ def warm_starts(problem) -> WarmStarts:
         # the four-bar from its closed form, the slide line through the pivots (h = 0), the output arm r5 sized
         # for the stroke and a rod twice as long: starts near the targets for every other free parameter
         r1 = stroke if "r1" in free else val["r1"]
-        arm = {"h": 0.0} if "h" in free else {}
+
+        def emit_free(**design):  # the fixed parameters keep their values
+            emit(**{k: x for k, x in design.items() if k in free})
+
         if cls is DragLinkSlider:
             for k2, k4 in ((2.0, 2.5), (3.0, 3.5), (2.5, 4.0)):
                 for d in drag_link_r3(tr, r1, k2 * r1, k4 * r1):
-                    emit(**{"r1": r1, "r2": k2 * r1, "r3": d.r3, "r4": k4 * r1, "r5": stroke / 2, "r6": stroke, **arm})
+                    emit_free(r1=r1, r2=k2 * r1, r3=d.r3, r4=k4 * r1, r5=stroke / 2, r6=stroke, h=0.0)
             how = "eqs. (7)-(13) give r3 for a few drag-links; r5 = stroke/2, h = 0"
         else:
             for swing in np.radians([40.0, 60.0, 80.0]):
@@ -428,7 +431,7 @@ def warm_starts(problem) -> WarmStarts:
                     d = crank_rocker_design(tr, float(swing), r1, pos)
                     if d is not None:
                         r5 = stroke / (2 * math.sin(swing / 2))
-                        emit(**{"r1": r1, "r2": d.r2, "r3": d.r3, "r4": d.r4, "r5": r5, "r6": 2 * r5, **arm})
+                        emit_free(r1=r1, r2=d.r2, r3=d.r3, r4=d.r4, r5=r5, r6=2 * r5, h=0.0)
             how = "the classical crank-rocker construction at swings 40-80 deg; r5 from the stroke, h = 0"
         return result("partial", how)
     return result("none", "")

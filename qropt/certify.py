@@ -153,16 +153,17 @@ def _certify(problem, range_target, m, th, z, f, gap_tol, feas_tol):
     elif obj == "min_size":
         exact = m.size(problem.size)
         info.update(nlp=f, certified=exact, gap=abs(exact - f) if f is not None else 0.0)
-    for key, v in criteria.violations(problem, m).items():  # a bound the samples missed: add where it is exceeded
-        if v <= feas_tol:  # (first: feasibility takes a free slot before the objective's angles)
-            continue
-        if key.startswith("gamma_min"):
+    exceeded = criteria.violations(problem, m)  # a bound the samples missed: add where it is exceeded
+    for key, (quantity, _) in criteria.BOUNDS.items():
+        if exceeded.get(f"{key} bound (exact)", 0.0) <= feas_tol:  # (feasibility first: it takes a free slot
+            continue  # before the objective's angles)
+        if quantity == "gamma_min":
             add.insert(0, g.theta2)
-        elif key.startswith("max_footprint"):
+        elif quantity == "footprint":
             add += list(m.bounding_box().angles)
-        elif key.startswith("max_peak_velocity"):
+        elif quantity == "peak_velocity":
             frac += _working_fractions(m, None, m.peak_velocity().theta2)
-        elif key.startswith("max_peak_accel"):
+        elif quantity == "peak_accel":
             t = m.peak_acceleration(1.0, problem.accel_over).theta2
             if problem.accel_over == "working":
                 frac += _working_fractions(m, None, t)

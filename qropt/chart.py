@@ -20,6 +20,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from qropt.criteria import maximises
 from qropt.errors import ProblemError, QroptError
 from qropt.problem import Problem
 from qropt.result import Result
@@ -393,7 +394,7 @@ def _panel(ch: Chart, name: str) -> tuple:
     """Values and title of one panel: the objective (gamma_min in degrees) or a parameter."""
     if name != "objective":
         return ch.grid(name), f"optimal {name}"
-    if ch.problem.objective == "max_gamma_min":
+    if maximises(ch.problem.objective):  # gamma_min, the one maximised criterion
         return np.degrees(ch.grid()), "best gamma_min [deg]"
     return ch.grid(), f"{ch.problem.objective or 'feasible'}: objective"
 
@@ -440,7 +441,7 @@ def chart_figure(ch: Chart):
     ridge = None
     if ch.y.kind == "fixed":  # a design choice on y: its best value for each x
         z = _panel(ch, "objective")[0]
-        sign = 1.0 if ch.problem.objective == "max_gamma_min" else -1.0
+        sign = 1.0 if maximises(ch.problem.objective) else -1.0
         cols_ok = np.isfinite(z).any(axis=0)
         ridge = (xs[cols_ok], ys[np.nanargmax(sign * np.where(np.isfinite(z), z, -np.inf * sign), axis=0)][cols_ok])
     for ax, name in zip(axes.flat, names, strict=False):

@@ -27,6 +27,7 @@ import dask
 from qropt import starts
 from qropt.certify import better
 from qropt.chart import Axis, Cell, ChartError, axis_kind, problem_at
+from qropt.criteria import maximises
 from qropt.errors import QroptError
 from qropt.problem import Problem
 from qropt.result import Result
@@ -102,7 +103,7 @@ class _Tile:
         if a.objective is None or b.objective is None:
             return False
         tol = BETTER * max(1.0, abs(b.objective))
-        return better(self.problem, a.objective, b.objective + (tol if self.problem.objective == "max_gamma_min"
+        return better(self.problem, a.objective, b.objective + (tol if maximises(self.problem.objective)
                                                                  else -tol))  # fmt: skip
 
     def full(self, problem) -> Result:

@@ -65,6 +65,21 @@ def value(problem, quantity: str, m) -> float:
     raise KeyError(quantity)
 
 
+def in_nlp_terms(quantity: str, v: float, omega2: float) -> float:
+    """A criterion's value as the NLP states it: cos gamma_min, accelerations per omega2^2 and velocities per
+    |omega2| (the NLP works at omega2 = 1), sizes as they are."""
+    if quantity == "gamma_min":
+        return math.cos(v)
+    return v / {"peak_accel": omega2**2, "peak_velocity": abs(omega2)}.get(quantity, 1.0)
+
+
+def objective_for(quantity: str) -> tuple[str, str | None]:
+    """(objective, size measure or None) that optimises a criterion: the inverse of ``measured``."""
+    if quantity in SIZES:
+        return "min_size", quantity
+    return ("max_" if quantity == "gamma_min" else "min_") + quantity, None
+
+
 def violations(problem, m) -> dict:
     """Exact violation (>= 0) of each bound condition of the problem: '<condition> bound (exact)' -> value."""
     out = {}
@@ -102,8 +117,9 @@ def better(problem, a, b) -> bool:
 
 
 def finite(v) -> bool:
+    """A finite real number (not a bool)."""
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
-__all__ = ["OBJECTIVES", "SIZES", "BOUNDS", "UNITS", "maximises", "measured", "bound_of", "value", "violations",
-           "objective_of", "objective_value", "better"]  # fmt: skip
+__all__ = ["OBJECTIVES", "SIZES", "BOUNDS", "UNITS", "maximises", "measured", "bound_of", "objective_for",
+           "in_nlp_terms", "value", "violations", "objective_of", "objective_value", "better", "finite"]  # fmt: skip

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from qropt import criteria
 from qropt.errors import ProblemError, QroptError
 from qropt.problem import Problem
-from qropt.result import SOLUTION_PRESENT, Result
+from qropt.result import SOLUTION_PRESENT, Result, json_safe
 
 # type name -> (mechanism kind, free lengths, free offsets, fixed values)
 TYPES = {
@@ -100,7 +100,7 @@ class Comparison:
     def to_json(self) -> str:
         d = {"time_ratio": self.time_ratio, "stroke": self.stroke, "objective": self.objective,
              "omega2": self.omega2, "units": criteria.UNITS, "rows": self.table()}  # fmt: skip
-        return json.dumps(_clean(d), indent=2, allow_nan=False)
+        return json.dumps(json_safe(d), indent=2, allow_nan=False)
 
     def to_csv(self, path) -> None:
         rows = self.table()
@@ -133,9 +133,9 @@ def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min"
 
     solver = solver or DEFAULT
     types = list(TYPES) if types is None else _types(types)
-    if not (_real(time_ratio) and time_ratio >= 1):
+    if not (criteria.finite(time_ratio) and time_ratio >= 1):
         raise ProblemError(f"time_ratio is slow/fast >= 1, got {time_ratio!r}")
-    if not (_real(stroke) and stroke > 0):
+    if not (criteria.finite(stroke) and stroke > 0):
         raise ProblemError(f"stroke must be a positive number, got {stroke!r}")
     if bounds is not None and not isinstance(bounds, dict):
         raise ProblemError(f"bounds is a dict name -> (lower, upper), got {bounds!r}")
@@ -185,22 +185,8 @@ def _types(types) -> list[str]:
     return out
 
 
-def _real(v) -> bool:
-    return criteria.finite(v)
-
-
 def _cell(v):
     return "" if v is None else f"{v:.12g}" if isinstance(v, float) else v
-
-
-def _clean(v):
-    if isinstance(v, float):
-        return v if math.isfinite(v) else None
-    if isinstance(v, dict):
-        return {k: _clean(x) for k, x in v.items()}
-    if isinstance(v, (list, tuple)):
-        return [_clean(x) for x in v]
-    return v
 
 
 __all__ = ["TYPES", "CRITERIA", "type_problem", "design", "Comparison", "Row", "QroptError"]

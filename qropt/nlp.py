@@ -22,7 +22,7 @@ import casadi
 import numpy as np
 
 from qropt.closures import RIGHT_ANGLE, transmission_cos
-from qropt.criteria import BOUNDS, measured
+from qropt.criteria import BOUNDS, in_nlp_terms, measured
 from qropt.mechanisms import FourBar, FourBarSlider
 from qropt.ops import CASADI
 
@@ -257,12 +257,8 @@ class Formulation:
         """The bound conditions' values in the NLP's terms (cos of the gamma_min bound; accelerations and
         velocities per omega2^2 and |omega2|)."""
         problem = problem or self.problem
-        out = []
-        for k in self.bounds_used:
-            b = problem.conditions[k]
-            scale = {"gamma_min": None, "max_peak_accel": problem.omega2**2, "max_peak_velocity": abs(problem.omega2)}
-            out.append(math.cos(b) if k == "gamma_min" else b / scale.get(k, 1.0))
-        return np.array(out, float)
+        return np.array([in_nlp_terms(BOUNDS[k][0], problem.conditions[k], problem.omega2) for k in self.bounds_used],
+                        float)  # fmt: skip
 
     # ---- numbers -------------------------------------------------------------
     def base_samples(self):

@@ -106,19 +106,7 @@ def crank_rocker_slider_family(tr, stroke, r1, r2, r6, pick):
         if len(roots) <= pick:
             return None
         r3 = roots[pick]
-        e = analytic.crank_rocker_extremes(r1, r2, r3, r4)
-
-        def travel(r5):
-            def x(t4):
-                return r5 * math.cos(t4) + math.sqrt(max(r6**2 - (r5 * math.sin(t4)) ** 2, 0.0))
-
-            return abs(x(e.theta4_extended) - x(e.theta4_folded)) - stroke
-
-        grid = np.linspace(1e-3, 0.95 * r6, 200)
-        v = np.array([travel(x) for x in grid])
-        k = np.flatnonzero(np.sign(v[:-1]) != np.sign(v[1:]))
-        if not k.size:
-            return None
-        return {"r3": r3, "r4": r4, "r5": brentq(travel, grid[k[0]], grid[k[0] + 1], xtol=1e-15)}
+        arms = analytic.rocker_slider_r5(stroke, r1, r2, r3, r4, r6, n=200)
+        return {"r3": r3, "r4": r4, "r5": arms[0]} if arms else None
 
     return design

@@ -247,9 +247,9 @@ def _wrap(text, width):
 
 
 def _label(q):
-    units = {"gamma_min": "deg", "sum": "length", "longest": "length", "footprint": "length^2",
-             "peak_accel": "length/s^2", "peak_velocity": "length/s"}  # fmt: skip
-    return f"{q} [{units[q]}]"
+    from qropt.criteria import UNITS
+
+    return f"{q} [{'deg' if q == 'gamma_min' else UNITS[q]}]"
 
 
 def _front_xy(front, va, vb):

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Any
 
-from qropt.criteria import BOUNDS, OBJECTIVES, SIZES, SLIDER_ONLY
+from qropt.criteria import BOUNDS, OBJECTIVES, SIZES, SLIDER_ONLY, finite
 from qropt.errors import ProblemError
 from qropt.mechanisms import FourBar, FourBarSlider, Mechanism, mechanism_type
 from qropt.mechanisms.base import REQUIRED
@@ -23,11 +23,6 @@ BRANCHES = ("sigma", "sigma_slider")
 
 def _frozen(d):
     return MappingProxyType(dict(d or {}))
-
-
-def _number(v) -> bool:
-    """A finite real number (not a bool)."""
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
 @dataclass(frozen=True, eq=False)
@@ -128,7 +123,7 @@ class Problem:
                 continue
             vals = self.branches.get(k, (self.fixed.get(k, self.mechanism.PARAMS[k]),))
             vals = tuple(vals if isinstance(vals, (tuple, list)) else (vals,))
-            if not vals or not all(_number(v) and v in (-1.0, 1.0) for v in vals):
+            if not vals or not all(finite(v) and v in (-1.0, 1.0) for v in vals):
                 raise self._err(f"branch {k} takes signs from (-1, +1), got {vals}")
             out[k] = tuple(float(v) for v in vals)
         for k in self.branches:
@@ -182,11 +177,11 @@ class Problem:
         elif "grashof" in c:
             raise self._err(f"{self.mechanism.__name__} has no four-bar: no grashof condition")
         g = c.get("gamma_min")
-        if g is not None and not (_number(g) and 0 <= g < math.pi / 2):
+        if g is not None and not (finite(g) and 0 <= g < math.pi / 2):
             raise self._err(f"gamma_min bound must be in [0, pi/2) rad, a number; got {g!r}")
         for k in BOUNDS:
             if k != "gamma_min" and k in c:
-                if not (_number(c[k]) and c[k] > 0):
+                if not (finite(c[k]) and c[k] > 0):
                     raise self._err(f"{k} is an upper bound, a positive number; got {c[k]!r}")
                 c[k] = float(c[k])
                 if k in SLIDER_ONLY and self.mechanism is FourBar:
@@ -194,7 +189,7 @@ class Problem:
         linear = []
         for row in c.get("linear", ()):
             if not (isinstance(row, (list, tuple)) and len(row) == 3 and isinstance(row[0], Mapping)
-                    and all(_number(v) for v in (*row[0].values(), row[1], row[2]))):  # fmt: skip
+                    and all(finite(v) for v in (*row[0].values(), row[1], row[2]))):  # fmt: skip
                 raise self._err(f"a linear condition is (coefficients dict, lower, upper) of numbers, got {row!r}")
             coeffs, lo, hi = dict(row[0]), float(row[1]), float(row[2])
             self._check_names(coeffs)
@@ -204,7 +199,7 @@ class Problem:
         ratio = []
         for row in c.get("ratio", ()):
             if not (isinstance(row, (list, tuple)) and len(row) == 4 and all(isinstance(v, str) for v in row[:2])
-                    and all(_number(v) for v in row[2:])):  # fmt: skip
+                    and all(finite(v) for v in row[2:])):  # fmt: skip
                 raise self._err(f"a ratio condition is (numerator, denominator, lower, upper), got {row!r}")
             num, den, lo, hi = row[0], row[1], float(row[2]), float(row[3])
             self._check_names({num: 1, den: 1})
@@ -229,7 +224,7 @@ class Problem:
             raise self._err(f"unknown size measure {self.size!r}; measures are {SIZES}")
         if self.accel_over not in ("cycle", "working"):
             raise self._err(f"accel_over is 'cycle' or 'working', got {self.accel_over!r}")
-        if not (_number(self.omega2) and self.omega2 != 0):
+        if not (finite(self.omega2) and self.omega2 != 0):
             raise self._err(f"omega2 is the crank speed in rad/s, a nonzero finite number; got {self.omega2!r}")
         if self.objective in SLIDER_ONLY and self.mechanism is FourBar:
             raise self._err(f"FourBar has no slider: {self.objective} does not apply")

@@ -25,16 +25,16 @@ UNITS = {"angles": "rad (gamma_min, swing, theta)", "lengths": "the problem's le
          "times": "s"}  # fmt: skip
 
 
-def _clean(v):
+def json_safe(v):
     """JSON-safe copy: non-finite floats become None (strict JSON has no NaN)."""
     if isinstance(v, float):
         return v if math.isfinite(v) else None
     if isinstance(v, dict):
-        return {str(k): _clean(x) for k, x in v.items()}
+        return {str(k): json_safe(x) for k, x in v.items()}
     if isinstance(v, (list, tuple)):
-        return [_clean(x) for x in v]
+        return [json_safe(x) for x in v]
     if hasattr(v, "item") and not isinstance(v, (str, bytes)):  # numpy scalars
-        return _clean(v.item())
+        return json_safe(v.item())
     return v
 
 
@@ -121,7 +121,7 @@ class Result:
 
     def to_dict(self) -> dict:
         """Strict-JSON dictionary (no NaN: None); the mechanism as its type kind and parameters."""
-        return _clean({
+        return json_safe({
             "units": UNITS,
             "status": self.status,
             "success": self.success,

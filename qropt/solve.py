@@ -18,7 +18,7 @@ import numpy as np
 
 from qropt import starts as starts_
 from qropt.certify import Certificate, Designs, better, certify, objective_of, objective_value, quantities, residuals
-from qropt.criteria import BOUNDS, SIZES, maximises, violations
+from qropt.criteria import BOUNDS, UNITS, in_nlp_terms, maximises, measured, objective_for, violations
 from qropt.errors import ProblemError, QroptError
 from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, TWO_PI, Formulation
 from qropt.problem import Problem
@@ -247,12 +247,10 @@ class Solver:
             msg += f"; {len(cands)} fail ({'; '.join(why[:3])})" if cands else ""
             return Result("infeasible", msg, stats={"plan": plan.kind, "starts": len(cands),
                                                     "t_total": time.perf_counter() - t0})  # fmt: skip
-        if plan.kind == "family" and not extra and not good:  # no point of the family refines: search instead
-            return self.solve(problem, starts_n=starts_n, use_analytic=False, seed=seed, targets=targets,
-                              max_rounds=max_rounds, diagnose=diagnose)  # fmt: skip
-        if plan.kind == "enumeration" and not extra and not good:  # or the closed form missed: search to be sure
-            return self.solve(problem, starts_n=starts_n, use_analytic=False, seed=seed, targets=targets,
-                              max_rounds=max_rounds, diagnose=diagnose)  # fmt: skip
+        if plan.kind in ("family", "enumeration") and not extra and not good:
+            # no closed-form point refines (or the closed form missed): search instead
+            kw = {"starts_n": starts_n, "seed": seed, "targets": targets, "max_rounds": max_rounds}
+            return self.solve(problem, use_analytic=False, diagnose=diagnose, **kw)
         stats = {"starts": len(cands), "plan": plan.kind, "omega2": problem.omega2, "formulations": self.formulations,
                  "ipopt_runs": sum(len(c.statuses) for c in cands if c.origin != "enumeration"),
                  "iterations_total": sum(c.iterations for c in cands),
@@ -425,9 +423,8 @@ class Solver:
             bound = problem.conditions.get(key)
             if bound is None:
                 continue
-            objective = "max_gamma_min" if quantity == "gamma_min" else "min_size" if quantity in SIZES else (
-                f"min_{quantity}")  # fmt: skip
-            sub = problem.replace(objective=objective, size=quantity if quantity in SIZES else problem.size,
+            objective, size = objective_for(quantity)
+            sub = problem.replace(objective=objective, size=size or problem.size,
                                   conditions={k: v for k, v in problem.conditions.items() if k != key})  # fmt: skip
             r = self.solve(sub, targets=targets, starts_n=starts_n, seed=seed)
             if r.status not in ("optimal", "acceptable"):
@@ -439,11 +436,10 @@ class Solver:
             if (best < bound) if sense == "lower" else (best > bound):
                 span = (0.0, best) if sense == "lower" else (best, math.inf)
                 word = "largest" if sense == "lower" else "smallest"
-                unit = {"gamma_min": " rad", "sum": "", "longest": "", "footprint": " length^2",
-                        "peak_accel": " length/s^2", "peak_velocity": " length/s"}[quantity]  # fmt: skip
 
-                def show(v, unit=unit):
-                    return f"{v:.6g}{unit}" + (f" ({math.degrees(v):.2f} deg)" if unit == " rad" else "")
+                def show(v, quantity=quantity):
+                    deg = f" ({math.degrees(v):.2f} deg)" if quantity == "gamma_min" else ""
+                    return f"{v:.6g} {UNITS[quantity]}{deg}"
 
                 msg = (f"{key} {show(bound)} is beyond reach: the {word} {quantity} of a design meeting the "
                        f"targets and the other conditions is {show(best)} ({r.certificate.global_claim})")  # fmt: skip
@@ -506,15 +502,8 @@ def _real(name, v) -> float:
 
 
 def _nlp_value(problem, info) -> float:
-    """A certified objective in the NLP's terms (what IPOPT minimises): cos gamma_min, peak |d2x/dtheta2|,
-    peak working |dx/dtheta2|, size."""
-    if problem.objective == "max_gamma_min":
-        return math.cos(info["certified"])
-    if problem.objective == "min_peak_accel":
-        return info["certified"] / problem.omega2**2
-    if problem.objective == "min_peak_velocity":
-        return info["certified"] / abs(problem.omega2)
-    return info["certified"]
+    """A certified objective in the NLP's terms (what IPOPT minimises)."""
+    return in_nlp_terms(measured(problem.objective, problem.size), info["certified"], problem.omega2)
 
 
 def _within(c: Candidate, tol) -> bool:

@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 import qropt.cli as cli
+from qropt.criteria import maximises
 
 COMMAND = "chart"
 HELP = "solve a problem file over a grid of time ratios, strokes, swings or fixed parameters (a design chart)"
@@ -109,9 +110,9 @@ def summary(ch) -> list[str]:
              "took over"]  # fmt: skip
     z = ch.grid()
     if np.isfinite(z).any():
-        best = np.nanargmax(z) if p.objective == "max_gamma_min" else np.nanargmin(z)
+        deg = maximises(p.objective)  # gamma_min, shown in degrees
+        best = np.nanargmax(z) if deg else np.nanargmin(z)
         c = ch.cells[int(best)]
-        deg = p.objective == "max_gamma_min"
         lo, hi = (math.degrees(v) if deg else v for v in (np.nanmin(z), np.nanmax(z)))
         at = ", ".join(f"{a.name} {math.degrees(a.values[k]) if a.name == 'swing' else a.values[k]:.6g}"
                        for a, k in ((ch.x, c.i), (ch.y, c.j)) if a)  # fmt: skip

@@ -11,7 +11,7 @@ HELP = "type synthesis: the task solved for every quick-return type, compared cr
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from qropt.cli import angle, real
-    from qropt.criteria import OBJECTIVES
+    from qropt.criteria import BOUNDS, OBJECTIVES, UNITS
     from qropt.design import TYPES
 
     parser.add_argument("--tr", type=real, required=True, help="time ratio (slow/fast, >= 1)")
@@ -21,11 +21,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="size measure of min_size (default footprint)")  # fmt: skip
     parser.add_argument("--types", nargs="+", metavar="TYPE", help="types (default all): " + ", ".join(TYPES))
     parser.add_argument("--gamma-min", type=angle, help="lower bound on gamma_min (e.g. 40deg)")
-    parser.add_argument("--max-footprint", type=real, help="upper bound on the footprint [length^2]")
-    parser.add_argument("--max-sum", type=real, help="upper bound on the sum of link lengths [length]")
-    parser.add_argument("--max-longest", type=real, help="upper bound on the longest link [length]")
-    parser.add_argument("--max-peak-accel", type=real, help="upper bound on the peak acceleration [length/s^2]")
-    parser.add_argument("--max-peak-velocity", type=real, help="upper bound on the peak working velocity [length/s]")
+    for key, (quantity, sense) in BOUNDS.items():
+        if sense == "upper":  # --max-footprint, --max-sum, --max-longest, --max-peak-accel, --max-peak-velocity
+            parser.add_argument("--" + key.replace("_", "-"), type=real,
+                                help=f"upper bound on {quantity} [{UNITS[quantity]}]")  # fmt: skip
     parser.add_argument("--omega2", type=real, default=1.0, help="crank speed [rad/s] (default 1)")
     parser.add_argument("--pareto", nargs=2, metavar=("A", "B"), help="also each type's front between two objectives")
     parser.add_argument("--n", type=int, default=12, help="front points per type with --pareto (default 12)")
@@ -36,11 +35,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def conditions_of(args) -> dict:
     """The bound conditions given on the command line."""
-    c = {} if args.gamma_min is None else {"gamma_min": args.gamma_min}
-    for k in ("max_footprint", "max_sum", "max_longest", "max_peak_accel", "max_peak_velocity"):
-        if getattr(args, k) is not None:
-            c[k] = getattr(args, k)
-    return c
+    from qropt.criteria import BOUNDS
+
+    return {k: getattr(args, k) for k in BOUNDS if getattr(args, k) is not None}
 
 
 def run(args) -> int:

@@ -45,5 +45,6 @@ def run(args) -> int:
 
 
 def _show(q, v):
-    units = {"gamma_min": "deg", "footprint": "length^2", "peak_accel": "length/s^2", "peak_velocity": "length/s"}
-    return f"{q} {math.degrees(v):.4f} deg" if q == "gamma_min" else f"{q} {v:.6g} {units.get(q, 'length')}"
+    from qropt.criteria import UNITS
+
+    return f"{q} {math.degrees(v):.4f} deg" if q == "gamma_min" else f"{q} {v:.6g} {UNITS[q]}"
