@@ -19,8 +19,13 @@ def circle_circle(xp, p, a, q, b, sigma, around=0.0):
     ux, uy = p[0] - q[0], p[1] - q[1]
     ll = ux * ux + uy * uy
     c = (b * b + ll - a * a) / (2.0 * b * xp.sqrt(ll))
-    ca, sa = math.cos(around), math.sin(around)
-    psi = around + xp.atan2(uy * ca - ux * sa, ux * ca + uy * sa)
+    if around == 0.0:
+        psi = xp.atan2(uy, ux)
+    elif around == math.pi:
+        psi = around + xp.atan2(-uy, -ux)
+    else:
+        ca, sa = math.cos(around), math.sin(around)
+        psi = around + xp.atan2(uy * ca - ux * sa, ux * ca + uy * sa)
     angle = psi + sigma * xp.acos(c)
     x = (q[0] + b * xp.cos(angle), q[1] + b * xp.sin(angle))
     return x, angle, 1.0 - c * c

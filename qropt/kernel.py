@@ -6,7 +6,7 @@ started at the vertex of the grid parabola (error O(h^3)), and refined by Newton
 exact AD derivatives, all brackets in one compiled call. A refined point is accepted only if
 its last Newton step is below 1e-10 rad, it stays inside its bracket and the curvature has the
 extreme's sign; any other bracket is refined by the safeguarded Newton/false-position iteration
-of ``cycle.stationary`` on the same exact derivatives. Three groups of quantities are compiled
+of ``cycle.stationary`` on the same exact derivatives. Four groups of quantities are compiled
 on demand: ``cycle`` (output x, squared transmission cosines, assembly margins), ``accel``
 (d2x/dtheta2, refined with exact third and fourth derivatives), ``velocity`` (dx/dtheta2) and ``coords`` (every joint
 coordinate, for bounding boxes).
@@ -28,6 +28,7 @@ from qropt.ops import CASADI, NUMPY, Jet
 
 NEWTON_STEPS = 2  # from the grid parabola's vertex (error <~1e-4 rad), two steps reach ~1e-16 rad
 TWO_PI = 2.0 * np.pi
+CSE = {"cse": True}  # common subexpressions of the nested derivatives merged: a third of the instructions
 STEP_TOL = 1e-10  # rad: a last Newton step this small means the point is converged (error ~ step^2)
 _KERNELS: dict = {}
 
@@ -85,7 +86,7 @@ class _Quantity:
         n = P.numel()
         z = casadi.SX.sym("z", 1 + n)
         d = casadi.Function("d", [t, P], [q, d1, d2])
-        self.derivs = Batched(casadi.Function("dz", [z], [casadi.vertcat(*d(z[0], z[1:]))]))
+        self.derivs = Batched(casadi.Function("dz", [z], [casadi.vertcat(*d(z[0], z[1:]))], CSE))
         zn = casadi.SX.sym("z", 3 + n)
         x, lo, hi, pz = zn[0], zn[1], zn[2], zn[3:]
         for _ in range(NEWTON_STEPS):
@@ -93,8 +94,8 @@ class _Quantity:
             x = casadi.fmin(casadi.fmax(x - g1 / g2, lo), hi)
         _, g1, g2 = d(x, pz)
         value = casadi.Function("v", [t, P], [precise])
-        self.newton = Batched(casadi.Function("n", [zn], [casadi.vertcat(x, g1 / g2, g2, value(x, pz))]))
-        self.value = Batched(casadi.Function("vz", [z], [value(z[0], z[1:])]))
+        self.newton = Batched(casadi.Function("n", [zn], [casadi.vertcat(x, g1 / g2, g2, value(x, pz))], CSE))
+        self.value = Batched(casadi.Function("vz", [z], [value(z[0], z[1:])], CSE))
 
     def at(self, theta, p):
         """(q, dq/dtheta, d2q/dtheta2) at the crank angles theta (rad): three arrays."""
@@ -115,6 +116,13 @@ class Kernel:
         self.right_joints = [j for j, lines in lp.transmission.items() if lines is RIGHT_ANGLE]
         self.margin_names = [what for what, _ in lp.margins]
         self.point_names = list(lp.points)
+        nj, nm = len(self.joints), len(self.margin_names)
+        # the 'cycle' group's extremes: x's max and min, each varying joint's largest cos^2, each margin's least
+        self.cycle_requests = (
+            ((0, "max"), (0, "min"))
+            + tuple((1 + j, "max") for j in range(nj))
+            + tuple((1 + nj + m, "min") for m in range(nm))
+        )
         self._t, self._P, self._lp = t, P, lp
         self._groups: dict = {}
 
@@ -178,6 +186,16 @@ class Kernel:
             f = self._groups[key] = Batched(casadi.Function(f"{group}_newton", [z], [sw(z[0], z[1:])]))
         return f
 
+    def _plan(self, requests):
+        """Rows of the grid and signs (+1 max, -1 min) of a request list (kept per list: a handful exist)."""
+        key = ("plan", tuple(requests))
+        plan = self._groups.get(key)
+        if plan is None:
+            rows = np.array([q for q, _ in requests], int)
+            sgn = np.array([1.0 if kind == "max" else -1.0 for _, kind in requests])
+            plan = self._groups[key] = (rows, sgn, sgn[:, None])
+        return plan
+
     def refine(self, group: str, grid_q, requests, p):
         """Extremes of a group's quantities. requests: [(quantity index, 'max' | 'min')].
 
@@ -185,47 +203,57 @@ class Kernel:
         """
         n = grid_q.shape[1]
         h = TWO_PI / n
-        rows = np.array([q for q, _ in requests], int)
-        sgn = np.array([1.0 if kind == "max" else -1.0 for _, kind in requests])
-        v = grid_q[rows] * sgn[:, None]  # every request as a search for maxima
-        prev = np.concatenate([v[:, -1:], v[:, :-1]], axis=1)
-        nxt = np.concatenate([v[:, 1:], v[:, :1]], axis=1)
-        with np.errstate(invalid="ignore"):
-            hit = (v >= prev) & (v > nxt) & np.isfinite(prev) & np.isfinite(nxt)
+        rows, sgn, sgn_col = self._plan(requests)
+        ext = np.empty((rows.size, n + 2))  # every request as a search for maxima, padded cyclically
+        v = ext[:, 1:-1]
+        np.multiply(grid_q[rows], sgn_col, out=v)
+        ext[:, 0], ext[:, -1] = v[:, -1], v[:, 0]
+        prev, nxt = ext[:, :-2], ext[:, 2:]
+        hit = v >= prev  # comparisons with nan are False: a sample next to a nan is never a peak
+        hit &= v > nxt
         r, i = np.nonzero(hit)
-        counts = np.bincount(r, minlength=rows.size)
         if not r.size:
             return [Extremes(np.zeros(0), np.zeros(0)) for _ in requests]
-        v0, vm, vp = v[r, i], prev[r, i], nxt[r, i]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            shift = 0.5 * (vm - vp) / (vm - 2 * v0 + vp)
-        shift[~(np.abs(shift) <= 1.0)] = 0.0
+        vm, v0, vp = ext[r, i], ext[r, i + 1], ext[r, i + 2]
+        # grid parabola's vertex: vm <= v0 > vp, so the denominator is negative and |shift| <= 1/2
+        shift = 0.5 * (vm - vp) / (vm - 2.0 * v0 + vp)
         th = h * i
-        lo, hi = th - h, th + h
         z = np.empty((r.size, 4 + p.size))
-        z[:, 0], z[:, 1], z[:, 2], z[:, 3], z[:, 4:] = rows[r], th + shift * h, lo, hi, p
+        z[:, 0] = rows[r]
+        z[:, 1] = th + shift * h
+        z[:, 2] = lo = th - h
+        z[:, 3] = hi = th + h
+        z[:, 4:] = p
         res = self._switch(group)(z)
         x, val = res[:, 0], res[:, 3]
-        ok = (np.abs(res[:, 1]) <= STEP_TOL) & (x > lo) & (x < hi) & (sgn[r] * res[:, 2] < 0)
-        quantity_of, keep = rows[r], np.ones(r.size, bool)
-        for q in np.unique(quantity_of[~ok]):  # rare: flat, narrow or no extremes; the safeguarded iteration
-            j = np.flatnonzero(~ok & (quantity_of == q))
-            quantity = self.group(group)[q]
-            # a true extreme turns the slope inside its bracket; a jump (an angle wrapping at +-pi) does not
-            s = sgn[r[j]]
-            turns = (s * quantity.at(lo[j], p)[1] >= 0) & (s * quantity.at(hi[j], p)[1] <= 0)
-            keep[j[~turns]] = False
-            j = j[turns]
-            if j.size:
-                x[j] = self._safeguarded(quantity, lo[j], hi[j], p)
-                val[j] = quantity.value(np.column_stack([x[j], np.broadcast_to(p, (j.size, p.size))]))[:, 0]
+        ok = np.abs(res[:, 1]) <= STEP_TOL
+        ok &= x > lo
+        ok &= x < hi
+        ok &= sgn[r] * res[:, 2] < 0
+        keep = None
+        if not ok.all():  # rare: flat, narrow or no extremes; the safeguarded iteration
+            quantity_of, keep = rows[r], np.ones(r.size, bool)
+            for q in np.unique(quantity_of[~ok]):
+                j = np.flatnonzero(~ok & (quantity_of == q))
+                quantity = self.group(group)[q]
+                # a true extreme turns the slope inside its bracket; a jump (an angle wrapping at +-pi) does not
+                s = sgn[r[j]]
+                turns = (s * quantity.at(lo[j], p)[1] >= 0) & (s * quantity.at(hi[j], p)[1] <= 0)
+                keep[j[~turns]] = False
+                j = j[turns]
+                if j.size:
+                    x[j] = self._safeguarded(quantity, lo[j], hi[j], p)
+                    val[j] = quantity.value(np.column_stack([x[j], np.broadcast_to(p, (j.size, p.size))]))[:, 0]
         x = np.mod(x, TWO_PI)
         x[x > TWO_PI - 1e-12] = 0.0
-        out, start = [], 0
-        for c in counts.tolist():
-            k = keep[start : start + c]
-            out.append(Extremes(x[start : start + c][k], val[start : start + c][k]))
-            start += c
+        bounds = np.searchsorted(r, np.arange(rows.size + 1))  # r is sorted: each request's slice
+        out = []
+        for a, b in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
+            if keep is None:
+                out.append(Extremes(x[a:b], val[a:b]))
+            else:
+                k = keep[a:b]
+                out.append(Extremes(x[a:b][k], val[a:b][k]))
         return out
 
     @staticmethod

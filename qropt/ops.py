@@ -104,7 +104,7 @@ class Jet:
     def __add__(self, o):
         if isinstance(o, Jet):
             return Jet(self.c + o.c)
-        if np.ndim(o) <= np.ndim(self.c) - 1:
+        if isinstance(o, float | int) or np.ndim(o) <= np.ndim(self.c) - 1:
             return self._plus_value(o)
         return Jet.of(self.c[0] + o, self.c[1], self.c[2])
 
@@ -114,10 +114,16 @@ class Jet:
         return Jet(-self.c)
 
     def __sub__(self, o):
+        if isinstance(o, Jet):
+            return Jet(self.c - o.c)
         return self + (-o)
 
     def __rsub__(self, o):
-        return Jet(-self.c) + o
+        c = -self.c
+        if isinstance(o, float | int) or np.ndim(o) <= np.ndim(c) - 1:
+            c[0] += o
+            return Jet(c)
+        return Jet(c) + o
 
     def __mul__(self, o):
         if isinstance(o, Jet):
@@ -213,11 +219,13 @@ def _jatan2(y, x):
         return np.arctan2(y, x)
     y, x = _lift(y), _lift(x)
     (x0, x1, x2), (y0, y1, y2) = x.c, y.c
-    d = x0 * x0 + y0 * y0
-    n = x0 * y1 - y0 * x1
-    dn = x0 * y2 - y0 * x2
-    dd = 2.0 * (x0 * x1 + y0 * y1)
-    return Jet.of(np.arctan2(y0, x0), n / d, (dn * d - n * dd) / (d * d))
+    c = np.empty(np.broadcast_shapes(x.c.shape, y.c.shape))
+    r = 1.0 / (x0 * x0 + y0 * y0)
+    c[0] = np.arctan2(y0, x0)
+    c[1] = n = (x0 * y1 - y0 * x1) * r
+    # (x0 y2 - y0 x2) / d - n d'/d with d' = 2 (x0 x1 + y0 y1)
+    c[2] = (x0 * y2 - y0 * x2 - 2.0 * n * (x0 * x1 + y0 * y1)) * r
+    return Jet(c)
 
 
 def _jfabs(u):

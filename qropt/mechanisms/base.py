@@ -280,6 +280,8 @@ class Mechanism:
         lp = self.evaluate(JET, Jet.seed(t, omega2, alpha2))
 
         def parts(j):
+            if isinstance(j, Jet) and j.c.shape == (3,) + t.shape:
+                return list(j.c.copy())
             if isinstance(j, Jet):
                 return [np.broadcast_to(c, t.shape).astype(float) for c in (j.v, j.d1, j.d2)]
             return [np.broadcast_to(float(j), t.shape).astype(float), np.zeros_like(t), np.zeros_like(t)]
@@ -320,7 +322,11 @@ class Mechanism:
         k = self._kernel
         for n in cycle.GRIDS:
             q = k.grid_values(self.params, cycle.grid(n))
-            if np.nanmin(q[1 + len(k.joints) :], initial=np.inf) < -cycle.MARGIN_TOL or resolved(q):
+            margins = q[1 + len(k.joints) :]
+            least = margins.min(initial=np.inf)
+            if least != least:  # a nan sample: the least of the others
+                least = np.nanmin(margins, initial=np.inf)
+            if least < -cycle.MARGIN_TOL or resolved(q):
                 break
         return q
 
@@ -330,13 +336,16 @@ class Mechanism:
         k, q = self._kernel, self._grid
         nj, nm = len(k.joints), len(k.margin_names)
         margins_grid = q[1 + nj :]
-        least = [float(np.nanmin(m)) if np.isfinite(m).any() else -np.inf for m in margins_grid]
+        at = margins_grid.argmin(axis=1)  # a row with a nan gives its first nan: the rows' own least below
+        least = margins_grid[np.arange(nm), at].tolist()
+        for m, v in enumerate(least):
+            if v != v:
+                finite = np.isfinite(margins_grid[m])
+                at[m] = np.flatnonzero(finite)[np.argmin(margins_grid[m][finite])] if finite.any() else 0
+                least[m] = float(margins_grid[m, at[m]]) if finite.any() else -np.inf
         if any(v < -cycle.MARGIN_TOL for v in least):  # cannot assemble: nothing else is defined
             return {"margins": [(v, 0.0) for v in least]}
-        specs = (
-            [(0, "max"), (0, "min")] + [(1 + j, "max") for j in range(nj)] + [(1 + nj + m, "min") for m in range(nm)]
-        )
-        res = k.refine("cycle", q, specs, k.vector(self.params))
+        res = k.refine("cycle", q, k.cycle_requests, k.vector(self.params))
         gammas = {j: (res[2 + i].theta, res[2 + i].value) for i, j in enumerate(k.joints)}
         gammas.update({j: (np.zeros(1), np.full(1, math.pi / 2)) for j in k.right_joints})
         margins = []
@@ -345,7 +354,7 @@ class Mechanism:
             if e.value.size and e.value.min() < least[m]:
                 margins.append((float(e.value.min()), float(e.theta[np.argmin(e.value)])))
             else:
-                margins.append((least[m], float(cycle.grid(q.shape[1])[np.nanargmin(margins_grid[m])])))
+                margins.append((least[m], float(cycle.grid(q.shape[1])[at[m]])))
         return {"max": (res[0].theta, res[0].value), "min": (res[1].theta, res[1].value), "gamma": gammas,
                 "margins": margins}  # fmt: skip
 
