@@ -44,6 +44,8 @@ IPOPT = {
     "calc_lam_p": False,
 }
 
+WARM = {"ipopt.bound_push": 1e-8, "ipopt.bound_frac": 1e-8}
+
 
 def slow_interval(time_ratio, orientation):
     """theta_min - theta_max (rad): the slow interval if orientation = +1, else the fast one."""
@@ -167,7 +169,8 @@ class Formulation:
         p = casadi.vertcat(PF, PT, S, W, PB)
         g = casadi.vertcat(*[r.expr for r in rows])
         self.w_sym, self.p_sym, self.g_sym = w, p, g
-        self.solver = casadi.nlpsol("qropt", "ipopt", {"x": w, "p": p, "f": f, "g": g}, {**IPOPT, **(ipopt or {})})
+        self._nlp, self._ipopt = {"x": w, "p": p, "f": f, "g": g}, {**IPOPT, **(ipopt or {})}
+        self.solver = casadi.nlpsol("qropt", "ipopt", self._nlp, self._ipopt)
         self._f = f
         self.epi_fun = casadi.Function("epi", [w, p], [casadi.vertcat(*[e for _, e in epi], 0)])
         self.epi_index = np.array([zi for zi, _ in epi], int)
@@ -299,12 +302,20 @@ class Formulation:
         hi += [np.inf] * self.nz + [3 * TWO_PI] * self.n_lift
         return np.array(lo, float), np.array(hi, float)
 
-    def solve(self, w0, p):
-        """One IPOPT run: (w, objective, constraint values, stats)."""
+    @functools.cached_property
+    def warm_solver(self):
+        """The same NLP for re-solves from a converged point (more samples, or IPOPT's iteration limit): its
+        start moves off a bound by 1e-8 only. IPOPT's default push (0.01, absolute for lengths below 1) can
+        move a small link across a Grashof or assembly limit, where the loop has no real solution."""
+        return casadi.nlpsol("qropt_warm", "ipopt", self._nlp, {**WARM, **self._ipopt})
+
+    def solve(self, w0, p, warm: bool = False):
+        """One IPOPT run: (w, objective, constraint values, stats); warm: a re-solve (see ``warm_solver``)."""
         lbx, ubx = self.bounds()
         w0 = np.clip(w0, lbx, ubx)
-        r = self.solver(x0=w0, p=p, lbx=lbx, ubx=ubx, lbg=self.lbg, ubg=self.ubg)
-        st = self.solver.stats()
+        solver = self.warm_solver if warm else self.solver
+        r = solver(x0=w0, p=p, lbx=lbx, ubx=ubx, lbg=self.lbg, ubg=self.ubg)
+        st = solver.stats()
         return np.array(r["x"]).ravel(), float(r["f"]), np.array(r["g"]).ravel(), st
 
     @functools.cached_property

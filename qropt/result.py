@@ -6,7 +6,8 @@ Statuses (grouped as cvxpy groups its own):
 - ``acceptable``: certified, but IPOPT stopped at its acceptable tolerance rather than its full one;
 - ``feasible``: a certified design of a problem without an objective;
 - ``infeasible``: no design meets the targets and conditions (with the reachable range of each target);
-- ``failed``: no start converged to a certified design (with IPOPT's reasons).
+- ``failed``: no start converged to a certified design (with IPOPT's reasons, and a design meeting every target and
+  condition where one is known: the optimum was not reached, not proved absent).
 """
 
 from __future__ import annotations

@@ -123,7 +123,7 @@ class Solver:
         st, g, info, m, restarts = {}, None, {}, None, 0
         while c.rounds < max_rounds:
             c.rounds += 1
-            w, f, g, st = form.solve(w, p)
+            w, f, g, st = form.solve(w, p, warm=c.rounds > 1)
             c.t_ipopt += st.get("t_wall_total", 0.0)
             c.iterations += st.get("iter_count", 0)
             c.statuses.append(st.get("return_status", "?"))
@@ -388,6 +388,10 @@ class Solver:
             r = self.solve(problem, targets=targets, starts_n=0, seed=seed, extra_starts=found, diagnose=False)
             if r.success:
                 return r
+        if problem.objective and not found:  # is there any design at all? (then the objective's solves failed)
+            r = self.solve(problem.replace(objective=None), targets=targets, starts_n=starts_n, seed=seed,
+                           diagnose=False)  # fmt: skip
+            found = [{k: r.params[k] for k in problem.free}] if r.success else []
         reach, msgs = {}, []
         for k, v in targets.items():
             lo, hi = self.target_range(problem, k, targets, starts_n=starts_n, seed=seed)
@@ -408,6 +412,12 @@ class Solver:
             msg += f"(IPOPT: {how}), though each target alone can be met (" + "; ".join(msgs) + ")"
             # IPOPT's own failures (invalid numbers, iteration limits) prove nothing: only converged or
             # infeasible-detected runs make the problem infeasible
+            if found:  # a design meeting every target and condition exists: the objective's solves failed
+                shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
+                msg += (f"; designs meeting every target and condition exist (one: {shown}), so the {problem.objective}"
+                        " optimum was not reached (it may lie at a singular limit: a dead point, a link of zero "
+                        "length or a bound)")  # fmt: skip
+                return Result("failed", msg, stats=stats, reachable=reach)
             proved = any(k in ("Infeasible_Problem_Detected", "Solve_Succeeded", ACCEPTABLE) for k in ends)
             return Result("infeasible" if proved else "failed", msg, stats=stats, reachable=reach)
         why = "; ".join(r for r in reasons[:3] if r)

@@ -13,8 +13,10 @@ import numpy as np
 import pytest
 
 from qropt import Problem, analytic, oracles, solve
-from qropt.chart import Chart, ChartError, chart
+from qropt.chart import Cell, Chart, ChartError, chart
+from qropt.chart_dask import _Tile
 from qropt.cli import main
+from qropt.solve import DEFAULT
 from tests import brute
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
@@ -169,14 +171,32 @@ def test_a_jump_of_branch_is_flagged():
 
 
 def test_a_better_branch_taking_over_is_flagged():
-    """From stroke 0.1286 down, the continuation follows one branch; the check at 0.09 finds a better one."""
+    """A check cell whose neighbour holds the task's worse local optimum: continuing from it stays on that
+    branch, the check's full solve finds the better one, and the cell keeps it and says so."""
+    p = problem("crank_rocker_slider_gamma")
+    worse = solve(p, targets={"stroke": 0.1093}).local_optima[1]
+    assert worse.status == "local_optimum"
+    tile = _Tile({"problem": p.to_dict(), "x": ["stroke", [0.1093, 0.1]], "y": None, "block": [0, 2, 0, 1],
+                  "check": 1}, DEFAULT, None)  # fmt: skip
+    tile.cells[(0, 0)] = Cell.of(0, 0, worse, "full")
+    tile.solve_cell((1, 0))
+    c = tile.cells[(1, 0)]
+    assert c.switched and c.method == "full" and c.why == "check" and not c.jump
+    best = solve(p, targets={"stroke": 0.1})
+    assert c.objective == pytest.approx(best.objective, abs=1e-9)
+    cont = solve(p, targets={"stroke": 0.1}, starts_n=0, use_analytic=False,
+                 extra_starts=[{k: worse.params[k] for k in p.free}])  # fmt: skip
+    assert cont.success and c.objective > cont.objective + 1e-5  # what continuing alone would have reported
+
+
+def test_continuation_across_a_branch_takeover_ends_on_the_better_branch():
+    """From stroke 0.1286 down, the better branch changes near 0.097: the chart's cell at 0.09 holds the full
+    solve's optimum, reached through a flagged full solve (a jump or a check)."""
     p = problem("crank_rocker_slider_gamma")
     ch = chart(p, ("stroke", (0.1286, 0.1093, 0.09)), check=1, progress=False)
     c = ch.cell(2)
-    assert c.switched and c.method == "full" and c.why == "check"
-    cont = solve(p, targets={"stroke": 0.09}, starts_n=0, use_analytic=False,
-                 extra_starts=[{k: ch.cell(1).params[k] for k in p.free}])  # fmt: skip
-    assert cont.success and c.objective > cont.objective + 1e-5  # what continuing alone would have reported
+    assert c.method == "full" and c.why in ("jump", "check")
+    assert c.objective == pytest.approx(solve(p, targets={"stroke": 0.09}).objective, abs=1e-9)
 
 
 def test_cli_writes_the_chart(tmp_path, capsys):

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import qropt
-from qropt import QroptError, criteria, oracles, problem_bases
+from qropt import QroptError, criteria, oracles, problem_bases, starts
 from qropt.design import TYPES, design, type_problem
 from qropt.pareto import pareto
 from tests import brute
@@ -149,9 +149,10 @@ def _type_rules(kind, v, fixed):
     return np.ones_like(next(iter(v.values())), bool)
 
 
-def _sampled(kind, n=60000, seed=7, window=0.1, keep=3):
-    """The ``keep`` designs of largest gamma_min (brute force) among random shapes of a type scaled to the stroke
-    exactly, inside the design bounds, whose exact TR is within ``window`` of the task's: (gamma_min, TR, params)."""
+def _sampled(kind, n=60000, seed=7, window=0.1, keep=3, score=None):
+    """The ``keep`` designs of largest gamma_min (brute force), or of least ``score(gamma_min, params)`` (None drops
+    a design), among random shapes of a type scaled to the stroke exactly, inside the design bounds, whose exact
+    TR is within ``window`` of the task's: (gamma_min, TR, params)."""
     p = type_problem(kind, TR, STROKE)
     bk = BRUTE_KIND.get(kind, kind)
     rng = np.random.default_rng(seed)
@@ -189,7 +190,10 @@ def _sampled(kind, n=60000, seed=7, window=0.1, keep=3):
             v = {name: x * k for name, x in v.items()}
             if all(lo <= v[name] <= hi for name, (lo, hi) in p.free.items()):
                 out.append((brute.gamma_min(bk, q), t, v))
-    return sorted(out, key=lambda c: -c[0])[:keep]
+    if score is None:
+        return sorted(out, key=lambda c: -c[0])[:keep]
+    scored = [(score(g, v), (g, t, v)) for g, t, v in out]
+    return [c for f, c in sorted((f, c) for f, c in scored if f is not None)][:keep]
 
 
 @pytest.mark.parametrize("kind", ["crank-shaper-rod", "whitworth", "crank-rocker-slider", "drag-link-slider"])
@@ -200,6 +204,54 @@ def test_no_sampled_design_beats_the_solve_at_its_time_ratio(comparison, kind):
     for gamma, tr, v in found:
         r = qropt.solve(type_problem(kind, TR, STROKE), targets={"time_ratio": tr})
         assert r.status == "optimal" and r.objective >= gamma - 1e-9, (kind, tr, v, gamma, r.objective)
+
+
+def test_the_smallest_drag_link_slider_with_a_transmission_bound():
+    """Every link free, min sum of lengths with gamma_min >= 30 deg: the solve's design holds by brute force
+    and no random design meeting the bound near the TR is smaller than the solve at that design's TR."""
+    bound = math.radians(30)
+    p = type_problem("drag-link-slider", TR, STROKE, objective="min_size", size="sum",
+                     conditions={"gamma_min": bound})  # fmt: skip
+    r = qropt.solve(p)
+    assert r.status == "optimal", r.message
+    q = dict(r.params)
+    t_max, t_min, x_max, x_min = brute.dead_centres("drag-link-slider", q)
+    assert brute.time_ratio(t_max, t_min) == pytest.approx(TR, abs=1e-9)
+    assert x_max - x_min == pytest.approx(STROKE, abs=1e-9)
+    assert brute.gamma_min("drag-link-slider", q) >= bound - 1e-8 / math.sin(bound)  # the feasibility tolerance
+    assert all(lo - 1e-12 <= q[k] <= hi + 1e-12 for k, (lo, hi) in p.free.items())
+    assert r.objective == pytest.approx(sum(q[k] for k in ("r1", "r2", "r3", "r4", "r5", "r6")), abs=1e-12)
+
+    def size(gamma, v):
+        return sum(v[k] for k in ("r1", "r2", "r3", "r4", "r5", "r6")) if gamma >= bound else None
+
+    found = _sampled("drag-link-slider", score=size, keep=3)
+    assert found  # the search found designs meeting the bound
+    for gamma, tr, v in found:
+        at = qropt.solve(p, targets={"time_ratio": tr})
+        assert at.status == "optimal" and at.objective <= size(gamma, v) + 1e-9, (tr, v, at.objective)
+
+
+def test_random_starts_of_a_four_bar_slider_are_designs():
+    """The Sobol starts of an all-free drag-link slider keep the type's rules and turn fully (of the raw points
+    over the bounds, few are Grashof drag-links)."""
+    p = type_problem("drag-link-slider", TR, STROKE, objective="min_size", size="sum")
+    points = starts.sobol(p, 16, 0)
+    assert 0 < len(points) <= 16
+    for v in points:
+        assert starts.orientation(p, v, starts.branches(p)[0]) is not None, v
+
+
+def test_a_design_that_exists_is_never_called_infeasible():
+    """Min longest link of an all-free drag-link slider has no attained optimum in these bounds (it runs to a
+    singular limit): the Result fails, says so and shows a design that meets the targets."""
+    r = qropt.solve(type_problem("drag-link-slider", TR, STROKE, objective="min_size", size="longest"))
+    assert r.status == "failed" and "designs meeting every target and condition exist" in r.message
+    shown = r.message.split("(one: ")[1].split(")")[0]
+    q = {k: float(v) for k, v in (kv.split("=") for kv in shown.split(", "))} | {"sigma": -1.0, "sigma_slider": 1.0}
+    t_max, t_min, x_max, x_min = brute.dead_centres("drag-link-slider", q)
+    assert brute.time_ratio(t_max, t_min) == pytest.approx(TR, rel=1e-4)
+    assert x_max - x_min == pytest.approx(STROKE, rel=1e-4)
 
 
 def test_the_table_csv_json_and_picture(comparison, tmp_path):
