@@ -102,15 +102,17 @@ class Formulation:
         kin = casadi.Function(
             "kin",
             [t, X, PF],
-            [lp.x, dx, ddx, casadi.vertcat(*cos_all, 0), casadi.vertcat(*margins, 0), casadi.vertcat(*coords), dddx],
-        )
+            [lp.x, dx, ddx, casadi.vertcat(*cos_all, 0), casadi.vertcat(*margins, 0), casadi.vertcat(*coords), dddx,
+             casadi.jacobian(casadi.vertcat(*cos_all, 0), t)],
+        )  # fmt: skip
         n_exact = len(self.exact_joints)
 
         def at(theta):
             return kin(theta, X, PF)
 
-        x_max, v_max, a_max, *_ = at(TH[0])
-        x_min, v_min, a_min, *_ = at(TH[1])
+        self._dead = [at(TH[0]), at(TH[1])]  # the output's extremes: two sides of the path's box, exactly
+        x_max, v_max, a_max, *_ = self._dead[0]
+        x_min, v_min, a_min, *_ = self._dead[1]
         span = TH[1] - TH[0]
         rows = [
             Row("dead centre theta_max: output velocity", v_max, 0.0, 0.0),
@@ -146,11 +148,24 @@ class Formulation:
         for k in self.bounds_used:
             self._group(BOUNDS[k][0], epi)
         Z = casadi.SX.sym("z", len(self.z_names))
-        # peak acceleration: the largest extremes are lifted like the dead centres (d3x/dtheta3 = 0 there)
-        self.n_lift = LIFTED if obj == "min_peak_accel" else 0
+        # lifted extremes, like the dead centres: peak acceleration's largest (d3x/dtheta3 = 0 there), or under a
+        # gamma_min bound each sampled joint's worst transmission (d cos/dtheta2 = 0), whose angle moves with the
+        # design faster than samples follow it
+        if obj == "min_peak_accel":
+            self.lift_kind, self.n_lift = "accel", LIFTED
+        elif "gamma_min" in self.bounds_used and self.sampled_joints:
+            self.lift_kind, self.n_lift = "gamma", LIFTED * len(self.sampled_joints)
+        else:
+            self.lift_kind, self.n_lift = None, 0
         PHI = casadi.SX.sym("phi", self.n_lift)
         for k in range(self.n_lift):
             out = at(PHI[k])
+            if self.lift_kind == "gamma":
+                j = n_exact + k // LIFTED
+                rows.append(Row("lifted transmission extreme: stationary", out[7][j], 0.0, 0.0))
+                i0 = self._groups["gamma_min"]
+                epi += [(i0, out[3][j]), (i0, -out[3][j])]
+                continue
             rows.append(Row("lifted acceleration extreme: stationary", out[6], 0.0, 0.0))
             epi += [(0, out[2]), (0, -out[2])]
             if problem.accel_over == "working":
@@ -227,7 +242,7 @@ class Formulation:
             epi += [(i0, self._params[k]) for k in self.problem.mechanism.LENGTHS if k in self._params]
         else:  # the bounding box of every joint's path
             self.z_names += ["x_max", "-x_min", "y_max", "-y_min"]
-            for out in sampled + exact:
+            for out in sampled + exact + self._dead:
                 xy = out[5]
                 for i in range(xy.shape[0] // 2):
                     epi += [(i0, xy[2 * i]), (i0 + 1, -xy[2 * i]), (i0 + 2, xy[2 * i + 1]), (i0 + 3, -xy[2 * i + 1])]

@@ -20,7 +20,7 @@ from qropt import starts as starts_
 from qropt.certify import Certificate, Designs, better, certify, objective_of, objective_value, quantities, residuals
 from qropt.criteria import BOUNDS, UNITS, in_nlp_terms, maximises, measured, objective_for, violations
 from qropt.errors import ProblemError, QroptError
-from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, TWO_PI, Formulation
+from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, LIFTED, TWO_PI, Formulation
 from qropt.problem import Problem
 from qropt.result import Result
 
@@ -117,7 +117,7 @@ class Solver:
         samples, fractions = form.base_samples()
         used = used_f = form.n_base
         p = form.param_vector(targets, samples, fractions)
-        w = form.epigraph_start(form.pack(values0, th0, phi=_peaks(problem, values0, branch, designs)), p)
+        w = form.epigraph_start(form.pack(values0, th0, phi=_peaks(problem, values0, branch, designs, form)), p)
         c = Candidate(False, dict(values0), branch, orientation)
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
         st, g, info, m, restarts = {}, None, {}, None, 0
@@ -540,9 +540,20 @@ def _score(problem, values, branch, build):
         return None, None
 
 
-def _peaks(problem, values, branch, build):
-    """Initial lifted acceleration extremes: the start design's largest |d2x/dtheta2| (in the working
-    stroke when asked), else spread over the turn."""
+def _peaks(problem, values, branch, build, form=None):
+    """Initial lifted extremes: the start design's largest |d2x/dtheta2| (in the working stroke when asked), or
+    each sampled joint's smallest transmission angles (``form.lift_kind`` 'gamma'); else spread over the turn."""
+    if form is not None and form.lift_kind == "gamma":
+        try:
+            minima = build(problem, values, branch).transmission_minima_by_joint()
+        except QroptError:
+            return None
+        out = []
+        for joint in form.sampled_joints:
+            t, v = minima.get(joint, (np.zeros(0), np.zeros(0)))
+            worst = [float(a) for a, _ in sorted(zip(t.tolist(), v.tolist(), strict=True), key=lambda q: q[1])]
+            out += (worst + [float(a) for a in np.linspace(0.0, math.pi, LIFTED)])[:LIFTED]
+        return out
     if problem.objective != "min_peak_accel":
         return None
     try:
@@ -562,13 +573,14 @@ def _peaks(problem, values, branch, build):
 
 def _place(slots, used, new, period, near, base):
     """Put new sample angles into the extra slots: an angle close to an extra sample moves it there (the
-    worst angle drifts as the design changes), others take free slots. Returns the slots in use."""
+    worst angle drifts as the design changes), others take free slots; with every slot taken, the nearest
+    extra sample moves (an angle the exact evaluation names is never dropped). Returns the slots in use."""
     for t in new:
         extra = np.arange(base, used)
         if extra.size:
             d = np.abs((slots[extra] - t + period / 2) % period - period / 2)
             k = int(np.argmin(d))
-            if d[k] < near:
+            if d[k] < near or used == slots.size:
                 slots[extra[k]] = t
                 continue
         if used < slots.size:

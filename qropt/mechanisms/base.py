@@ -438,8 +438,12 @@ class Mechanism:
 
     def transmission_minima(self) -> list[tuple[np.ndarray, np.ndarray]]:
         """Every local minimum of every varying joint's transmission angle: [(theta2, value)] per joint (rad)."""
+        return [tv for tv in self.transmission_minima_by_joint().values() if tv[0].size]
+
+    def transmission_minima_by_joint(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """Every local minimum of each joint's transmission angle: joint -> (theta2, value) arrays (rad)."""
         self._require_full_turn()
-        return [tv for j, tv in self._cycle["gamma"].items() if tv[0].size]
+        return dict(self._cycle["gamma"])
 
     def gamma_min(self) -> GammaMin:
         """Smallest transmission angle over the full turn and every joint, exact (not a grid sample)."""
