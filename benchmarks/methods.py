@@ -8,7 +8,7 @@ import importlib
 import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
 
-from qropt import solve, starts
+from qropt import QroptError, solve, starts
 from qropt.certify import better
 from qropt.solve import DEFAULT
 
@@ -73,8 +73,16 @@ def local_starts(problem, seed, starts_n=STARTS, solver=DEFAULT):
                 th0, way = starts.dead_centre_start(problem, v, br, targets, way, None)
                 form = solver.formulation(problem, br, way)
                 samples, fractions = form.base_samples()
-                p = form.param_vector(targets, samples, fractions)
-                yield origin, v, br, way, form, form.epigraph_start(form.pack(v, th0), p), p
+                box = _box(problem, v, br) if form.n_box else None  # the lifted box sides, as qropt starts them
+                p = form.param_vector(targets, samples, fractions, box=box)
+                yield origin, v, br, way, form, form.epigraph_start(form.pack(v, th0, box=box), p), p
+
+
+def _box(problem, values, branch):
+    try:
+        return problem.build(values, branch).bounding_box()
+    except QroptError:
+        return None
 
 
 def local_solve(form, w0, p, method="SLSQP"):

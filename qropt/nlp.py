@@ -103,8 +103,12 @@ class Formulation:
             "kin",
             [t, X, PF],
             [lp.x, dx, ddx, casadi.vertcat(*cos_all, 0), casadi.vertcat(*margins, 0), casadi.vertcat(*coords), dddx,
-             casadi.jacobian(casadi.vertcat(*cos_all, 0), t)],
+             casadi.jacobian(casadi.vertcat(*cos_all, 0), t), casadi.jacobian(casadi.vertcat(*coords), t)],
         )  # fmt: skip
+        self.n_coords = len(coords)
+        moving = [i for i, c in enumerate(coords) if casadi.depends_on(casadi.SX(c), t)]
+        # a box side's default coordinate (before a design names the one that reaches it): the first moving x, y
+        self._default_coord = [next((i for i in moving if i % 2 == a), moving[0]) for a in (0, 0, 1, 1)]
         n_exact = len(self.exact_joints)
 
         def at(theta):
@@ -170,6 +174,16 @@ class Formulation:
             epi += [(0, out[2]), (0, -out[2])]
             if problem.accel_over == "working":
                 rows.append(Row("lifted acceleration extreme: in the working stroke", (PHI[k] - start) / length, 0, 1))
+        # the footprint's box: each side lifted at the extreme of the coordinate that reaches it (parameters SEL pick
+        # that coordinate, one-hot per side, from the last exact box), like the dead centres
+        self.n_box = 4 if "box" in self._groups else 0
+        PSI = casadi.SX.sym("psi", self.n_box)
+        SEL = casadi.SX.sym("sel", self.n_box * self.n_coords)
+        for s in range(self.n_box):
+            out, pick = at(PSI[s]), SEL[s * self.n_coords : (s + 1) * self.n_coords]
+            rows.append(Row(f"lifted box side {self.z_names[self._groups['box'] + s]}: stationary",
+                            casadi.dot(pick, out[8]), 0.0, 0.0))  # fmt: skip
+            epi.append((self._groups["box"] + s, (1 if s % 2 == 0 else -1) * casadi.dot(pick, out[5])))
         for zi, e in epi:
             rows.append(Row(f"epigraph {self.z_names[zi]}", e - Z[zi], -casadi.inf, 0.0))
         for k in range(self.n_samples):
@@ -180,8 +194,8 @@ class Formulation:
             rows.append(Row(f"{k} bound", self._measure(BOUNDS[k][0], Z) - PB[i], -casadi.inf, 0.0))
         f = self._objective_value(problem, Z, travel, span)
         self.rows = rows
-        w = casadi.vertcat(X, TH, Z, PHI)
-        p = casadi.vertcat(PF, PT, S, W, PB)
+        w = casadi.vertcat(X, TH, Z, PHI, PSI)
+        p = casadi.vertcat(PF, PT, S, W, PB, SEL)
         g = casadi.vertcat(*[r.expr for r in rows])
         self.w_sym, self.p_sym, self.g_sym = w, p, g
         self._nlp, self._ipopt = {"x": w, "p": p, "f": f, "g": g}, {**IPOPT, **(ipopt or {})}
@@ -286,17 +300,38 @@ class Formulation:
         pad = np.zeros(self.n_extra)
         return np.concatenate([angles, pad]), np.concatenate([fractions, pad])
 
-    def pack(self, values: dict, th, z=None, phi=None):
+    def pack(self, values: dict, th, z=None, phi=None, box=None):
+        """w from parameter values, dead-centre angles, epigraph values and the lifted angles: ``phi`` (peak
+        acceleration or transmission) and ``box`` (the sides' angles in BoundingBox order)."""
         x = [values[k] for k in self.free] + list(th) + list(z if z is not None else np.zeros(self.nz))
         phi = list(phi if phi is not None else np.linspace(0.0, math.pi, self.n_lift))[: self.n_lift]
         phi += [0.0] * (self.n_lift - len(phi))
-        return np.array(x + phi, float)
+        return np.array(x + phi + self.box_angles(box), float)
 
-    def param_vector(self, targets: dict, samples, fractions, fixed=None):
+    def box_angles(self, box=None) -> list:
+        """The lifted box sides' angles (z order: x_max, -x_min, y_max, -y_min) from a BoundingBox's angles."""
+        if not self.n_box:
+            return []
+        if box is None:
+            return [0.0, math.pi, 0.5 * math.pi, -0.5 * math.pi]
+        return [box.angles[i] for i in (1, 0, 3, 2)]
+
+    def box_select(self, box=None) -> np.ndarray:
+        """SEL: per side (z order), one-hot over the loop's coordinates: the one that reaches it in ``box``."""
+        if not self.n_box:
+            return np.zeros(0)
+        which = [box.coords[i] for i in (1, 0, 3, 2)] if box is not None and box.coords else self._default_coord
+        sel = np.zeros((4, self.n_coords))
+        sel[np.arange(4), which] = 1.0
+        return sel.ravel()
+
+    def param_vector(self, targets: dict, samples, fractions, fixed=None, box=None):
+        """p: fixed values, targets, sample angles and working-arc fractions, bound values and the box sides'
+        coordinates (from ``box``, a BoundingBox of the design the solve is at)."""
         fixed = self.problem.fixed if fixed is None else fixed
         pf = [fixed[k] for k in self.fixed]
         pt = [targets[k] for k in self.targets]
-        return np.concatenate([pf, pt, samples, fractions, self.bound_values()]).astype(float)
+        return np.concatenate([pf, pt, samples, fractions, self.bound_values(), self.box_select(box)]).astype(float)
 
     def epigraph_start(self, w0, p):
         """z values that make every epigraph row feasible at w0."""
@@ -313,8 +348,8 @@ class Formulation:
     def bounds(self):
         lo = [self.problem.free[k][0] for k in self.free] + [-2 * TWO_PI, -2 * TWO_PI]
         hi = [self.problem.free[k][1] for k in self.free] + [2 * TWO_PI, 3 * TWO_PI]
-        lo += [-np.inf] * self.nz + [-2 * TWO_PI] * self.n_lift
-        hi += [np.inf] * self.nz + [3 * TWO_PI] * self.n_lift
+        lo += [-np.inf] * self.nz + [-2 * TWO_PI] * (self.n_lift + self.n_box)
+        hi += [np.inf] * self.nz + [3 * TWO_PI] * (self.n_lift + self.n_box)
         return np.array(lo, float), np.array(hi, float)
 
     @functools.cached_property

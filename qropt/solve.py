@@ -116,8 +116,10 @@ class Solver:
         form = self.formulation(problem, branch, orientation, range_target, sense)
         samples, fractions = form.base_samples()
         used = used_f = form.n_base
-        p = form.param_vector(targets, samples, fractions)
-        w = form.epigraph_start(form.pack(values0, th0, phi=_peaks(problem, values0, branch, designs, form)), p)
+        box = _box(problem, values0, branch, designs) if form.n_box else None
+        p = form.param_vector(targets, samples, fractions, box=box)
+        phi = _peaks(problem, values0, branch, designs, form)
+        w = form.epigraph_start(form.pack(values0, th0, phi=phi, box=box), p)
         c = Candidate(False, dict(values0), branch, orientation)
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
         st, g, info, m, restarts = {}, None, {}, None, 0
@@ -142,7 +144,11 @@ class Solver:
                 break
             used = _place(samples, used, add, TWO_PI, 0.05, form.n_base)
             used_f = _place(fractions, used_f, frac, 1.0, 0.01, form.n_base)
-            p = form.param_vector(targets, samples, fractions)
+            if form.n_box and m is not None:  # each box side lifted at the coordinate that reaches it now
+                box = m.bounding_box()
+                at = form.nx + 2 + form.nz + form.n_lift
+                w[at : at + form.n_box] = form.box_angles(box)
+            p = form.param_vector(targets, samples, fractions, box=box)
             w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
         c.mechanism, c.info = m, info
         c.residuals = residuals(problem, form.violations(g), m, {k: targets[k] for k in form.targets})
@@ -569,6 +575,14 @@ def _peaks(problem, values, branch, build, form=None):
         order = [i for i in order if (ts[i] - lo) % TWO_PI <= length]
         return [lo + (ts[i] - lo) % TWO_PI for i in order] or None
     return [float(ts[i]) for i in order]
+
+
+def _box(problem, values, branch, build):
+    """The start design's bounding box (its sides' angles and coordinates start the lifted sides), or None."""
+    try:
+        return build(problem, values, branch).bounding_box()
+    except QroptError:
+        return None
 
 
 def _place(slots, used, new, period, near, base):

@@ -233,6 +233,46 @@ def test_the_smallest_drag_link_slider_with_a_transmission_bound():
         assert at.status == "optimal" and at.objective <= size(gamma, v) + 1e-9, (tr, v, at.objective)
 
 
+def _footprint(kind, q, n=200_000):
+    """Area of the box of every joint's path (ground pivots included), on a dense grid of crank angles."""
+    th = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
+    j = brute.joints(kind, q, th)
+    xs = [j[k][0] for k in ("A", "B", "C", "D") if k in j] + [np.zeros(1), np.full(1, q["r1"])]
+    ys = [j[k][1] for k in ("A", "B", "C", "D") if k in j] + [np.zeros(2)]
+    x, y = np.concatenate(xs), np.concatenate(ys)
+    return (x.max() - x.min()) * (y.max() - y.min())
+
+
+def test_the_smallest_footprint_drag_link_slider_with_a_transmission_bound():
+    """Every link free, min footprint with gamma_min >= 30 deg (each box side and the worst transmission lifted):
+    the design holds by brute force, its footprint matches a dense simulation, and no random design meeting
+    the bound near the TR has a smaller footprint than the solve at that design's TR."""
+    bound = math.radians(30)
+    p = type_problem("drag-link-slider", TR, STROKE, objective="min_size", size="footprint",
+                     conditions={"gamma_min": bound})  # fmt: skip
+    r = qropt.solve(p)
+    assert r.status == "optimal", r.message
+    q = dict(r.params)
+    t_max, t_min, x_max, x_min = brute.dead_centres("drag-link-slider", q)
+    assert brute.time_ratio(t_max, t_min) == pytest.approx(TR, abs=1e-9)
+    assert x_max - x_min == pytest.approx(STROKE, abs=1e-9)
+    assert brute.gamma_min("drag-link-slider", q) >= bound - 1e-8 / math.sin(bound)
+    assert r.objective == pytest.approx(_footprint("drag-link-slider", q), rel=1e-8)
+
+    def footprint(gamma, v):
+        return (
+            _footprint("drag-link-slider", {**v, "sigma": -1.0, "sigma_slider": 1.0}, 20_000)
+            if gamma >= bound
+            else None
+        )
+
+    found = _sampled("drag-link-slider", score=footprint, keep=2)
+    assert found
+    for gamma, tr, v in found:
+        at = qropt.solve(p, targets={"time_ratio": tr})
+        assert at.status == "optimal" and at.objective <= footprint(gamma, v) + 1e-9, (tr, v, at.objective)
+
+
 def test_random_starts_of_a_four_bar_slider_are_designs():
     """The Sobol starts of an all-free drag-link slider keep the type's rules and turn fully (of the raw points
     over the bounds, few are Grashof drag-links)."""

@@ -150,14 +150,16 @@ class AccelerationExtremes(NamedTuple):
 
 
 class BoundingBox(NamedTuple):
-    """Extremes of every joint's path over a turn (length) and the crank angles (rad) where they occur
-    (in the order x_min, x_max, y_min, y_max)."""
+    """Extremes of every joint's path over a turn (length), the crank angles (rad) where they occur and the
+    coordinates that reach them (index into the loop's points, two per joint: x then y), each in the order
+    x_min, x_max, y_min, y_max."""
 
     x_min: float
     x_max: float
     y_min: float
     y_max: float
     angles: tuple
+    coords: tuple = ()
 
 
 class GammaMin(NamedTuple):
@@ -531,18 +533,20 @@ class Mechanism:
         q = c.shape[0]
         res = k.refine("coords", c, [(i, kind) for i in range(q) for kind in ("max", "min")], k.vector(self.params))
         grid = cycle.grid()
-        box, angles = [], []
+        box, angles, coords = [], [], []
         for axis in (0, 1):
             for kind, pick in (("min", np.argmin), ("max", np.argmax)):
-                vals, ths = [], []
+                vals, ths, which = [], [], []
                 for i in range(axis, q, 2):
                     e = res[2 * i + (kind == "min")]
                     vals += [*e.value.tolist(), *c[i].tolist()]
                     ths += [*e.theta.tolist(), *grid.tolist()]
+                    which += [i] * (e.value.size + c.shape[1])
                 j = int(pick(vals))
                 box.append(float(vals[j]))
                 angles.append(float(ths[j]))
-        return BoundingBox(*box, tuple(angles))
+                coords.append(which[j])
+        return BoundingBox(*box, tuple(angles), tuple(coords))
 
     def footprint(self) -> float:
         """Area of the bounding box of every joint's path over a turn (length^2), exact."""
