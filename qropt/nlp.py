@@ -152,26 +152,27 @@ class Formulation:
         for k in self.bounds_used:
             self._group(BOUNDS[k][0], epi)
         Z = casadi.SX.sym("z", len(self.z_names))
-        # lifted extremes, like the dead centres: peak acceleration's largest (d3x/dtheta3 = 0 there), or under a
-        # gamma_min bound each sampled joint's worst transmission (d cos/dtheta2 = 0), whose angle moves with the
-        # design faster than samples follow it
-        if obj == "min_peak_accel":
-            self.lift_kind, self.n_lift = "accel", LIFTED
-        elif "gamma_min" in self.bounds_used and self.sampled_joints:
-            self.lift_kind, self.n_lift = "gamma", LIFTED * len(self.sampled_joints)
-        else:
-            self.lift_kind, self.n_lift = None, 0
+        # lifted extremes, like the dead centres: peak acceleration's largest (d3x/dtheta3 = 0 there) for its
+        # objective or bound, and under a gamma_min bound each sampled joint's worst transmission (d cos/dtheta2 = 0):
+        # their crank angles move with the design faster than samples follow them
+        self.lifts = []
+        if "peak_accel" in self._groups:
+            self.lifts += [("accel", None)] * LIFTED
+        if "gamma_min" in self.bounds_used:
+            self.lifts += [("gamma", joint) for joint in self.sampled_joints for _ in range(LIFTED)]
+        self.n_lift = len(self.lifts)
         PHI = casadi.SX.sym("phi", self.n_lift)
-        for k in range(self.n_lift):
+        for k, (kind, joint) in enumerate(self.lifts):
             out = at(PHI[k])
-            if self.lift_kind == "gamma":
-                j = n_exact + k // LIFTED
+            if kind == "gamma":
+                j = n_exact + self.sampled_joints.index(joint)
                 rows.append(Row("lifted transmission extreme: stationary", out[7][j], 0.0, 0.0))
                 i0 = self._groups["gamma_min"]
                 epi += [(i0, out[3][j]), (i0, -out[3][j])]
                 continue
             rows.append(Row("lifted acceleration extreme: stationary", out[6], 0.0, 0.0))
-            epi += [(0, out[2]), (0, -out[2])]
+            i0 = self._groups["peak_accel"]
+            epi += [(i0, out[2]), (i0, -out[2])]
             if problem.accel_over == "working":
                 rows.append(Row("lifted acceleration extreme: in the working stroke", (PHI[k] - start) / length, 0, 1))
         # the footprint's box: each side lifted at the extreme of the coordinate that reaches it (parameters SEL pick

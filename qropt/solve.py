@@ -546,34 +546,38 @@ def _score(problem, values, branch, build):
         return None, None
 
 
-def _peaks(problem, values, branch, build, form=None):
-    """Initial lifted extremes: the start design's largest |d2x/dtheta2| (in the working stroke when asked), or
-    each sampled joint's smallest transmission angles (``form.lift_kind`` 'gamma'); else spread over the turn."""
-    if form is not None and form.lift_kind == "gamma":
-        try:
-            minima = build(problem, values, branch).transmission_minima_by_joint()
-        except QroptError:
-            return None
-        out = []
-        for joint in form.sampled_joints:
-            t, v = minima.get(joint, (np.zeros(0), np.zeros(0)))
-            worst = [float(a) for a, _ in sorted(zip(t.tolist(), v.tolist(), strict=True), key=lambda q: q[1])]
-            out += (worst + [float(a) for a in np.linspace(0.0, math.pi, LIFTED)])[:LIFTED]
-        return out
-    if problem.objective != "min_peak_accel":
+def _peaks(problem, values, branch, build, form):
+    """Initial lifted extremes (``form.lifts``): the start design's largest |d2x/dtheta2| (in the working stroke
+    when asked) and each sampled joint's smallest transmission angles; spread over the turn where it has none."""
+    if not form.n_lift:
         return None
     try:
         m = build(problem, values, branch)
-        ex = m.acceleration_extremes()
+        accel = _accel_peaks(problem, m) if ("accel", None) in form.lifts else []
+        minima = m.transmission_minima_by_joint() if any(k == "gamma" for k, _ in form.lifts) else {}
     except QroptError:
         return None
+    out = []
+    for kind, joint in dict.fromkeys(form.lifts):
+        if kind == "accel":
+            worst = accel
+        else:
+            t, v = minima.get(joint, (np.zeros(0), np.zeros(0)))
+            worst = [float(a) for a, _ in sorted(zip(t.tolist(), v.tolist(), strict=True), key=lambda q: q[1])]
+        out += (worst + [float(a) for a in np.linspace(0.0, math.pi, LIFTED)])[:LIFTED]
+    return out
+
+
+def _accel_peaks(problem, m) -> list:
+    """Crank angles of a design's acceleration extremes, largest |d2x/dtheta2| first (in the working stroke
+    when the problem asks for it)."""
+    ex = m.acceleration_extremes()
     ts = np.concatenate([ex.maxima[0], ex.minima[0]])
     vs = np.concatenate([ex.maxima[1], ex.minima[1]])
     order = np.argsort(-np.abs(vs))
     if problem.accel_over == "working":
         lo, length = m.working_arc()
-        order = [i for i in order if (ts[i] - lo) % TWO_PI <= length]
-        return [lo + (ts[i] - lo) % TWO_PI for i in order] or None
+        return [lo + (ts[i] - lo) % TWO_PI for i in order if (ts[i] - lo) % TWO_PI <= length]
     return [float(ts[i]) for i in order]
 
 
