@@ -215,8 +215,11 @@ class Kernel:
         if not r.size:
             return [Extremes(np.zeros(0), np.zeros(0)) for _ in requests]
         vm, v0, vp = ext[r, i], ext[r, i + 1], ext[r, i + 2]
-        # grid parabola's vertex: vm <= v0 > vp, so the denominator is negative and |shift| <= 1/2
-        shift = 0.5 * (vm - vp) / (vm - 2.0 * v0 + vp)
+        # grid parabola's vertex: vm <= v0 > vp, so the denominator is negative and |shift| <= 1/2 (nan next to an
+        # infinite sample, which the clip below turns into no shift)
+        with np.errstate(invalid="ignore"):
+            shift = 0.5 * (vm - vp) / (vm - 2.0 * v0 + vp)
+        shift[~(np.abs(shift) <= 0.5)] = 0.0
         th = h * i
         z = np.empty((r.size, 4 + p.size))
         z[:, 0] = rows[r]

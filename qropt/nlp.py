@@ -152,12 +152,15 @@ class Formulation:
         for k in self.bounds_used:
             self._group(BOUNDS[k][0], epi)
         Z = casadi.SX.sym("z", len(self.z_names))
-        # lifted extremes, like the dead centres: peak acceleration's largest (d3x/dtheta3 = 0 there) for its
-        # objective or bound, and under a gamma_min bound each sampled joint's worst transmission (d cos/dtheta2 = 0):
-        # their crank angles move with the design faster than samples follow them
+        # lifted extremes, like the dead centres: peak acceleration's largest (d3x/dtheta3 = 0 there) for its objective
+        # or bound, the working stroke's peak speeds (d2x/dtheta2 = 0) for theirs, and under a gamma_min bound each
+        # sampled joint's worst transmission (d cos/dtheta2 = 0): their crank angles move with the design faster
+        # than samples follow them
         self.lifts = []
         if "peak_accel" in self._groups:
             self.lifts += [("accel", None)] * LIFTED
+        if obj == "min_peak_velocity":  # the objective only: as a bound, lifted speeds stall some footprint solves
+            self.lifts += [("velocity", None)] * LIFTED
         if "gamma_min" in self.bounds_used:
             self.lifts += [("gamma", joint) for joint in self.sampled_joints for _ in range(LIFTED)]
         self.n_lift = len(self.lifts)
@@ -169,6 +172,12 @@ class Formulation:
                 rows.append(Row("lifted transmission extreme: stationary", out[7][j], 0.0, 0.0))
                 i0 = self._groups["gamma_min"]
                 epi += [(i0, out[3][j]), (i0, -out[3][j])]
+                continue
+            if kind == "velocity":  # the working stroke's largest speeds (d2x/dtheta2 = 0 there)
+                rows.append(Row("lifted velocity extreme: stationary", out[2], 0.0, 0.0))
+                rows.append(Row("lifted velocity extreme: in the working stroke", (PHI[k] - start) / length, 0, 1))
+                i0 = self._groups["peak_velocity"]
+                epi += [(i0, out[1]), (i0, -out[1])]
                 continue
             rows.append(Row("lifted acceleration extreme: stationary", out[6], 0.0, 0.0))
             i0 = self._groups["peak_accel"]

@@ -554,18 +554,29 @@ def _peaks(problem, values, branch, build, form):
     try:
         m = build(problem, values, branch)
         accel = _accel_peaks(problem, m) if ("accel", None) in form.lifts else []
+        speed = _speed_peaks(m) if ("velocity", None) in form.lifts else []
         minima = m.transmission_minima_by_joint() if any(k == "gamma" for k, _ in form.lifts) else {}
     except QroptError:
         return None
     out = []
     for kind, joint in dict.fromkeys(form.lifts):
-        if kind == "accel":
-            worst = accel
+        if kind in ("accel", "velocity"):
+            worst = accel if kind == "accel" else speed
         else:
             t, v = minima.get(joint, (np.zeros(0), np.zeros(0)))
             worst = [float(a) for a, _ in sorted(zip(t.tolist(), v.tolist(), strict=True), key=lambda q: q[1])]
         out += (worst + [float(a) for a in np.linspace(0.0, math.pi, LIFTED)])[:LIFTED]
     return out
+
+
+def _speed_peaks(m) -> list:
+    """Crank angles of a design's velocity extremes in the working stroke, largest |dx/dtheta2| first (measured
+    from the working stroke's start, so that they lie in its lifted interval)."""
+    ex = m.velocity_extremes()
+    ts = np.concatenate([ex.maxima[0], ex.minima[0]])
+    vs = np.concatenate([ex.maxima[1], ex.minima[1]])
+    lo, length = m.working_arc()
+    return [lo + (ts[i] - lo) % TWO_PI for i in np.argsort(-np.abs(vs)) if (ts[i] - lo) % TWO_PI <= length]
 
 
 def _accel_peaks(problem, m) -> list:

@@ -178,3 +178,8 @@ def test_solve_options_raise_only_qropt_errors(opts):
         assert r.status in qropt.STATUSES
     except QroptError:
         pass
+
+
+def test_a_required_length_given_as_none_is_missing():
+    with pytest.raises(InvalidParameter, match="missing parameter 'r3'"):
+        qropt.SliderCrank(r2=0.1, r3=None)

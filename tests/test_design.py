@@ -273,6 +273,26 @@ def test_the_smallest_footprint_drag_link_slider_with_a_transmission_bound():
         assert at.status == "optimal" and at.objective <= footprint(gamma, v) + 1e-9, (tr, v, at.objective)
 
 
+def test_the_most_uniform_cut_under_a_transmission_bound():
+    """A crank-shaper with a rod, min peak working speed with gamma_min >= 35 deg (the speeds and the worst
+    transmission lifted): the design holds by brute force and its peak speed matches a dense complex-step
+    evaluation over the working stroke."""
+    bound = math.radians(35)
+    p = type_problem("crank-shaper-rod", TR, STROKE, objective="min_peak_velocity", conditions={"gamma_min": bound})
+    r = qropt.solve(p)
+    assert r.status == "optimal", r.message
+    q = dict(r.params)
+    t_max, t_min, x_max, x_min = brute.dead_centres("crank-shaper", q)
+    assert brute.time_ratio(t_max, t_min) == pytest.approx(TR, abs=1e-9)
+    assert x_max - x_min == pytest.approx(STROKE, abs=1e-9)
+    assert brute.gamma_min("crank-shaper", q) >= bound - 1e-8 / math.sin(bound)
+    a = (t_min - t_max) % (2 * np.pi)  # the working stroke is the slow one
+    lo, length = (t_max, a) if a >= np.pi else (t_min, 2 * np.pi - a)
+    th = lo + length * np.linspace(0.0, 1.0, 40_001)
+    v = np.imag(brute.output("crank-shaper", q, th + 1j * brute.STEP)) / brute.STEP
+    assert r.objective == pytest.approx(np.abs(v).max(), rel=1e-7)
+
+
 def test_random_starts_of_a_four_bar_slider_are_designs():
     """The Sobol starts of an all-free drag-link slider keep the type's rules and turn fully (of the raw points
     over the bounds, few are Grashof drag-links)."""

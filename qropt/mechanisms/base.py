@@ -191,7 +191,7 @@ class Mechanism:
         values = {}
         for k, default in self.PARAMS.items():
             v = params.get(k, default)
-            if v is REQUIRED:
+            if v is REQUIRED or (v is None and default is REQUIRED):
                 raise InvalidParameter(f"{name}: missing parameter {k!r}; it needs {self.required()}")
             if v is None:
                 continue
