@@ -73,14 +73,14 @@ def local_starts(problem, seed, starts_n=STARTS, solver=DEFAULT):
                 th0, way = starts.dead_centre_start(problem, v, br, targets, way, None)
                 form = solver.formulation(problem, br, way)
                 samples, fractions = form.base_samples()
-                box = _box(problem, v, br) if form.n_box else None  # the lifted box sides, as qropt starts them
+                phi, box = form.lifted_start(_design(problem, v, br))  # the lifted extremes, as qropt starts them
                 p = form.param_vector(targets, samples, fractions, box=box)
-                yield origin, v, br, way, form, form.epigraph_start(form.pack(v, th0, box=box), p), p
+                yield origin, v, br, way, form, form.epigraph_start(form.pack(v, th0, phi=phi, box=box), p), p
 
 
-def _box(problem, values, branch):
+def _design(problem, values, branch):
     try:
-        return problem.build(values, branch).bounding_box()
+        return problem.build(values, branch)
     except QroptError:
         return None
 

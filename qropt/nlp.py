@@ -23,6 +23,7 @@ import numpy as np
 
 from qropt.closures import RIGHT_ANGLE, transmission_cos
 from qropt.criteria import BOUNDS, in_nlp_terms, measured
+from qropt.errors import QroptError
 from qropt.mechanisms import FourBar, FourBarSlider
 from qropt.ops import CASADI
 
@@ -317,6 +318,45 @@ class Formulation:
         phi = list(phi if phi is not None else np.linspace(0.0, math.pi, self.n_lift))[: self.n_lift]
         phi += [0.0] * (self.n_lift - len(phi))
         return np.array(x + phi + self.box_angles(box), float)
+
+    def lifted_start(self, m) -> tuple:
+        """(phi, box): the lifted angles' start at a built design m (None where m is None or does not turn):
+        its largest |d2x/dtheta2| (in the working stroke when asked), its working stroke's largest speeds and
+        each sampled joint's smallest transmission angles, spread over the turn where it has too few; and its
+        bounding box (the lifted sides' angles and coordinates)."""
+        if m is None:
+            return None, None
+        try:
+            box = m.bounding_box() if self.n_box else None
+            if not self.n_lift:
+                return None, box
+            kinds = dict.fromkeys(self.lifts)
+            minima = m.transmission_minima_by_joint() if any(k == "gamma" for k, _ in kinds) else {}
+            phi = []
+            for kind, joint in kinds:
+                if kind == "accel":
+                    worst = self._largest(m, m.acceleration_extremes(), self.problem.accel_over == "working")
+                elif kind == "velocity":
+                    worst = self._largest(m, m.velocity_extremes(), True)
+                else:
+                    t, v = minima.get(joint, (np.zeros(0), np.zeros(0)))
+                    worst = [float(a) for a, _ in sorted(zip(t.tolist(), v.tolist(), strict=True), key=lambda q: q[1])]
+                phi += (worst + [float(a) for a in np.linspace(0.0, math.pi, LIFTED)])[:LIFTED]
+            return phi, box
+        except QroptError:
+            return None, None
+
+    @staticmethod
+    def _largest(m, extremes, working: bool) -> list:
+        """Crank angles of extremes (maxima, minima), largest magnitude first; only the working stroke's,
+        measured from its start (inside its lifted interval), if ``working``."""
+        ts = np.concatenate([extremes.maxima[0], extremes.minima[0]])
+        vs = np.concatenate([extremes.maxima[1], extremes.minima[1]])
+        order = np.argsort(-np.abs(vs))
+        if not working:
+            return [float(ts[i]) for i in order]
+        lo, length = m.working_arc()
+        return [lo + (ts[i] - lo) % TWO_PI for i in order if (ts[i] - lo) % TWO_PI <= length]
 
     def box_angles(self, box=None) -> list:
         """The lifted box sides' angles (z order: x_max, -x_min, y_max, -y_min) from a BoundingBox's angles."""

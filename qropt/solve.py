@@ -20,7 +20,7 @@ from qropt import starts as starts_
 from qropt.certify import Certificate, Designs, better, certify, objective_of, objective_value, quantities, residuals
 from qropt.criteria import BOUNDS, UNITS, in_nlp_terms, maximises, measured, objective_for, violations
 from qropt.errors import ProblemError, QroptError
-from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, LIFTED, TWO_PI, Formulation
+from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, TWO_PI, Formulation
 from qropt.problem import Problem
 from qropt.result import Result
 
@@ -116,9 +116,12 @@ class Solver:
         form = self.formulation(problem, branch, orientation, range_target, sense)
         samples, fractions = form.base_samples()
         used = used_f = form.n_base
-        box = _box(problem, values0, branch, designs) if form.n_box else None
+        try:
+            m0 = designs(problem, values0, branch)
+        except QroptError:
+            m0 = None
+        phi, box = form.lifted_start(m0)
         p = form.param_vector(targets, samples, fractions, box=box)
-        phi = _peaks(problem, values0, branch, designs, form)
         w = form.epigraph_start(form.pack(values0, th0, phi=phi, box=box), p)
         c = Candidate(False, dict(values0), branch, orientation)
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
@@ -544,60 +547,6 @@ def _score(problem, values, branch, build):
         return (objective_of(problem, m) if problem.objective else 0.0), 0.0
     except QroptError:
         return None, None
-
-
-def _peaks(problem, values, branch, build, form):
-    """Initial lifted extremes (``form.lifts``): the start design's largest |d2x/dtheta2| (in the working stroke
-    when asked) and each sampled joint's smallest transmission angles; spread over the turn where it has none."""
-    if not form.n_lift:
-        return None
-    try:
-        m = build(problem, values, branch)
-        accel = _accel_peaks(problem, m) if ("accel", None) in form.lifts else []
-        speed = _speed_peaks(m) if ("velocity", None) in form.lifts else []
-        minima = m.transmission_minima_by_joint() if any(k == "gamma" for k, _ in form.lifts) else {}
-    except QroptError:
-        return None
-    out = []
-    for kind, joint in dict.fromkeys(form.lifts):
-        if kind in ("accel", "velocity"):
-            worst = accel if kind == "accel" else speed
-        else:
-            t, v = minima.get(joint, (np.zeros(0), np.zeros(0)))
-            worst = [float(a) for a, _ in sorted(zip(t.tolist(), v.tolist(), strict=True), key=lambda q: q[1])]
-        out += (worst + [float(a) for a in np.linspace(0.0, math.pi, LIFTED)])[:LIFTED]
-    return out
-
-
-def _speed_peaks(m) -> list:
-    """Crank angles of a design's velocity extremes in the working stroke, largest |dx/dtheta2| first (measured
-    from the working stroke's start, so that they lie in its lifted interval)."""
-    ex = m.velocity_extremes()
-    ts = np.concatenate([ex.maxima[0], ex.minima[0]])
-    vs = np.concatenate([ex.maxima[1], ex.minima[1]])
-    lo, length = m.working_arc()
-    return [lo + (ts[i] - lo) % TWO_PI for i in np.argsort(-np.abs(vs)) if (ts[i] - lo) % TWO_PI <= length]
-
-
-def _accel_peaks(problem, m) -> list:
-    """Crank angles of a design's acceleration extremes, largest |d2x/dtheta2| first (in the working stroke
-    when the problem asks for it)."""
-    ex = m.acceleration_extremes()
-    ts = np.concatenate([ex.maxima[0], ex.minima[0]])
-    vs = np.concatenate([ex.maxima[1], ex.minima[1]])
-    order = np.argsort(-np.abs(vs))
-    if problem.accel_over == "working":
-        lo, length = m.working_arc()
-        return [lo + (ts[i] - lo) % TWO_PI for i in order if (ts[i] - lo) % TWO_PI <= length]
-    return [float(ts[i]) for i in order]
-
-
-def _box(problem, values, branch, build):
-    """The start design's bounding box (its sides' angles and coordinates start the lifted sides), or None."""
-    try:
-        return build(problem, values, branch).bounding_box()
-    except QroptError:
-        return None
 
 
 def _place(slots, used, new, period, near, base):
