@@ -206,31 +206,40 @@ def test_no_sampled_design_beats_the_solve_at_its_time_ratio(comparison, kind):
         assert r.status == "optimal" and r.objective >= gamma - 1e-9, (kind, tr, v, gamma, r.objective)
 
 
-def test_the_smallest_drag_link_slider_with_a_transmission_bound():
-    """Every link free, min sum of lengths with gamma_min >= 30 deg: the solve's design holds by brute force
-    and no random design meeting the bound near the TR is smaller than the solve at that design's TR."""
-    bound = math.radians(30)
-    p = type_problem("drag-link-slider", TR, STROKE, objective="min_size", size="sum",
-                     conditions={"gamma_min": bound})  # fmt: skip
+def _certified_under_gamma_bound(kind, bound, **task):
+    """The task solved with gamma_min >= bound, its design checked by brute force (TR, stroke, gamma_min within
+    the feasibility tolerance, parameters inside their bounds): (problem, result, params, gamma_min)."""
+    p = type_problem(kind, TR, STROKE, conditions={"gamma_min": bound}, **task)
     r = qropt.solve(p)
     assert r.status == "optimal", r.message
-    q = dict(r.params)
-    t_max, t_min, x_max, x_min = brute.dead_centres("drag-link-slider", q)
+    q, bk = dict(r.params), BRUTE_KIND.get(kind, kind)
+    t_max, t_min, x_max, x_min = brute.dead_centres(bk, q)
     assert brute.time_ratio(t_max, t_min) == pytest.approx(TR, abs=1e-9)
     assert x_max - x_min == pytest.approx(STROKE, abs=1e-9)
-    g = brute.gamma_min("drag-link-slider", q)
-    assert bound - 1e-8 / math.sin(bound) <= g <= bound + 1e-6  # within the feasibility tolerance; the bound binds
+    g = brute.gamma_min(bk, q)
+    assert g >= bound - 1e-8 / math.sin(bound)
     assert all(lo - 1e-12 <= q[k] <= hi + 1e-12 for k, (lo, hi) in p.free.items())
-    assert r.objective == pytest.approx(sum(q[k] for k in ("r1", "r2", "r3", "r4", "r5", "r6")), abs=1e-12)
+    return p, r, q, g
 
-    def size(gamma, v):
-        return sum(v[k] for k in ("r1", "r2", "r3", "r4", "r5", "r6")) if gamma >= bound else None
 
-    found = _sampled("drag-link-slider", score=size, keep=3)
+def _no_sampled_design_beats(p, kind, score, keep):
+    """The ``keep`` random designs of least ``score`` near the TR (see _sampled), each against the solve of ``p``
+    at that design's own exact TR."""
+    found = _sampled(kind, score=score, keep=keep)
     assert found  # the search found designs meeting the bound
     for gamma, tr, v in found:
         at = qropt.solve(p, targets={"time_ratio": tr})
-        assert at.status == "optimal" and at.objective <= size(gamma, v) + 1e-9, (tr, v, at.objective)
+        assert at.status == "optimal" and at.objective <= score(gamma, v) + 1e-9, (tr, v, at.objective)
+
+
+def test_the_smallest_drag_link_slider_with_a_transmission_bound():
+    """Every link free, min sum of lengths with gamma_min >= 30 deg: the design holds by brute force with the
+    bound binding, and no random design meeting the bound near the TR is smaller than the solve at its TR."""
+    bound, lengths = math.radians(30), ("r1", "r2", "r3", "r4", "r5", "r6")
+    p, r, q, g = _certified_under_gamma_bound("drag-link-slider", bound, objective="min_size", size="sum")
+    assert g <= bound + 1e-6  # the bound binds
+    assert r.objective == pytest.approx(sum(q[k] for k in lengths), abs=1e-12)
+    _no_sampled_design_beats(p, "drag-link-slider", lambda g, v: sum(v[k] for k in lengths) if g >= bound else None, 3)
 
 
 def _footprint(kind, q, n=200_000):
@@ -248,44 +257,22 @@ def test_the_smallest_footprint_drag_link_slider_with_a_transmission_bound():
     the design holds by brute force, its footprint matches a dense simulation, and no random design meeting
     the bound near the TR has a smaller footprint than the solve at that design's TR."""
     bound = math.radians(30)
-    p = type_problem("drag-link-slider", TR, STROKE, objective="min_size", size="footprint",
-                     conditions={"gamma_min": bound})  # fmt: skip
-    r = qropt.solve(p)
-    assert r.status == "optimal", r.message
-    q = dict(r.params)
-    t_max, t_min, x_max, x_min = brute.dead_centres("drag-link-slider", q)
-    assert brute.time_ratio(t_max, t_min) == pytest.approx(TR, abs=1e-9)
-    assert x_max - x_min == pytest.approx(STROKE, abs=1e-9)
-    assert brute.gamma_min("drag-link-slider", q) >= bound - 1e-8 / math.sin(bound)
+    p, r, q, _ = _certified_under_gamma_bound("drag-link-slider", bound, objective="min_size", size="footprint")
     assert r.objective == pytest.approx(_footprint("drag-link-slider", q), rel=1e-8)
 
     def footprint(gamma, v):
-        return (
-            _footprint("drag-link-slider", {**v, "sigma": -1.0, "sigma_slider": 1.0}, 20_000)
-            if gamma >= bound
-            else None
-        )
+        q = {**v, "sigma": -1.0, "sigma_slider": 1.0}
+        return _footprint("drag-link-slider", q, 20_000) if gamma >= bound else None
 
-    found = _sampled("drag-link-slider", score=footprint, keep=2)
-    assert found
-    for gamma, tr, v in found:
-        at = qropt.solve(p, targets={"time_ratio": tr})
-        assert at.status == "optimal" and at.objective <= footprint(gamma, v) + 1e-9, (tr, v, at.objective)
+    _no_sampled_design_beats(p, "drag-link-slider", footprint, 2)
 
 
 def test_the_most_uniform_cut_under_a_transmission_bound():
     """A crank-shaper with a rod, min peak working speed with gamma_min >= 35 deg (the speeds and the worst
     transmission lifted): the design holds by brute force and its peak speed matches a dense complex-step
     evaluation over the working stroke."""
-    bound = math.radians(35)
-    p = type_problem("crank-shaper-rod", TR, STROKE, objective="min_peak_velocity", conditions={"gamma_min": bound})
-    r = qropt.solve(p)
-    assert r.status == "optimal", r.message
-    q = dict(r.params)
-    t_max, t_min, x_max, x_min = brute.dead_centres("crank-shaper", q)
-    assert brute.time_ratio(t_max, t_min) == pytest.approx(TR, abs=1e-9)
-    assert x_max - x_min == pytest.approx(STROKE, abs=1e-9)
-    assert brute.gamma_min("crank-shaper", q) >= bound - 1e-8 / math.sin(bound)
+    _, r, q, _ = _certified_under_gamma_bound("crank-shaper-rod", math.radians(35), objective="min_peak_velocity")
+    t_max, t_min, _, _ = brute.dead_centres("crank-shaper", q)
     a = (t_min - t_max) % (2 * np.pi)  # the working stroke is the slow one
     lo, length = (t_max, a) if a >= np.pi else (t_min, 2 * np.pi - a)
     th = lo + length * np.linspace(0.0, 1.0, 40_001)
