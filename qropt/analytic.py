@@ -242,6 +242,10 @@ def slider_crank_design(time_ratio: float, stroke: float, r2: float) -> list[Sli
     r3 = low + r2
     if abs(e) >= r3 - r2:  # the crank would not turn fully (a slider-crank needs r3 >= r2 + |e|)
         return []
+    if high * high - e * e < stroke * stroke:
+        # the triangle would put the folded dead centre behind O2 (x < 0), on the other side of the crank
+        # pin from where the slider is: this slider-crank's stroke is then shorter and its TR smaller
+        return []
     return [SliderCrankDesign(r2, r3, e), SliderCrankDesign(r2, r3, -e)]
 
 
@@ -328,6 +332,8 @@ def warm_starts(problem) -> WarmStarts:
             out.append({k: v[k] for k in free})
 
     def result(kind, how):
+        if kind == "enumeration":  # complete: no point is a proof that no design exists
+            return WarmStarts(out, kind, how)
         return WarmStarts(out, kind if out else "none", how if out else "no closed form applies")
 
     if cls is CrankRockerSlider and set(free) == {"r3", "r4", "r5"} and fixed.get("h", 0.0) == 0.0 and tr and stroke:

@@ -15,7 +15,8 @@ from qropt.certify import better, objective_value, quantities
 
 
 def score(problem, values: dict):
-    """(objective, quantities) of a design, or None if it does not build, violates a bound or a condition."""
+    """(objective, quantities) of a design, or None if it does not build, misses a target, or violates a bound or
+    a condition."""
     if any(not (lo - 1e-12 <= values[k] <= hi + 1e-12) for k, (lo, hi) in problem.free.items()):
         return None
     branch = {k: v[0] for k, v in problem.branches.items()}
@@ -26,6 +27,8 @@ def score(problem, values: dict):
         return None
     if m.dead_centres().reversals != 1:
         return None
+    if any(abs(q[k] - v) > 1e-8 * max(1.0, abs(v)) for k, v in problem.targets.items()):
+        return None  # a closed form's point that misses a target (outside its range of validity) is no design
     if any(v > 1e-12 for v in criteria.violations(problem, m).values()):
         return None
     return objective_value(problem, q), q

@@ -165,3 +165,26 @@ def test_grashof_feasible_coupler_range():
     assert grashof(R1, R2, 0.2, R4).kind == "drag-link"
     assert grashof(R1, R2, 0.149, R4).kind == "non-Grashof"
     assert grashof(R1, R2, 0.401, R4).kind == "non-Grashof"
+
+
+@pytest.mark.parametrize("tr", [1.2, 1.5, 2.0, 2.5])
+def test_every_stroke_triangle_design_meets_its_task(tr):
+    """The offset slider-crank's stroke triangle, over cranks from 1/60 to 2/3 of the stroke: every design it
+    returns meets the TR and stroke by brute force, and a crank it returns nothing for has a triangle whose
+    folded dead centre falls behind O2 (x_max < stroke), where the slider cannot follow it."""
+    stroke, returned = 0.3, 0
+    for r2 in np.geomspace(0.005, 0.2, 40):
+        designs = analytic.slider_crank_design(tr, stroke, r2)
+        for d in designs:
+            q = {"r2": d.r2, "r3": d.r3, "e": d.e, "sigma_slider": 1.0}
+            t_max, t_min, x_max, x_min = brute.dead_centres("slider-crank", q)
+            assert brute.time_ratio(t_max, t_min) == pytest.approx(tr, abs=1e-9)
+            assert x_max - x_min == pytest.approx(stroke, abs=1e-9)
+            returned += 1
+        if not designs:  # the triangle itself, solved here independently
+            phi = math.pi * (tr - 1) / (tr + 1)
+            low = max(np.roots([2 * (1 - math.cos(phi)), 4 * r2 * (1 - math.cos(phi)), 4 * r2 * r2 - stroke**2]).real)
+            high = low + 2 * r2
+            e = high * low * math.sin(phi) / stroke
+            assert low <= 0 or abs(e) >= low or high * high - e * e < stroke * stroke
+    assert returned >= 2  # the window of valid cranks narrows as TR grows
