@@ -15,8 +15,7 @@ from qropt.certify import better, objective_value, quantities
 
 
 def score(problem, values: dict):
-    """(objective, quantities) of a design, or None if it does not build, misses a target, or violates a bound or
-    a condition."""
+    """(objective, quantities) of a design, or None if it does not build, or violates a bound or a condition."""
     if any(not (lo - 1e-12 <= values[k] <= hi + 1e-12) for k, (lo, hi) in problem.free.items()):
         return None
     branch = {k: v[0] for k, v in problem.branches.items()}
@@ -27,18 +26,25 @@ def score(problem, values: dict):
         return None
     if m.dead_centres().reversals != 1:
         return None
-    if any(abs(q[k] - v) > 1e-8 * max(1.0, abs(v)) for k, v in problem.targets.items()):
-        return None  # a closed form's point that misses a target (outside its range of validity) is no design
     if any(v > 1e-12 for v in criteria.violations(problem, m).values()):
         return None
     return objective_value(problem, q), q
+
+
+def candidate(problem, values: dict):
+    """``score`` of a closed form's design, or None if it misses a target (a point outside the closed form's range
+    of validity is no design of the task)."""
+    s = score(problem, values)
+    if s is None or any(abs(s[1][k] - v) > 1e-8 * max(1.0, abs(v)) for k, v in problem.targets.items()):
+        return None
+    return s
 
 
 def best_of(problem, candidates):
     """The best of closed-form candidate designs: {'objective', 'params'}."""
     best, where = None, None
     for c in candidates:
-        s = score(problem, c)
+        s = candidate(problem, c)
         if s is not None and better(problem, s[0], best):
             best, where = s[0], dict(c)
     return {"objective": best, "params": where}
@@ -52,7 +58,7 @@ def along(problem, design, lo, hi, n=400, boundary=None):
 
     def f(t):
         d = design(t)
-        s = score(problem, d) if d is not None else None
+        s = candidate(problem, d) if d is not None else None
         return math.inf if s is None else sign * s[0]
 
     ts = np.linspace(lo, hi, n)
