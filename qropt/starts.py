@@ -69,7 +69,7 @@ def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
     kept = []
     branch = branches(problem)[0]
     build = build or _build
-    u = qmc.Sobol(len(names), scramble=True, seed=seed).random(POOL * n)
+    u = qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(max(0, POOL * n - 1).bit_length())
     cols = {}
     for j, k in enumerate(names):
         lo, hi = problem.free[k]
