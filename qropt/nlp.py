@@ -158,8 +158,8 @@ class Formulation:
         # sampled joint's worst transmission (d cos/dtheta2 = 0): their crank angles move with the design faster
         # than samples follow them
         self.lifts = []
-        if "peak_accel" in self._groups:
-            self.lifts += [("accel", None)] * LIFTED
+        if "peak_accel" in self._groups:  # a four-bar-driven slider's acceleration has more extremes of note
+            self.lifts += [("accel", None)] * (2 * LIFTED if issubclass(cls, FourBarSlider) else LIFTED)
         if obj == "min_peak_velocity":  # the objective only: as a bound, lifted speeds stall some footprint solves
             self.lifts += [("velocity", None)] * LIFTED
         if "gamma_min" in self.bounds_used:
@@ -341,7 +341,8 @@ class Formulation:
                 else:
                     t, v = minima.get(joint, (np.zeros(0), np.zeros(0)))
                     worst = [float(a) for a, _ in sorted(zip(t.tolist(), v.tolist(), strict=True), key=lambda q: q[1])]
-                phi += (worst + [float(a) for a in np.linspace(0.0, math.pi, LIFTED)])[:LIFTED]
+                n = self.lifts.count((kind, joint))
+                phi += (worst + [float(a) for a in np.linspace(0.0, math.pi, n)])[:n]
             return phi, box
         except QroptError:
             return None, None

@@ -281,6 +281,21 @@ def test_the_most_uniform_cut_under_a_transmission_bound():
     assert r.objective == pytest.approx(np.abs(v).max(), rel=1e-7)
 
 
+def test_the_least_peak_acceleration_of_a_crank_rocker_slider():
+    """Every link free, min peak acceleration (four lifted extremes for a four-bar-driven slider): the design
+    meets the task by brute force and its peak matches a dense simulation (central differences of the
+    complex-step velocity)."""
+    r = qropt.solve(type_problem("crank-rocker-slider", TR, STROKE, objective="min_peak_accel"))
+    assert r.status == "optimal", r.message
+    q = dict(r.params)
+    t_max, t_min, x_max, x_min = brute.dead_centres("crank-rocker-slider", q)
+    assert brute.time_ratio(t_max, t_min) == pytest.approx(TR, abs=1e-9)
+    assert x_max - x_min == pytest.approx(STROKE, abs=1e-9)
+    th, h = np.linspace(0.0, 2 * np.pi, 200_000, endpoint=False), 1e-4
+    v = [np.imag(brute.output("crank-rocker-slider", q, th + d + 1j * brute.STEP)) / brute.STEP for d in (h, -h)]
+    assert r.objective == pytest.approx(np.abs((v[0] - v[1]) / (2 * h)).max(), rel=1e-6)
+
+
 def test_random_starts_of_a_four_bar_slider_are_designs():
     """The Sobol starts of an all-free drag-link slider keep the type's rules and turn fully (of the raw points
     over the bounds, few are Grashof drag-links)."""
