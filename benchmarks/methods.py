@@ -8,7 +8,7 @@ import importlib
 import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
 
-from qropt import QroptError, solve, starts
+from qropt import solve, starts
 from qropt.certify import better
 from qropt.solve import DEFAULT
 
@@ -73,16 +73,9 @@ def local_starts(problem, seed, starts_n=STARTS, solver=DEFAULT):
                 th0, way = starts.dead_centre_start(problem, v, br, targets, way, None)
                 form = solver.formulation(problem, br, way)
                 samples, fractions = form.base_samples()
-                phi, box = form.lifted_start(_design(problem, v, br))  # the lifted extremes, as qropt starts them
+                phi, box = form.lifted_start(v)  # the lifted extremes, as qropt starts them
                 p = form.param_vector(targets, samples, fractions, box=box)
                 yield origin, v, br, way, form, form.epigraph_start(form.pack(v, th0, phi=phi, box=box), p), p
-
-
-def _design(problem, values, branch):
-    try:
-        return problem.build(values, branch)
-    except QroptError:
-        return None
 
 
 def local_solve(form, w0, p, method="SLSQP"):

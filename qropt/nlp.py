@@ -319,14 +319,16 @@ class Formulation:
         phi += [0.0] * (self.n_lift - len(phi))
         return np.array(x + phi + self.box_angles(box), float)
 
-    def lifted_start(self, m) -> tuple:
-        """(phi, box): the lifted angles' start at a built design m (None where m is None or does not turn):
-        its largest |d2x/dtheta2| (in the working stroke when asked), its working stroke's largest speeds and
-        each sampled joint's smallest transmission angles, spread over the turn where it has too few; and its
-        bounding box (the lifted sides' angles and coordinates)."""
-        if m is None:
+    def lifted_start(self, values: dict, build=None) -> tuple:
+        """(phi, box): the lifted angles' start at the design with free parameters ``values`` on this branch
+        (built by ``build(problem, values, branch)``, default ``Problem.build``; None where it does not build or
+        turn): its largest |d2x/dtheta2| (in the working stroke when asked), its working stroke's largest speeds
+        and each sampled joint's smallest transmission angles, spread over the turn where it has too few; and
+        its bounding box (the lifted sides' angles and coordinates)."""
+        if not (self.n_lift or self.n_box):
             return None, None
         try:
+            m = (build or type(self.problem).build)(self.problem, values, self.branch)
             box = m.bounding_box() if self.n_box else None
             if not self.n_lift:
                 return None, box

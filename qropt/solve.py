@@ -116,11 +116,7 @@ class Solver:
         form = self.formulation(problem, branch, orientation, range_target, sense)
         samples, fractions = form.base_samples()
         used = used_f = form.n_base
-        try:
-            m0 = designs(problem, values0, branch)
-        except QroptError:
-            m0 = None
-        phi, box = form.lifted_start(m0)
+        phi, box = form.lifted_start(values0, designs)
         p = form.param_vector(targets, samples, fractions, box=box)
         w = form.epigraph_start(form.pack(values0, th0, phi=phi, box=box), p)
         c = Candidate(False, dict(values0), branch, orientation)

@@ -78,13 +78,17 @@ def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
     ok = np.ones(u.shape[0], bool)
     for rule in problem.mechanism.rules(NUMPY, p, problem.conditions.get("grashof")):
         ok &= np.broadcast_to(np.asarray(rule.value) >= 0, ok.shape)
-    points = [{k: float(cols[k][i]) for k in names} for i in range(u.shape[0])]
-    for i in np.flatnonzero(ok):
-        if orientation(problem, points[i], branch, build) is not None:
-            kept.append(_to_stroke(problem, points[i], branch, build))
+
+    def point(i):
+        return {k: float(cols[k][i]) for k in names}
+
+    for i in np.flatnonzero(ok).tolist():
+        v = point(i)
+        if orientation(problem, v, branch, build) is not None:
+            kept.append(_to_stroke(problem, v, branch, build))
             if len(kept) == n:
                 break
-    return kept or points[:n]
+    return kept or [point(i) for i in range(n)]
 
 
 def _to_stroke(problem, values, branch, build) -> dict:

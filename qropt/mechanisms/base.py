@@ -528,6 +528,10 @@ class Mechanism:
     def bounding_box(self) -> BoundingBox:
         """Extremes of every joint's path over a turn (exact), with the crank angles where they occur."""
         self._require_full_turn()
+        return self._bounding_box
+
+    @cached_property
+    def _bounding_box(self) -> BoundingBox:
         k = self._kernel
         c = k.grid_coords(self.params, cycle.grid())
         q = c.shape[0]
