@@ -14,8 +14,8 @@ import time
 import numpy as np
 from tqdm import tqdm
 
+from qropt.kinematics.ops import JET, NUMPY, Jet
 from qropt.mechanisms import TYPES
-from qropt.ops import JET, NUMPY, Jet
 from tests.randmech import random_mechanisms
 
 SAMPLES = 3600

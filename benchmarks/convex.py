@@ -16,9 +16,9 @@ import numpy as np
 
 import qropt
 from benchmarks.report import RESULTS, environment, save
+from qropt.convex.servo import speed_profile
+from qropt.convex.tolerance import allocate, sensitivities
 from qropt.examples import paper_mechanism
-from qropt.servo import speed_profile
-from qropt.tolerance import allocate, sensitivities
 
 TORQUE = dict(omega_max=13.0, alpha_max=200.0, force=1000.0, inertia=1.0, torque_max=113.0)
 CUT = dict(omega_max=20.0, v_cut=0.5, a_max=40.0, alpha_max=400.0, v_max=2.0)

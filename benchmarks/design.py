@@ -17,9 +17,11 @@ import time
 import numpy as np
 
 from benchmarks.report import save
-from qropt import Solver, criteria, problem_bases
-from qropt.design import TYPES, design, type_problem
-from qropt.pareto import pareto
+from problems import _bases as problem_bases
+from qropt import Solver
+from qropt.studies._design import TYPES, design, type_problem
+from qropt.studies._pareto import pareto
+from qropt.synthesis import criteria
 
 FRONTS = {
     "slider_crank: max_gamma_min vs min_peak_accel": (problem_bases.slider_crank(omega2=2.0),

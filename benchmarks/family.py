@@ -17,7 +17,7 @@ from tqdm import tqdm
 
 from benchmarks.report import save
 from qropt import Problem, solve
-from qropt.family import family
+from qropt.studies._family import family
 
 
 def main(points: int = 1000):

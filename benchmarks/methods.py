@@ -8,9 +8,10 @@ import importlib
 import numpy as np
 from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
 
-from qropt import solve, starts
-from qropt.certify import better
-from qropt.solve import DEFAULT
+from qropt import solve
+from qropt.synthesis import starts
+from qropt.synthesis.certificate import better
+from qropt.synthesis.solver import DEFAULT
 
 STARTS = 8  # Sobol starts for every multi-start method, as qropt's default
 FEASIBLE = 1e-6  # a local method's design counts only if it meets the targets this well
@@ -40,7 +41,7 @@ def _scipy_local(problem, seed, method):
     """A local scipy method on qropt's NLP functions (exact CasADi derivatives) from qropt's starts (every closed
     form, then the Sobol points, both TR orientations for those); no exchange loop. The best design by exact
     evaluation."""
-    from qropt import oracles
+    from problems import _oracles as oracles
 
     best, nfev = None, 0
     for _origin, _v, br, _way, form, w0, p in local_starts(problem, seed):
@@ -147,7 +148,7 @@ def scipy_trust_constr(problem, seed):
 def scipy_de(problem, seed):
     """differential_evolution over the free parameters: exact objective plus a penalty on target and
     condition violations (a design that does not work scores 1e6)."""
-    from qropt import oracles
+    from problems import _oracles as oracles
 
     names = list(problem.free)
     sign = -1.0 if problem.objective == "max_gamma_min" else 1.0

@@ -39,7 +39,7 @@ def _module(name):
 
 def evaluate(problem, values):
     """(objective, violation) of a returned design by exact analysis; (None, inf) if it does not work."""
-    from qropt import oracles
+    from problems import _oracles as oracles
 
     if values is None:
         return None, math.inf

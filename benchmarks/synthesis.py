@@ -20,8 +20,9 @@ from tqdm import tqdm
 import qropt
 from benchmarks.methods import local_solve, local_starts
 from benchmarks.report import save
-from qropt import DragLinkSlider, analytic
+from qropt import DragLinkSlider
 from qropt.examples import paper_mechanism, paper_problem
+from qropt.synthesis import analytic
 
 R1, R2, R4, R6 = 0.1, 0.225, 0.275, 0.3
 

@@ -3,7 +3,8 @@ maximise the minimum transmission angle (r2, r3, r4 free).
 
 Oracle: grid along the classical construction ``analytic.crank_rocker_design``, refined."""
 
-from qropt import oracles, problem_bases
+from problems import _bases as problem_bases
+from problems import _oracles as oracles
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 

@@ -3,7 +3,7 @@ r6 = 0.5 fixed; r3, r4, r5 free; best transmission angle.
 
 Oracle: grid along r4 (r3 from the rocker's closed-form TR, r5 from the stroke, both by brentq), refined."""
 
-from qropt import problem_bases
+from problems import _bases as problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-6}
 

@@ -2,7 +2,7 @@
 
 Oracle: grid along r4 (closed forms and brentq), refined."""
 
-from qropt import problem_bases
+from problems import _bases as problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-6}
 

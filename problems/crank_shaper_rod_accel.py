@@ -3,7 +3,7 @@ over the rod length.
 
 Oracle: r2, r4 in closed form; grid over r6, refined."""
 
-from qropt import problem_bases
+from problems import _bases as problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-6}
 

@@ -3,7 +3,7 @@ best transmission angle over the rod length.
 
 Oracle: r2, r4 in closed form (TR and stroke fix them); grid over r6, refined."""
 
-from qropt import problem_bases
+from problems import _bases as problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 

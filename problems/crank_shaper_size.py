@@ -4,7 +4,9 @@ Oracle: closed form r2 = r1 sin(phi / 2), r4 = stroke r1 / (2 r2) (phi of eq. 7)
 is fixed by TR and stroke, so ``min_size`` must return it.
 """
 
-from qropt import Problem, analytic, oracles
+from problems import _oracles as oracles
+from qropt import Problem
+from qropt.synthesis import analytic
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-9}
 

@@ -3,7 +3,7 @@ optima in two mirror pairs.
 
 Oracle: closed form, eqs. (7)-(13) (the branch mirrors give the same lengths and gamma_min)."""
 
-from qropt import oracles
+from problems import _oracles as oracles
 from qropt.examples import paper_problem
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-8}

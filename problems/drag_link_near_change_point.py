@@ -3,7 +3,7 @@ the change point r3 = 0.4 and the transmission angle collapses.
 
 Oracle: closed form, eqs. (7)-(13)."""
 
-from qropt import oracles
+from problems import _oracles as oracles
 from qropt.examples import paper_problem
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-8}

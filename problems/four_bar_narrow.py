@@ -3,7 +3,8 @@ around one of its two solutions.
 
 Oracle: closed form (the rocker's TR from its limit positions) solved for r3 by brentq."""
 
-from qropt import Problem, oracles
+from problems import _oracles as oracles
+from qropt import Problem
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-09}
 

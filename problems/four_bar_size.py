@@ -4,7 +4,8 @@ Oracle: grid along the classical construction, the gamma_min boundary located by
 
 import math
 
-from qropt import oracles, problem_bases
+from problems import _bases as problem_bases
+from problems import _oracles as oracles
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 

@@ -6,7 +6,7 @@ Oracle: closed form, eqs. (7)-(13): r3 = 0.2504281 m (gamma_min 27.008 deg) or 0
 (9.095 deg), r5 = 0.15 m.
 """
 
-from qropt import oracles
+from problems import _oracles as oracles
 from qropt.examples import paper_problem
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-9}

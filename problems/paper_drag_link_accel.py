@@ -2,7 +2,7 @@
 
 Oracle: closed form, eqs. (7)-(13): the best of its roots (peak acceleration evaluated exactly)."""
 
-from qropt import oracles
+from problems import _oracles as oracles
 from qropt.examples import paper_problem
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-8}

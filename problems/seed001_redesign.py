@@ -3,7 +3,9 @@ lengths, the shortest lever.
 
 Oracle: closed form r2 = r1 sin(phi / 2), r4 = stroke / (2 sin(phi / 2))."""
 
-from qropt import Problem, analytic, oracles
+from problems import _oracles as oracles
+from qropt import Problem
+from qropt.synthesis import analytic
 
 ORACLE = {"kind": "closed form", "tolerance": 1e-09}
 

@@ -2,7 +2,7 @@
 
 Oracle: grid along the closed-form family (r2 -> r3, e from the stroke triangle), refined."""
 
-from qropt import problem_bases
+from problems import _bases as problem_bases
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 

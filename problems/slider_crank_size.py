@@ -4,7 +4,8 @@ Oracle: grid along the closed-form family; the gamma_min boundary located by bre
 
 import math
 
-from qropt import oracles, problem_bases
+from problems import _bases as problem_bases
+from problems import _oracles as oracles
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 

@@ -4,7 +4,8 @@ at omega2 = 10 rad/s; the rod r6 is free.
 Oracle: r2 = r1 / sin(phi / 2) = 0.2 m and r5 = 0.15 m are forced; the peak acceleration falls as
 the rod lengthens, so the optimum is r6 at its upper bound (reference: grid over r6, refined)."""
 
-from qropt import oracles, problem_bases
+from problems import _bases as problem_bases
+from problems import _oracles as oracles
 
 ORACLE = {"kind": "grid", "tolerance": 1e-6}
 

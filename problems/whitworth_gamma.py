@@ -2,7 +2,8 @@
 
 Oracle: r2, r5 in closed form; grid over r6, refined."""
 
-from qropt import oracles, problem_bases
+from problems import _bases as problem_bases
+from problems import _oracles as oracles
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 

@@ -4,7 +4,8 @@ Oracle: r2, r5 in closed form; grid over r6 with the gamma_min boundary located 
 
 import math
 
-from qropt import oracles, problem_bases
+from problems import _bases as problem_bases
+from problems import _oracles as oracles
 
 ORACLE = {"kind": "grid", "tolerance": 1e-7}
 

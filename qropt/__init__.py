@@ -1,9 +1,14 @@
-"""qropt: optimisation-based dimensional synthesis of quick-return mechanisms."""
+"""qropt: optimisation-based dimensional synthesis of quick-return mechanisms.
 
-from qropt.certify import Certificate
-from qropt.design import Comparison, design
+The public names only; the flow of data is kinematics -> mechanisms -> synthesis -> studies -> convex -> io
+(see docs/architecture.md).
+"""
+
+from qropt.convex.servo import SpeedProfile, speed_profile
+from qropt.convex.tolerance import Allocation, MonteCarlo, allocate, sensitivities
 from qropt.errors import (
     AssemblyError,
+    ChartError,
     DegenerateMechanism,
     GrashofError,
     InvalidParameter,
@@ -11,49 +16,63 @@ from qropt.errors import (
     ProblemError,
     QroptError,
 )
-from qropt.family import Family, family
 from qropt.mechanisms import (
     CrankRockerSlider,
     CrankShaper,
     DragLinkSlider,
     FourBar,
+    Mechanism,
     SliderCrank,
     Whitworth,
     grashof,
     mechanism_type,
 )
-from qropt.pareto import Front, pareto
-from qropt.problem import Problem
-from qropt.reachable import Reachable, reachable
-from qropt.result import STATUSES, Result
-from qropt.solve import Solver, solve, target_range
+from qropt.studies import Chart, Comparison, Family, Front, Reachable, chart, design, family, pareto, reachable
+from qropt.synthesis.certificate import Certificate
+from qropt.synthesis.problem import Problem
+from qropt.synthesis.result import STATUSES, Result
+from qropt.synthesis.solver import Solver, solve, target_range
 
 __version__ = "0.1.0"
 
 __all__ = [
+    # mechanism types
     "SliderCrank",
     "CrankShaper",
     "Whitworth",
     "CrankRockerSlider",
     "DragLinkSlider",
     "FourBar",
+    "Mechanism",
     "grashof",
+    "mechanism_type",
+    # synthesis
     "Problem",
     "Result",
     "STATUSES",
     "Certificate",
     "Solver",
     "solve",
-    "family",
-    "Family",
-    "reachable",
-    "Reachable",
     "target_range",
+    # studies
     "design",
     "Comparison",
     "pareto",
     "Front",
-    "mechanism_type",
+    "family",
+    "Family",
+    "reachable",
+    "Reachable",
+    "chart",
+    "Chart",
+    # convex layer
+    "speed_profile",
+    "SpeedProfile",
+    "sensitivities",
+    "allocate",
+    "Allocation",
+    "MonteCarlo",
+    # errors
     "QroptError",
     "InvalidParameter",
     "GrashofError",
@@ -61,4 +80,5 @@ __all__ = [
     "NoDeadCentres",
     "DegenerateMechanism",
     "ProblemError",
+    "ChartError",
 ]

@@ -52,3 +52,7 @@ class DegenerateMechanism(QroptError):
 
 class ProblemError(QroptError):
     """A synthesis problem is malformed: unknown names, empty or contradictory bounds, no free parameter."""
+
+
+class ChartError(QroptError):
+    """A chart cannot be made as asked: a bad axis, tile, worker count or scheduler."""

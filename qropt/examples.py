@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from qropt import analytic
 from qropt.mechanisms import DragLinkSlider
-from qropt.problem import Problem
+from qropt.synthesis import analytic
+from qropt.synthesis.problem import Problem
 
 
 def paper_mechanism() -> DragLinkSlider:

@@ -12,7 +12,8 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from qropt import Problem, analytic
+from qropt import Problem
+from qropt.synthesis import analytic
 from tests import brute
 
 B = {"sigma": -1.0, "sigma_slider": 1.0}

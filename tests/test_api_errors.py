@@ -15,8 +15,8 @@ from hypothesis import strategies as st
 import qropt
 from qropt import AssemblyError, InvalidParameter, NoDeadCentres, ProblemError, QroptError, Solver, solve
 from qropt.examples import paper_mechanism, paper_problem
-from qropt.family import family
-from qropt.reachable import reachable
+from qropt.studies._family import family
+from qropt.studies._reachable import reachable
 
 PAPER = paper_mechanism()
 

@@ -12,11 +12,13 @@ import time
 import numpy as np
 import pytest
 
-from qropt import Problem, analytic, oracles, solve
-from qropt.chart import Cell, Chart, ChartError, chart
-from qropt.chart_dask import _Tile
+from problems import _oracles as oracles
+from qropt import Problem, solve
 from qropt.cli import main
-from qropt.solve import DEFAULT
+from qropt.studies._chart import Cell, Chart, ChartError, chart
+from qropt.studies._tiles import _Tile
+from qropt.synthesis import analytic
+from qropt.synthesis.solver import DEFAULT
 from tests import brute
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]

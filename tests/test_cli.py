@@ -171,7 +171,7 @@ def test_working_stroke_shading_is_the_slow_arc_for_either_sense_of_rotation():
     import matplotlib.pyplot as plt
 
     from qropt.examples import paper_mechanism
-    from qropt.plots import _shade
+    from qropt.io.plots import _shade
 
     m = paper_mechanism()
     d, (a, b) = m.dead_centres(), m.stroke_angles()
@@ -187,7 +187,7 @@ def test_a_slotted_lever_is_drawn_through_its_crank_pin_block():
     import matplotlib.pyplot as plt
 
     from qropt import Whitworth
-    from qropt.plots import draw_mechanism
+    from qropt.io.plots import draw_mechanism
 
     m = Whitworth(r1=0.1, r2=0.2, r5=0.12, r6=0.3)
     for theta in np.linspace(0, 2 * math.pi, 13):

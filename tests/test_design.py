@@ -14,9 +14,12 @@ import numpy as np
 import pytest
 
 import qropt
-from qropt import QroptError, criteria, oracles, problem_bases, starts
-from qropt.design import TYPES, design, type_problem
-from qropt.pareto import pareto
+from problems import _bases as problem_bases
+from problems import _oracles as oracles
+from qropt import QroptError
+from qropt.studies._design import TYPES, design, type_problem
+from qropt.studies._pareto import pareto
+from qropt.synthesis import criteria, starts
 from tests import brute
 
 TR, STROKE = 1.5, 0.3
@@ -408,7 +411,7 @@ def test_an_interior_front_point_matches_the_family_with_its_bound(front):
 
 
 def test_a_dominated_point_is_removed_with_its_reason():
-    from qropt.pareto import _front
+    from qropt.studies._pareto import _front
 
     p = problem_bases.slider_crank(omega2=2.0)
     r1 = qropt.solve(p)

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 import qropt
-from qropt import InvalidParameter, cli, export
+from qropt import InvalidParameter, cli
 from qropt.examples import paper_mechanism
+from qropt.io import export
 
 MECHANISMS = [
     paper_mechanism(),
@@ -92,7 +93,7 @@ def test_wrong_suffix_is_an_error(tmp_path):
 def test_animation_is_a_gif_of_one_turn(tmp_path):
     from PIL import Image
 
-    from qropt.animation import animate
+    from qropt.io.animation import animate
 
     f = tmp_path / "m.gif"
     animate(qropt.SliderCrank(r2=0.1, r3=0.35, e=0.06), f, omega2=-2.0)

@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from qropt import DragLinkSlider, Problem, ProblemError, analytic, grashof
+from qropt import DragLinkSlider, Problem, ProblemError, grashof
 from qropt.examples import paper_mechanism
-from qropt.family import family
-from qropt.reachable import reachable
+from qropt.studies._family import family
+from qropt.studies._reachable import reachable
+from qropt.synthesis import analytic
 from tests import brute
 
 R2, R4 = 0.225, 0.275

@@ -6,8 +6,8 @@ import casadi
 import numpy as np
 import pytest
 
-from qropt.closures import transmission_angle, transmission_cos
-from qropt.ops import CASADI
+from qropt.kinematics.closures import transmission_angle, transmission_cos
+from qropt.kinematics.ops import CASADI
 from tests import brute
 from tests.randmech import KINDS, random_mechanisms
 
@@ -100,7 +100,7 @@ def test_rates_match_casadi_ad(kind):
 
 @pytest.mark.parametrize("kind", KINDS)
 def test_numpy_and_casadi_namespaces_agree(kind):
-    from qropt.ops import NUMPY
+    from qropt.kinematics.ops import NUMPY
 
     for _, m in random_mechanisms(kind, 40, seed=5):
         t = casadi.SX.sym("t")

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from qropt import DragLinkSlider, analytic
+from qropt import DragLinkSlider
+from qropt.synthesis import analytic
 from tests import brute
 
 R1, R2, R4, R5, R6 = 0.1, 0.225, 0.275, 0.15, 0.3

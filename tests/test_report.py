@@ -12,7 +12,7 @@ import pytest
 
 from qropt import InvalidParameter, cli
 from qropt.examples import paper_problem
-from qropt.report import render
+from qropt.io.report import render
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from qropt import AssemblyError, CrankShaper, FourBar, analytic
+from qropt import AssemblyError, CrankShaper, FourBar
+from qropt.synthesis import analytic
 
 # Seed 001, Table 1: crank angle q (deg) -> theoretical slider position (mm).
 SEED001 = [70.00, 78.36, 86.58, 94.53, 102.08, 109.07, 115.36, 120.77, 125.12, 128.21, 129.82, 129.71, 127.65,

@@ -11,9 +11,9 @@ import scipy.integrate
 
 import qropt
 from qropt import cli as qropt_cli
+from qropt.convex.servo import speed_profile
 from qropt.errors import InvalidParameter
 from qropt.examples import paper_mechanism
-from qropt.servo import speed_profile
 
 INLINE = qropt.SliderCrank(r2=0.1, r3=0.4)  # geometric TR 1
 CUT = dict(omega_max=20.0, v_cut=0.5, a_max=40.0, alpha_max=400.0, v_max=2.0)

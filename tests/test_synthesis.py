@@ -11,7 +11,8 @@ import pytest
 from scipy.optimize import brentq, minimize_scalar
 
 import qropt
-from qropt import ProblemError, Solver, analytic, solve
+from qropt import ProblemError, Solver, solve
+from qropt.synthesis import analytic
 from tests import brute
 from tests.synth_tasks import TASKS
 

@@ -11,9 +11,9 @@ import pytest
 
 import qropt
 from qropt import cli as qropt_cli
+from qropt.convex.tolerance import allocate, sensitivities
 from qropt.errors import InvalidParameter
 from qropt.examples import paper_mechanism
-from qropt.tolerance import allocate, sensitivities
 
 OMEGA2 = 10.0
 MECHANISMS = [

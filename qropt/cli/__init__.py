@@ -69,7 +69,7 @@ def build_mechanism(args) -> Mechanism:
     if getattr(args, "design", None):
         if given or args.type is not None:
             raise CliError("--from reads the whole design: give no TYPE or parameters with it")
-        from qropt.export import load_design
+        from qropt.io.export import load_design
 
         return load_design(args.design)
     if args.type is None:
@@ -206,7 +206,7 @@ def cmd_analyze(args):
             m, args.table if args.table is not None else math.radians(1.0), args.omega2, args.alpha2, args.csv or "-"
         )
     if args.plot:
-        from qropt import plots
+        from qropt.io import plots
 
         plots.save(plots.cycle_figure(m, args.theta2, args.omega2, args.alpha2), args.plot)
         if not args.json:
@@ -225,11 +225,11 @@ def _export_arguments(p):
 
 def export(args, m, theta2: float = 0.0) -> list[str]:
     """Write the drawings and the design file the command line asks for; the paths written."""
-    from qropt import export as ex
+    from qropt.io import export as ex
 
     done = []
     if getattr(args, "animate", None):
-        from qropt.animation import animate
+        from qropt.io.animation import animate
 
         animate(m, args.animate, omega2=getattr(args, "omega2", None) or 1.0, progress=not QUIET)
         done.append(args.animate)
@@ -324,7 +324,7 @@ def progress_bar(what: str, total=None, unit="point"):
 
 
 def cmd_family(args):
-    from qropt.family import family
+    from qropt.studies._family import family
 
     problem = load_problem(args.problem)
     with progress_bar("tracing") as bar:
@@ -366,13 +366,13 @@ def cmd_family(args):
                                 q.get("peak_accel"), q.get("grashof")])  # fmt: skip
             bar.close()
     if args.plot:
-        from qropt import plots
+        from qropt.io import plots
 
         plots.save(plots.family_figure(fam, best=best), args.plot)
 
 
 def cmd_reachable(args):
-    from qropt.reachable import reachable
+    from qropt.studies._reachable import reachable
 
     given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
     if args.type is None and not given:
@@ -408,7 +408,7 @@ def cmd_reachable(args):
             print(f"  TR {t:g}: {len(xs)} design(s)" + (": " + ", ".join(f"{x:.10g}" for x in xs) if xs else ""))
         print(f"  adjustable {args.free}: {adj.explanation}")
     if args.plot:
-        from qropt import plots
+        from qropt.io import plots
 
         plots.save(plots.reachable_figure(r, args.tr), args.plot)
 
@@ -419,7 +419,7 @@ def load_problem(path: str):
     from pathlib import Path
 
     from qropt.errors import ProblemError
-    from qropt.problem import Problem
+    from qropt.synthesis.problem import Problem
 
     file = Path(path)
     if not file.is_file():
@@ -435,6 +435,7 @@ def load_problem(path: str):
             raise ProblemError(f"{path}: {e}") from None
     if file.suffix != ".py":
         raise CliError(f"{path}: a problem file is .py (with build()), .toml or .json")
+    _importable(file)
     spec = importlib.util.spec_from_file_location(f"qropt_problem_{file.stem}", file)
     module = importlib.util.module_from_spec(spec)
     try:
@@ -451,8 +452,17 @@ def load_problem(path: str):
     return built
 
 
+def _importable(file) -> None:
+    """A problem file may import its siblings: its own folder goes on sys.path, and the folder above it too
+    where its folder is a package (``from problems import _bases``)."""
+    folder = file.resolve().parent
+    for d in ([folder.parent] if (folder / "__init__.py").is_file() else []) + [folder]:
+        if str(d) not in sys.path:
+            sys.path.insert(0, str(d))
+
+
 def cmd_synth(args):
-    from qropt.solve import solve
+    from qropt.synthesis.solver import solve
 
     if args.problem is None:
         from qropt.examples import paper_problem
@@ -489,7 +499,7 @@ def cmd_synth(args):
         st = r.stats
         print(f"stats: {st.get('starts')} starts, {st.get('t_total', 0):.3f} s total")
     if args.plot and r.mechanism is not None:
-        from qropt import plots
+        from qropt.io import plots
 
         plots.save(plots.cycle_figure(r.mechanism, omega2=problem.omega2), args.plot)
     if r.mechanism is not None:

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 import qropt.cli as cli
-from qropt.criteria import maximises
+from qropt.synthesis.criteria import maximises
 
 COMMAND = "chart"
 HELP = "solve a problem file over a grid of time ratios, strokes, swings or fixed parameters (a design chart)"
@@ -62,7 +62,7 @@ def file_axes(path: str) -> dict:
 
 
 def run(args) -> int:
-    from qropt.chart import chart
+    from qropt.studies._chart import chart
 
     problem = cli.load_problem(args.problem)
     defaults = file_axes(args.problem)

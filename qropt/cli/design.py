@@ -11,8 +11,8 @@ HELP = "type synthesis: the task solved for every quick-return type, compared cr
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from qropt.cli import angle, real
-    from qropt.criteria import BOUNDS, OBJECTIVES, UNITS
-    from qropt.design import TYPES
+    from qropt.studies._design import TYPES
+    from qropt.synthesis.criteria import BOUNDS, OBJECTIVES, UNITS
 
     parser.add_argument("--tr", type=real, required=True, help="time ratio (slow/fast, >= 1)")
     parser.add_argument("--stroke", type=real, required=True, help="slider stroke [length]")
@@ -35,14 +35,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def conditions_of(args) -> dict:
     """The bound conditions given on the command line."""
-    from qropt.criteria import BOUNDS
+    from qropt.synthesis.criteria import BOUNDS
 
     return {k: getattr(args, k) for k in BOUNDS if getattr(args, k) is not None}
 
 
 def run(args) -> int:
     from qropt.cli import picture_path, progress_bar
-    from qropt.design import TYPES, design
+    from qropt.studies._design import TYPES, design
 
     plot = picture_path(args.plot) if args.plot else None
     n_types = len(args.types or TYPES)

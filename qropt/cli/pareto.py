@@ -10,7 +10,7 @@ HELP = "the trade-off front between two objectives (epsilon-constraint, every po
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from qropt.pareto import OBJECTIVES
+    from qropt.studies._pareto import OBJECTIVES
 
     parser.add_argument("problem", help="a problem file (.py, .toml, .json)")
     parser.add_argument("--objectives", nargs=2, required=True, metavar=("A", "B"),
@@ -22,7 +22,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args) -> int:
     from qropt.cli import load_problem, picture_path, progress_bar
-    from qropt.pareto import pareto
+    from qropt.studies._pareto import pareto
 
     plot = picture_path(args.plot) if args.plot else None
     problem = load_problem(args.problem)
@@ -45,6 +45,6 @@ def run(args) -> int:
 
 
 def _show(q, v):
-    from qropt.criteria import UNITS
+    from qropt.synthesis.criteria import UNITS
 
     return f"{q} {math.degrees(v):.4f} deg" if q == "gamma_min" else f"{q} {v:.6g} {UNITS[q]}"

@@ -15,7 +15,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args) -> int:
     from qropt.cli import load_problem, progress_bar
-    from qropt.report import render
+    from qropt.io.report import render
 
     problem = load_problem(args.problem) if args.problem else None
     with progress_bar("report sections", unit="section") as bar:

@@ -10,8 +10,8 @@ import sys
 
 import numpy as np
 
+from qropt.convex.servo import OBJECTIVES, speed_profile
 from qropt.mechanisms import REGISTRY, mechanism_type
-from qropt.servo import OBJECTIVES, speed_profile
 
 COMMAND = "servo"
 HELP = "fastest crank-speed profile of a servo-driven crank within speed, acceleration and torque limits"

@@ -9,9 +9,9 @@ import math
 import sys
 from pathlib import Path
 
+from qropt.convex.tolerance import QUANTITIES, allocate
 from qropt.errors import InvalidParameter
 from qropt.mechanisms import REGISTRY, mechanism_type
-from qropt.tolerance import QUANTITIES, allocate
 
 COMMAND = "tolerance"
 HELP = "exact sensitivities and the largest tolerances keeping TR, stroke, gamma_min within limits"

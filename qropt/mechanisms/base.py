@@ -17,11 +17,11 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
-from qropt import cycle
-from qropt.closures import transmission_angle
 from qropt.errors import AssemblyError, DegenerateMechanism, InvalidParameter, NoDeadCentres
-from qropt.kernel import derivative_on_grid, kernel, resolved
-from qropt.ops import JET, NUMPY, Jet
+from qropt.kinematics import cycle
+from qropt.kinematics.closures import transmission_angle
+from qropt.kinematics.kernel import derivative_on_grid, kernel, resolved
+from qropt.kinematics.ops import JET, NUMPY, Jet
 
 REQUIRED = object()
 REGISTRY: dict[str, type[Mechanism]] = {}

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from qropt.closures import RIGHT_ANGLE, on_ray, pin_in_slot, rod_lines, rod_to_line
 from qropt.errors import InvalidParameter
+from qropt.kinematics.closures import RIGHT_ANGLE, on_ray, pin_in_slot, rod_lines, rod_to_line
 from qropt.mechanisms.base import REQUIRED, Loop, Mechanism, Rule
 
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 import math
 from typing import ClassVar, NamedTuple
 
-from qropt.closures import circle_circle, joint_lines, on_ray, rod_lines, rod_to_line
 from qropt.errors import GrashofError
+from qropt.kinematics.closures import circle_circle, joint_lines, on_ray, rod_lines, rod_to_line
 from qropt.mechanisms.base import REQUIRED, Loop, Mechanism, Rule
 
 LINKS = ("r1", "r2", "r3", "r4")

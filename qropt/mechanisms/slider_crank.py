@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from qropt.closures import rod_lines, rod_to_line
+from qropt.kinematics.closures import rod_lines, rod_to_line
 from qropt.mechanisms.base import REQUIRED, Loop, Mechanism, Rule
 
 

@@ -16,13 +16,22 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from qropt import starts as starts_
-from qropt.certify import Certificate, Designs, better, certify, objective_of, objective_value, quantities, residuals
-from qropt.criteria import BOUNDS, UNITS, in_nlp_terms, maximises, measured, objective_for, violations
 from qropt.errors import ProblemError, QroptError
-from qropt.nlp import BASE_SAMPLES, EXTRA_SAMPLES, TWO_PI, Formulation
-from qropt.problem import Problem
-from qropt.result import Result
+from qropt.synthesis import starts as starts_
+from qropt.synthesis.certificate import (
+    Certificate,
+    Designs,
+    better,
+    certify,
+    objective_of,
+    objective_value,
+    quantities,
+    residuals,
+)
+from qropt.synthesis.criteria import BOUNDS, UNITS, in_nlp_terms, maximises, measured, objective_for, violations
+from qropt.synthesis.formulation import BASE_SAMPLES, EXTRA_SAMPLES, TWO_PI, Formulation
+from qropt.synthesis.problem import Problem
+from qropt.synthesis.result import Result
 
 TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
 ACCEPTABLE = "Solved_To_Acceptable_Level"

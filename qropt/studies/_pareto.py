@@ -13,10 +13,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from qropt import criteria
 from qropt.errors import ProblemError
-from qropt.problem import Problem
-from qropt.result import SOLUTION_PRESENT, Result
+from qropt.synthesis import criteria
+from qropt.synthesis.problem import Problem
+from qropt.synthesis.result import SOLUTION_PRESENT, Result
 
 OBJECTIVES = tuple(o for o in criteria.OBJECTIVES if o)
 MAX_POINTS = 1000
@@ -60,7 +60,7 @@ class Front:
 
     def plot(self, path) -> None:
         """The front in the two criteria, with the designs drawn at a few points."""
-        from qropt.plots import front_figure, save
+        from qropt.io.plots import front_figure, save
 
         save(front_figure(self), path)
 
@@ -69,7 +69,7 @@ def pareto(problem: Problem, objectives=("max_gamma_min", "min_peak_accel"), n: 
            progress=None) -> Front:  # fmt: skip
     """The trade-off front between two objectives of ``problem`` (its own objective is replaced); see the
     module docstring. n: sweep points including the two ends (>= 2)."""
-    from qropt.solve import DEFAULT
+    from qropt.synthesis.solver import DEFAULT
 
     solver = solver or DEFAULT
     a, b = _check(problem, objectives, n)

@@ -10,7 +10,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from qropt.export import link_segments  # noqa: E402
+from qropt.io.export import link_segments  # noqa: E402
 from qropt.mechanisms import FourBar, Mechanism  # noqa: E402
 
 
@@ -247,7 +247,7 @@ def _wrap(text, width):
 
 
 def _label(q):
-    from qropt.criteria import UNITS
+    from qropt.synthesis.criteria import UNITS
 
     return f"{q} [{'deg' if q == 'gamma_min' else UNITS[q]}]"
 

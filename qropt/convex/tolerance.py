@@ -19,10 +19,10 @@ import casadi
 import numpy as np
 from tqdm import tqdm
 
-from qropt.closures import RIGHT_ANGLE, transmission_angle
 from qropt.errors import DegenerateMechanism, InvalidParameter, QroptError
+from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle
+from qropt.kinematics.ops import CASADI, JET, NUMPY, Jet
 from qropt.mechanisms import Mechanism
-from qropt.ops import CASADI, JET, NUMPY, Jet
 
 QUANTITIES = ("time_ratio", "stroke", "gamma_min", "peak_acceleration")
 METHODS = ("worst-case", "rss")

@@ -12,7 +12,7 @@ import functools
 
 import numpy as np
 
-from qropt.ops import Jet
+from qropt.kinematics.ops import Jet
 
 TWO_PI = 2.0 * np.pi
 GRID = 720

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from qropt.errors import InvalidParameter
-from qropt.export import link_segments
+from qropt.io.export import link_segments
 from qropt.mechanisms import FourBar, Mechanism
 
 

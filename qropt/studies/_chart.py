@@ -20,18 +20,14 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from qropt.criteria import maximises
-from qropt.errors import ProblemError, QroptError
-from qropt.problem import Problem
-from qropt.result import Result
+from qropt.errors import ChartError, ProblemError
+from qropt.synthesis.criteria import maximises
+from qropt.synthesis.problem import Problem
+from qropt.synthesis.result import Result
 
 TILE = (10, 10)  # cells per tile along x and y
 CHECK = 10  # the full solve also runs at the centre of every CHECK x CHECK block of cells
 MAX_CELLS = 1_000_000
-
-
-class ChartError(QroptError):
-    """A chart cannot be made as asked: a bad axis, tile, worker count or scheduler."""
 
 
 class Axis(NamedTuple):
@@ -277,8 +273,8 @@ def chart(problem: Problem, x, y=None, *, scheduler=None, workers=None, progress
     the full solve also runs where both cell indices are multiples of it. A tqdm bar on standard error when
     ``progress`` and it is a terminal.
     """
-    from qropt import chart_dask
-    from qropt.solve import DEFAULT, Solver
+    from qropt.studies import _tiles as chart_dask
+    from qropt.synthesis.solver import DEFAULT, Solver
 
     if not isinstance(problem, Problem):
         raise ChartError(f"chart takes a qropt.Problem, got {type(problem).__name__}")

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from qropt import analytic
 from qropt.errors import InvalidParameter
+from qropt.synthesis import analytic
 
 # The paper's printed values (its claims, shown beside the exact ones). Table 5: theta2 = 60 deg, omega2 = 10 rad/s.
 TABLE5 = {"theta3 [rad]": -0.3247, "omega3 [rad/s]": 7.566, "alpha3 [rad/s^2]": -51.18, "theta4 [rad]": 0.4313,
@@ -56,7 +56,7 @@ def _fmt(v) -> str:
 
 
 def _design_section(title, r, free) -> str:
-    from qropt import plots
+    from qropt.io import plots
 
     if not r.success:
         return f"<h2>{title}</h2><p class=bad>{html.escape(r.status)}: {html.escape(r.message)}</p>"
@@ -80,9 +80,10 @@ def _table5(m) -> list[float]:
 
 
 def _paper(tick) -> str:
-    from qropt import family, plots, reachable, solve
+    from qropt import family, reachable, solve
     from qropt.examples import paper_mechanism, paper_problem
-    from qropt.problem import Problem
+    from qropt.io import plots
+    from qropt.synthesis.problem import Problem
 
     p = paper_problem()
     r = solve(p)
@@ -180,7 +181,7 @@ def render(problem=None, path=None, progress=None) -> str:
     """The report's HTML (also written to ``path`` if given): the paper's project, or the given problem's design.
 
     progress: callable() after each section."""
-    from qropt.problem import Problem
+    from qropt.synthesis.problem import Problem
 
     if problem is not None and not isinstance(problem, Problem):
         raise InvalidParameter(f"render takes a qropt.Problem or None, got {type(problem).__name__}")

@@ -12,8 +12,8 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from qropt.errors import InvalidParameter, QroptError
+from qropt.kinematics.ops import NUMPY
 from qropt.mechanisms import FourBar, Mechanism
-from qropt.ops import NUMPY
 
 
 def _rule_interval(m: Mechanism, free: str):

@@ -21,11 +21,11 @@ from dataclasses import dataclass
 import casadi
 import numpy as np
 
-from qropt.closures import RIGHT_ANGLE, transmission_cos
-from qropt.criteria import BOUNDS, in_nlp_terms, measured
 from qropt.errors import QroptError
+from qropt.kinematics.closures import RIGHT_ANGLE, transmission_cos
+from qropt.kinematics.ops import CASADI
 from qropt.mechanisms import FourBar, FourBarSlider
-from qropt.ops import CASADI
+from qropt.synthesis.criteria import BOUNDS, in_nlp_terms, measured
 
 TWO_PI = 2.0 * math.pi
 BASE_SAMPLES = 8  # uniform sample angles of the epigraphs; the exchange loop adds what binds
@@ -432,7 +432,7 @@ class Formulation:
     def square_system(self):
         """z = [w, p] -> [residual of the square rows, their Jacobian in (free, theta_max, theta_min)
         (column-major)], evaluated without conversions (see kernel.Batched)."""
-        from qropt.kernel import Batched
+        from qropt.kinematics.kernel import Batched
 
         rows, n = self.square_rows, self.nx + 2
         r = self.g_sym[rows.tolist()] - casadi.DM(self.lbg[rows])
@@ -444,7 +444,7 @@ class Formulation:
     @functools.cached_property
     def constraint_values(self):
         """z = [w, p] -> g, evaluated without conversions."""
-        from qropt.kernel import Batched
+        from qropt.kinematics.kernel import Batched
 
         z = casadi.SX.sym("z", self.w_sym.numel() + self.p_sym.numel())
         f = casadi.Function("g", [self.w_sym, self.p_sym], [self.g_sym])

@@ -16,7 +16,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from qropt.certify import Certificate
+from qropt.synthesis.certificate import Certificate
 
 STATUSES = ("optimal", "local_optimum", "acceptable", "feasible", "infeasible", "failed")
 SOLUTION_PRESENT = ("optimal", "local_optimum", "acceptable", "feasible")

@@ -24,13 +24,13 @@ import time
 
 import dask
 
-from qropt import starts
-from qropt.certify import better
-from qropt.chart import Axis, Cell, ChartError, axis_kind, problem_at
-from qropt.criteria import maximises
 from qropt.errors import QroptError
-from qropt.problem import Problem
-from qropt.result import Result
+from qropt.studies._chart import Axis, Cell, ChartError, axis_kind, problem_at
+from qropt.synthesis import starts
+from qropt.synthesis.certificate import better
+from qropt.synthesis.criteria import maximises
+from qropt.synthesis.problem import Problem
+from qropt.synthesis.result import Result
 
 JUMP_FLOOR = 0.02  # a step moving the design by less (relative to its largest length) is never a jump
 JUMP_RATIO = 4.0  # a jump moves the design this many times faster than the step before it on the same line
@@ -199,7 +199,7 @@ def solver_options(solver) -> dict:
 
 def worker_tile(spec: dict, options: dict) -> list[dict]:
     """Run on a worker: one tile with this process's Solver for ``options``; the cells as dictionaries."""
-    from qropt.solve import Solver
+    from qropt.synthesis.solver import Solver
 
     key = json.dumps(options, sort_keys=True, default=str)
     if key not in _SOLVERS:

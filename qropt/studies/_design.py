@@ -12,10 +12,10 @@ import json
 import math
 from dataclasses import dataclass, field
 
-from qropt import criteria
 from qropt.errors import ProblemError, QroptError
-from qropt.problem import Problem
-from qropt.result import SOLUTION_PRESENT, Result, json_safe
+from qropt.synthesis import criteria
+from qropt.synthesis.problem import Problem
+from qropt.synthesis.result import SOLUTION_PRESENT, Result, json_safe
 
 # type name -> (mechanism kind, free lengths, free offsets, fixed values)
 TYPES = {
@@ -114,7 +114,7 @@ class Comparison:
 
     def plot(self, path) -> None:
         """The designs side by side at one scale, each with its numbers (and the fronts, if computed)."""
-        from qropt.plots import comparison_figure, save
+        from qropt.io.plots import comparison_figure, save
 
         save(comparison_figure(self), path)
 
@@ -129,7 +129,7 @@ def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min"
     the reason in ``Comparison.fronts``); progress: a callable
     called once per finished type.
     """
-    from qropt.solve import DEFAULT
+    from qropt.synthesis.solver import DEFAULT
 
     solver = solver or DEFAULT
     types = list(TYPES) if types is None else _types(types)
@@ -150,7 +150,7 @@ def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min"
         r = solver.solve(p)
         rows.append(_row(kind, p, r))
         if pareto is not None:
-            from qropt.pareto import pareto as front
+            from qropt.studies._pareto import pareto as front
 
             try:
                 fronts[kind] = front(p, pareto, n=n, solver=solver)

@@ -22,9 +22,9 @@ from dataclasses import dataclass
 import casadi
 import numpy as np
 
-from qropt import cycle
-from qropt.closures import RIGHT_ANGLE, transmission_angle, transmission_cos2
-from qropt.ops import CASADI, NUMPY, Jet
+from qropt.kinematics import cycle
+from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle, transmission_cos2
+from qropt.kinematics.ops import CASADI, NUMPY, Jet
 
 NEWTON_STEPS = 2  # from the grid parabola's vertex (error <~1e-4 rad), two steps reach ~1e-16 rad
 TWO_PI = 2.0 * np.pi

@@ -11,10 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from qropt import analytic
 from qropt.errors import QroptError
-from qropt.nlp import slow_interval
-from qropt.ops import NUMPY
+from qropt.kinematics.ops import NUMPY
+from qropt.synthesis import analytic
+from qropt.synthesis.formulation import slow_interval
 
 
 @dataclass(frozen=True)

@@ -193,7 +193,7 @@ class SpeedProfile:
 
     def plot(self, path) -> None:
         """omega2, slider v and a (and the torque when given) against time, limits dashed, working stroke shaded."""
-        from qropt import plots
+        from qropt.io import plots
 
         s = self.motion()
         rows = [("crank omega2 [rad/s]", s.omega, ["omega_max"]), ("slider v [length/s]", s.v, ["v_max", "v_cut"]),

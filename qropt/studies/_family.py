@@ -18,11 +18,11 @@ from functools import cached_property
 import casadi
 import numpy as np
 
-from qropt import starts as starts_
-from qropt.certify import quantities
 from qropt.errors import ProblemError, QroptError
-from qropt.problem import Problem
-from qropt.solve import DEFAULT, Solver
+from qropt.synthesis import starts as starts_
+from qropt.synthesis.certificate import quantities
+from qropt.synthesis.problem import Problem
+from qropt.synthesis.solver import DEFAULT, Solver
 
 NEWTON_TOL = 1e-12
 

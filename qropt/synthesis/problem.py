@@ -13,10 +13,10 @@ from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Any
 
-from qropt.criteria import BOUNDS, OBJECTIVES, SIZES, SLIDER_ONLY, finite
 from qropt.errors import ProblemError
 from qropt.mechanisms import FourBar, FourBarSlider, Mechanism, mechanism_type
 from qropt.mechanisms.base import REQUIRED
+from qropt.synthesis.criteria import BOUNDS, OBJECTIVES, SIZES, SLIDER_ONLY, finite
 
 BRANCHES = ("sigma", "sigma_slider")
 

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import math
 
-from qropt import Problem, analytic, oracles
+from problems import _oracles as oracles
+from qropt import Problem
+from qropt.synthesis import analytic
 
 
 def slider_crank(**changes) -> Problem:

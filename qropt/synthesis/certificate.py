@@ -11,10 +11,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from qropt import criteria
-from qropt.criteria import better, objective_of, objective_value
 from qropt.errors import AssemblyError, QroptError
 from qropt.mechanisms import FourBar
+from qropt.synthesis import criteria
+from qropt.synthesis.criteria import better, objective_of, objective_value
 
 TWO_PI = 2.0 * math.pi
 

@@ -10,8 +10,9 @@ import math
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from qropt import QroptError, analytic, criteria
-from qropt.certify import better, objective_value, quantities
+from qropt import QroptError
+from qropt.synthesis import analytic, criteria
+from qropt.synthesis.certificate import better, objective_value, quantities
 
 
 def score(problem, values: dict):

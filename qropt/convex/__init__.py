@@ -1,0 +1,1 @@
+"""The convex layer (cvxpy): servo crank-speed profiles and tolerance allocation, on the exact analysis."""

@@ -1,0 +1,10 @@
+"""Studies built on single solves: type synthesis (``design``), trade-off fronts (``pareto``), one-parameter
+families (``family``), reachable ranges (``reachable``) and design charts (``chart``)."""
+
+from qropt.studies._chart import Chart, chart
+from qropt.studies._design import Comparison, design
+from qropt.studies._family import Family, family
+from qropt.studies._pareto import Front, pareto
+from qropt.studies._reachable import Reachable, reachable
+
+__all__ = ["Chart", "chart", "Comparison", "design", "Family", "family", "Front", "pareto", "Reachable", "reachable"]
