@@ -24,8 +24,8 @@ from tqdm import tqdm
 
 from benchmarks.report import RESULTS, environment, save
 from qropt import Problem, solve
-from qropt.studies._chart import TILE, chart
-from qropt.studies._tiles import LOCAL_CONFIG
+from qropt.studies._chart_run import TILE, chart
+from qropt.studies._dask import LOCAL_CONFIG
 
 REPEAT = 3
 SAME = ("status", "objective", "params", "method", "why", "source", "jump", "switched")
@@ -44,7 +44,7 @@ def _tiles(args):
     the clusters' schedulers in the main process) or half of it (step 2: the ceiling for 2 workers, no Dask)."""
     specs, k, step = args
     from qropt import solve
-    from qropt.studies._tiles import solve_tile
+    from qropt.studies._continuation import solve_tile
     from qropt.synthesis.solver import DEFAULT
 
     solve(Problem.from_dict(specs[0]["problem"]))

@@ -45,11 +45,10 @@ def timed(f, repeat):
 def front_by_full_solves(problem, objectives, n, solver):
     """The baseline front: the same sweep, every point a full default solve."""
     a, b = objectives
-    bound = criteria.bound_of(b, problem.size)
+    cb = criteria.of(b, problem.size)
     ends = [solver.solve(problem.replace(objective=o)) for o in (a, b)]
-    qb = criteria.measured(b, problem.size)
-    lo, hi = (criteria.value(problem, qb, r.mechanism) for r in ends)
-    return [solver.solve(problem.replace(objective=a, conditions={**problem.conditions, bound: float(e)}))
+    lo, hi = (cb.value(problem, r.mechanism) for r in ends)
+    return [solver.solve(problem.replace(objective=a, conditions={**problem.conditions, cb.bound: float(e)}))
             for e in np.linspace(lo, hi, n)[1:-1]]  # fmt: skip
 
 

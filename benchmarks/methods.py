@@ -6,10 +6,11 @@ from __future__ import annotations
 import importlib
 
 import numpy as np
-from scipy.optimize import NonlinearConstraint, differential_evolution, minimize
+from scipy.optimize import differential_evolution
 
 from qropt import solve
 from qropt.synthesis import starts
+from qropt.synthesis.backends import Scipy
 from qropt.synthesis.certificate import better
 from qropt.synthesis.solver import DEFAULT
 
@@ -45,11 +46,11 @@ def _scipy_local(problem, seed, method):
 
     best, nfev = None, 0
     for _origin, _v, br, _way, form, w0, p in local_starts(problem, seed):
-        x, n = local_solve(form, w0, p, method)
+        x, n = local_solve(problem, form, w0, p, method)
         nfev += n
         if x is None:
             continue
-        values = dict(zip(form.free, x[: form.nx].tolist(), strict=True))
+        values = form.unpack(x).values
         s = oracles.score(problem, values)
         feasible = s is not None and violation(problem, s[1]) <= FEASIBLE
         if feasible and better(problem, s[0], best[0] if best else None):
@@ -74,67 +75,17 @@ def local_starts(problem, seed, starts_n=STARTS, solver=DEFAULT):
                 th0, way = starts.dead_centre_start(problem, v, br, targets, way, None)
                 form = solver.formulation(problem, br, way)
                 samples, fractions = form.base_samples()
-                phi, box = form.lifted_start(v)  # the lifted extremes, as qropt starts them
-                p = form.param_vector(targets, samples, fractions, box=box)
+                phi, box = form.lifted_start(problem, v)  # the lifted extremes, as qropt starts them
+                p = form.param_vector(problem, targets, samples, fractions, box=box)
                 yield origin, v, br, way, form, form.epigraph_start(form.pack(v, th0, phi=phi, box=box), p), p
 
 
-def local_solve(form, w0, p, method="SLSQP"):
-    """The one scipy driver of the benchmarks: SLSQP or trust-constr on a formulation, exact derivatives.
-    Returns (w or None, function evaluations)."""
-    fn = form.functions
-    lbx, ubx = form.bounds()
-    w0 = np.clip(w0, lbx, ubx)
-    calls = [0]
-
-    def f(w):
-        calls[0] += 1
-        return float(fn(w, p)[0])
-
-    def df(w):
-        return np.array(fn(w, p)[2]).ravel()
-
-    def g(w):
-        return np.array(fn(w, p)[1]).ravel()
-
-    def dg(w):
-        return np.array(fn(w, p)[3])
-
-    bounds = list(zip(np.where(np.isfinite(lbx), lbx, None), np.where(np.isfinite(ubx), ubx, None), strict=True))
-    with np.errstate(all="ignore"):
-        try:
-            if method == "SLSQP":
-                eq = form.lbg == form.ubg
-                lo = ~eq & np.isfinite(form.lbg)
-                hi = ~eq & np.isfinite(form.ubg)
-                cons = [
-                    {"type": "eq", "fun": lambda w: g(w)[eq] - form.lbg[eq], "jac": lambda w: dg(w)[eq]},
-                    {"type": "ineq", "fun": lambda w: g(w)[lo] - form.lbg[lo], "jac": lambda w: dg(w)[lo]},
-                    {"type": "ineq", "fun": lambda w: form.ubg[hi] - g(w)[hi], "jac": lambda w: -dg(w)[hi]},
-                ]
-                r = minimize(
-                    f,
-                    w0,
-                    jac=df,
-                    bounds=bounds,
-                    constraints=cons,
-                    method="SLSQP",
-                    options={"ftol": 1e-12, "maxiter": 300},
-                )
-            else:
-                con = NonlinearConstraint(g, form.lbg, form.ubg, jac=dg)
-                r = minimize(
-                    f,
-                    w0,
-                    jac=df,
-                    bounds=bounds,
-                    constraints=[con],
-                    method="trust-constr",
-                    options={"gtol": 1e-10, "xtol": 1e-12, "maxiter": 200},
-                )
-        except (ValueError, np.linalg.LinAlgError):
-            return None, calls[0]
-    return (r.x if np.all(np.isfinite(r.x)) else None), calls[0]
+def local_solve(problem, form, w0, p, method="SLSQP"):
+    """The one scipy driver of the benchmarks: SLSQP or trust-constr through qropt's backend protocol, on a
+    formulation with exact derivatives. Returns (w or None, function evaluations)."""
+    lbx, ubx = form.bounds(problem)
+    run = Scipy(method).run(form, w0, p, lbx, ubx)
+    return (run.w if np.all(np.isfinite(run.w)) else None), run.iterations
 
 
 def scipy_slsqp(problem, seed):

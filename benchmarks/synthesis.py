@@ -48,13 +48,13 @@ def slsqp(problem):
     """SLSQP on qropt's NLP from qropt's starts: the best converged design's values (no certificate)."""
     best = None
     for *_, form, w0, p in local_starts(problem, 0):
-        x, _ = local_solve(form, w0, p, "SLSQP")
+        x, _ = local_solve(problem, form, w0, p, "SLSQP")
         if x is not None:
             f = float(form.functions(x, p)[0])
             g = np.array(form.functions(x, p)[1]).ravel()
             feasible = np.all(g >= form.lbg - 1e-8) and np.all(g <= form.ubg + 1e-8)
             if feasible and (best is None or f < best[0]):
-                best = (f, dict(zip(form.free, x[: form.nx].tolist(), strict=True)))
+                best = (f, form.unpack(x).values)
     return best[1] if best else None
 
 

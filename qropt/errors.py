@@ -56,3 +56,8 @@ class ProblemError(QroptError):
 
 class ChartError(QroptError):
     """A chart cannot be made as asked: a bad axis, tile, worker count or scheduler."""
+
+
+class BodyError(InvalidParameter):
+    """A mechanism type's declared bodies cannot be drawn: none declared, an unknown kind, or a joint (of a body,
+    the ground or the output) that the mechanism's positions do not have."""

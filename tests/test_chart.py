@@ -15,8 +15,10 @@ import pytest
 from problems import _oracles as oracles
 from qropt import Problem, solve
 from qropt.cli import main
-from qropt.studies._chart import Cell, Chart, ChartError, chart
-from qropt.studies._tiles import _Tile
+from qropt.errors import ChartError
+from qropt.studies._chart import Cell, Chart
+from qropt.studies._chart_run import chart
+from qropt.studies._continuation import _Tile
 from qropt.synthesis import analytic
 from qropt.synthesis.solver import DEFAULT
 from tests import brute

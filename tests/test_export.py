@@ -25,9 +25,17 @@ MECHANISMS = [
 
 
 def _links(m, theta):
-    """The lengths the drawing must show: every rigid link (a slotted lever as far as it reaches)."""
+    """The lengths the drawing must show: every declared bar from its first joint to its farthest, and every slotted
+    lever as far as its joints reach over a turn."""
     p = {k: v[0] for k, v in m.positions(theta).points.items()}
-    return sorted(math.dist(p[a], p[b]) for a, b in export.link_segments(p))
+    turn = m.positions(np.linspace(0.0, 2 * math.pi, 361)).points
+    out = []
+    for b in m.bodies():
+        if b.kind == "bar":
+            out.append(max(math.dist(p[b.joints[0]], p[j]) for j in b.joints[1:]))
+        elif b.kind == "slot-lever":
+            out.append(max(float(np.hypot(*(turn[j] - turn[b.joints[0]]).T).max()) for j in b.joints[1:]))
+    return sorted(out)
 
 
 @pytest.mark.parametrize("m", MECHANISMS, ids=lambda m: m.KIND)

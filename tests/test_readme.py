@@ -1,4 +1,5 @@
-"""Every ``qropt`` command the README shows, run as a subprocess of the installed executable from a directory
+"""Every ``qropt`` command the README and the docs/*.md pages show (each once, the README's first, then the
+pages' in name order), run as a subprocess of the installed executable from a directory
 outside the repository (holding a copy of ``problems/``, which the commands name): exit code 0, and every file
 the command names written and not empty. A command that names a running Dask scheduler runs after the README's
 background lines (those ending in ``&``: the scheduler and its workers) are started as the README shows them.
@@ -24,22 +25,27 @@ ROOT = Path(__file__).resolve().parent.parent
 OUTPUT_FLAGS = ("--plot", "--csv", "--animate", "--dxf", "--svg", "--save", "-o")
 
 
-def readme_commands() -> list[str]:
-    """The README's shell lines that start with ``qropt``, comments removed."""
-    text = (ROOT / "README.md").read_text()
-    lines = [line for block in re.findall(r"```sh\n(.*?)```", text, re.S) for line in block.splitlines()]
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+
+
+def shell_lines(page: Path) -> list[str]:
+    return [line for block in re.findall(r"```sh\n(.*?)```", page.read_text(), re.S) for line in block.splitlines()]
+
+
+def readme_commands(pages=None) -> list[str]:
+    """The shell lines of the README and docs pages that start with ``qropt``, comments removed, each once."""
     out = []
-    for line in lines:
-        command = re.sub(r"\s+#.*$", "", line).strip()
-        if command.startswith("qropt ") or command == "qropt":
-            out.append(command)
+    for page in PAGES if pages is None else pages:
+        for line in shell_lines(page):
+            command = re.sub(r"\s+#.*$", "", line).strip()
+            if (command.startswith("qropt ") or command == "qropt") and command not in out:
+                out.append(command)
     return out
 
 
 def background_commands() -> list[str]:
-    """The README's shell lines that end in ``&`` (services the next commands use), without the ``&``."""
-    text = (ROOT / "README.md").read_text()
-    lines = [line.strip() for block in re.findall(r"```sh\n(.*?)```", text, re.S) for line in block.splitlines()]
+    """The pages' shell lines that end in ``&`` (services the next commands use), without the ``&``."""
+    lines = [line.strip() for page in PAGES for line in shell_lines(page)]
     return [re.sub(r"\s*&\s*(#.*)?$", "", line) for line in lines if re.search(r"&\s*(#.*)?$", line)]
 
 
@@ -78,6 +84,7 @@ COMMANDS = readme_commands()
 
 def test_the_readme_shows_commands():
     assert len(COMMANDS) >= 10 and COMMANDS[0].startswith("qropt ")
+    assert len(readme_commands([ROOT / "README.md"])) >= 3
 
 
 @pytest.fixture(scope="module")

@@ -16,6 +16,7 @@ import numpy as np
 
 from qropt.errors import QroptError
 from qropt.mechanisms import REGISTRY, Mechanism, mechanism_type
+from qropt.synthesis import criteria
 
 QUIET = False  # --quiet: no progress bars
 PARAM_NAMES = ("r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider")
@@ -53,14 +54,17 @@ def real(text: str) -> float:
     return v
 
 
-PLOT_FORMATS = (".png", ".pdf", ".svg")
 MIN_STEP = math.radians(0.01)  # the finest full-cycle table: 36,000 rows
 
 
 def picture_path(path: str) -> str:
-    """A path for a matplotlib picture, or CliError naming the formats."""
-    if not path.lower().endswith(PLOT_FORMATS):
-        raise CliError(f"--plot {path}: the picture formats are {', '.join(PLOT_FORMATS)}")
+    """A path for a picture, checked before any work (``qropt.io.paths.picture_path``), or CliError saying why."""
+    from qropt.io.paths import picture_path as check
+
+    try:
+        check(path)
+    except QroptError as e:
+        raise CliError(f"--plot {e}") from None
     return path
 
 
@@ -263,7 +267,7 @@ def parser() -> argparse.ArgumentParser:
     a.set_defaults(run=cmd_analyze)
     s = sub.add_parser("synth", help="solve a synthesis problem file (build() -> Problem)")
     s.add_argument("problem", nargs="?", help="a problem file (default: the paper's design task, built in)")
-    s.add_argument("--objective", choices=["max_gamma_min", "min_size", "min_peak_accel", "none"])
+    s.add_argument("--objective", choices=[o for o in criteria.objectives() if o] + ["none"])
     s.add_argument("--size", choices=["sum", "longest", "footprint"], help="size measure for min_size")
     s.add_argument("--starts", type=int, default=8, help="space-filling multi-start points (default 8)")
     s.add_argument("--json", action="store_true", help="print the Result as JSON")
@@ -387,6 +391,8 @@ def cmd_reachable(args):
         r = reachable(m, args.free, tuple(args.bounds) if args.bounds else None, progress=bar.update)
     tmin, xmin, tmax, xmax = r.time_ratio_range
     low, high = args.adjust if args.adjust else (tmin, tmax)
+    if low > high:
+        raise CliError(f"--adjust {low:g} {high:g}: TR_LOW is above TR_HIGH; give the lower time ratio first")
     if not tmin <= low <= high <= tmax:
         raise CliError(f"--adjust {low:g} {high:g} must lie within the reachable TR {tmin:.6g}..{tmax:.6g}")
     adj = r.adjustable(low, high)
@@ -443,7 +449,7 @@ def load_problem(path: str):
         built = module.build() if callable(getattr(module, "build", None)) else None
     except QroptError as e:
         raise type(e)(f"{path}: {e}") from None
-    except Exception as e:  # noqa: BLE001 - a user's file may fail in any way: one line naming it
+    except (Exception, SystemExit) as e:  # noqa: BLE001 - a user's file may fail in any way: one line naming it
         raise CliError(f"{path} does not load: {type(e).__name__}: {e}") from None
     if not callable(getattr(module, "build", None)):
         raise CliError(f"{path} has no build() function")
@@ -510,8 +516,9 @@ def cmd_synth(args):
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        if argv[:1] == ["bench"]:
-            return cmd_bench(argv[1:])
+        lead = next((i for i, a in enumerate(argv) if a not in ("--quiet", "-q")), len(argv))
+        if argv[lead : lead + 1] == ["bench"]:  # its options are the benchmark suite's own
+            return cmd_bench(argv[lead + 1 :])
         args = parser().parse_args(argv)
         global QUIET
         QUIET = args.quiet

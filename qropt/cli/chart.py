@@ -62,7 +62,7 @@ def file_axes(path: str) -> dict:
 
 
 def run(args) -> int:
-    from qropt.studies._chart import chart
+    from qropt.studies._chart_run import chart
 
     problem = cli.load_problem(args.problem)
     defaults = file_axes(args.problem)

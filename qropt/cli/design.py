@@ -10,21 +10,17 @@ HELP = "type synthesis: the task solved for every quick-return type, compared cr
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from qropt.cli import angle, real
+    from qropt.cli import real
     from qropt.studies._design import TYPES
-    from qropt.synthesis.criteria import BOUNDS, OBJECTIVES, UNITS
+    from qropt.synthesis import criteria
 
     parser.add_argument("--tr", type=real, required=True, help="time ratio (slow/fast, >= 1)")
     parser.add_argument("--stroke", type=real, required=True, help="slider stroke [length]")
-    parser.add_argument("--objective", default="max_gamma_min", choices=[o for o in OBJECTIVES if o])
+    parser.add_argument("--objective", default="max_gamma_min", choices=[o for o in criteria.objectives() if o])
     parser.add_argument("--size", default="footprint", choices=["sum", "longest", "footprint"],
                         help="size measure of min_size (default footprint)")  # fmt: skip
     parser.add_argument("--types", nargs="+", metavar="TYPE", help="types (default all): " + ", ".join(TYPES))
-    parser.add_argument("--gamma-min", type=angle, help="lower bound on gamma_min (e.g. 40deg)")
-    for key, (quantity, sense) in BOUNDS.items():
-        if sense == "upper":  # --max-footprint, --max-sum, --max-longest, --max-peak-accel, --max-peak-velocity
-            parser.add_argument("--" + key.replace("_", "-"), type=real,
-                                help=f"upper bound on {quantity} [{UNITS[quantity]}]")  # fmt: skip
+    bound_flags(parser)
     parser.add_argument("--omega2", type=real, default=1.0, help="crank speed [rad/s] (default 1)")
     parser.add_argument("--pareto", nargs=2, metavar=("A", "B"), help="also each type's front between two objectives")
     parser.add_argument("--n", type=int, default=12, help="front points per type with --pareto (default 12)")
@@ -33,11 +29,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--plot", metavar="FILE", help="draw the designs side by side (.png, .pdf, .svg)")
 
 
+def bound_flags(parser) -> None:
+    """A flag per bound condition, from the criteria: --gamma-min (an angle), --max-footprint, --max-sum, ..."""
+    from qropt.cli import angle, real
+    from qropt.synthesis import criteria
+
+    for key, c in criteria.bounds().items():
+        side = "lower" if c.maximise else "upper"
+        unit = "e.g. 40deg" if c.unit == "rad" else c.unit
+        parser.add_argument(
+            c.flag, dest=key, type=angle if c.unit == "rad" else real, help=f"{side} bound on {c.name} [{unit}]"
+        )
+
+
 def conditions_of(args) -> dict:
     """The bound conditions given on the command line."""
-    from qropt.synthesis.criteria import BOUNDS
+    from qropt.synthesis import criteria
 
-    return {k: getattr(args, k) for k in BOUNDS if getattr(args, k) is not None}
+    return {k: getattr(args, k) for k in criteria.bounds() if getattr(args, k, None) is not None}
 
 
 def run(args) -> int:

@@ -10,11 +10,16 @@ HELP = "the trade-off front between two objectives (epsilon-constraint, every po
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from qropt.studies._pareto import OBJECTIVES
+    from qropt.studies._pareto import objective_names
 
     parser.add_argument("problem", help="a problem file (.py, .toml, .json)")
-    parser.add_argument("--objectives", nargs=2, required=True, metavar=("A", "B"),
-                        help="two objectives: " + ", ".join(OBJECTIVES))  # fmt: skip
+    parser.add_argument(
+        "--objectives",
+        nargs=2,
+        required=True,
+        metavar=("A", "B"),
+        help="two objectives: " + ", ".join(objective_names()),
+    )
     parser.add_argument("--n", type=int, default=20, help="points along the front, ends included (default 20)")
     parser.add_argument("--csv", metavar="FILE", help="write the front as CSV")
     parser.add_argument("--plot", metavar="FILE", help="draw the front and designs along it (.png, .pdf, .svg)")
@@ -45,6 +50,7 @@ def run(args) -> int:
 
 
 def _show(q, v):
-    from qropt.synthesis.criteria import UNITS
+    from qropt.synthesis.criteria import CRITERIA
 
-    return f"{q} {math.degrees(v):.4f} deg" if q == "gamma_min" else f"{q} {v:.6g} {UNITS[q]}"
+    unit = CRITERIA[q].unit
+    return f"{q} {math.degrees(v):.4f} deg" if unit == "rad" else f"{q} {v:.6g} {unit}"

@@ -15,8 +15,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args) -> int:
     from qropt.cli import load_problem, progress_bar
-    from qropt.io.report import render
+    from qropt.io.report import render, report_path
 
+    report_path(args.output)  # a bad output path fails before anything is computed
     problem = load_problem(args.problem) if args.problem else None
     with progress_bar("report sections", unit="section") as bar:
         render(problem, args.output, progress=bar.update)

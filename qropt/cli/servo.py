@@ -11,6 +11,7 @@ import sys
 import numpy as np
 
 from qropt.convex.servo import OBJECTIVES, speed_profile
+from qropt.io.paths import picture_path
 from qropt.mechanisms import REGISTRY, mechanism_type
 
 COMMAND = "servo"
@@ -84,6 +85,8 @@ def write_csv(p, path: str) -> None:
 
 
 def run(args) -> int:
+    if args.plot is not None:
+        picture_path(args.plot)  # before solving: a bad path is refused at once
     m = mechanism_from(args)
     limits = {k: getattr(args, k) for k in LIMITS}
     p = speed_profile(m, **limits, cut_fraction=args.cut_fraction, objective=args.objective, n=args.n)

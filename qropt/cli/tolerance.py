@@ -16,26 +16,42 @@ from qropt.mechanisms import REGISTRY, mechanism_type
 COMMAND = "tolerance"
 HELP = "exact sensitivities and the largest tolerances keeping TR, stroke, gamma_min within limits"
 PARAM_NAMES = ("r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider")
-SUFFIX = {"um": 1e-6, "mm": 1e-3, "cm": 1e-2, "m": 1.0, "deg": math.pi / 180, "rad": 1.0}
+LENGTH_UNITS = {"um": 1e-6, "mm": 1e-3, "cm": 1e-2, "m": 1.0}  # in metres
+ANGLE_UNITS = {"deg": math.pi / 180, "rad": 1.0}
+PAPER_UNIT = "m"  # the paper's mechanism (the default design) is given in metres
 
 
-def limit(text: str) -> tuple[str, float]:
-    """'QUANTITY=VALUE[unit]': mm, cm, um, m convert to metres, deg to rad; a plain number is as is."""
+def limit(text: str) -> tuple[str, float, str | None]:
+    """'QUANTITY=VALUE[unit]' -> (quantity, value, unit or None). time_ratio is dimensionless (no unit); gamma_min
+    takes deg or rad (a plain number is rad); stroke takes um, mm, cm or m, converted in ``run`` to the design's
+    length unit (a plain number is in the design's unit); peak_acceleration is a plain number (length/s^2)."""
     name, sep, value = text.partition("=")
     name = name.strip()
     if not sep or name not in QUANTITIES:
-        raise argparse.ArgumentTypeError(f"not a limit: {text!r} (use e.g. time_ratio=0.01 or stroke=1mm; "
+        raise argparse.ArgumentTypeError(f"not a limit: {text!r} (use e.g. time_ratio=0.01 or stroke=0.001; "
                                          f"quantities: {', '.join(QUANTITIES)})")  # fmt: skip
     v = value.strip().lower()
-    scale = 1.0
-    for suffix in sorted(SUFFIX, key=len, reverse=True):
-        if v.endswith(suffix):
-            v, scale = v[: -len(suffix)], SUFFIX[suffix]
-            break
+    unit = next((u for u in sorted({**LENGTH_UNITS, **ANGLE_UNITS}, key=len, reverse=True) if v.endswith(u)), None)
+    if unit is not None:
+        v = v[: -len(unit)].strip()
+        allowed = {"gamma_min": ANGLE_UNITS, "stroke": LENGTH_UNITS}.get(name, {})
+        if unit not in allowed:
+            why = {
+                "time_ratio": "the time ratio is dimensionless",
+                "gamma_min": "gamma_min is an angle (deg, rad)",
+                "stroke": "the stroke is a length (um, mm, cm, m)",
+                "peak_acceleration": "give the peak acceleration as a plain number in length/s^2 of the design's unit",
+            }[name]
+            raise argparse.ArgumentTypeError(f"unit {unit!r} does not apply in the limit {text!r}: {why}")
     try:
-        return name, float(v) * scale
+        number = float(v)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number in the limit {text!r}") from None
+        raise argparse.ArgumentTypeError(
+            f"not a number in the limit {text!r} (units: {', '.join([*LENGTH_UNITS, *ANGLE_UNITS])})"
+        ) from None
+    if unit in ANGLE_UNITS:
+        number, unit = number * ANGLE_UNITS[unit], None
+    return name, number, unit
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -45,8 +61,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         "paper's mechanism")  # fmt: skip
     for k in PARAM_NAMES:
         parser.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
-    parser.add_argument("--limit", type=limit, action="append", required=True, metavar="QUANTITY=VALUE",
-                        help="allowed deviation: time_ratio=0.01, stroke=1mm, gamma_min=1deg (repeatable)")  # fmt: skip
+    parser.add_argument(
+        "--limit",
+        type=limit,
+        action="append",
+        required=True,
+        metavar="QUANTITY=VALUE",
+        help="allowed deviation, once per quantity: time_ratio=0.01, stroke=0.001 (the design's "
+        "length unit) or stroke=1mm (with --unit, or the default design in m), gamma_min=1deg",
+    )
+    parser.add_argument(
+        "--unit",
+        choices=sorted(LENGTH_UNITS),
+        help="the design's length unit, so that a stroke limit may carry a unit suffix (default: "
+        "m for the paper's mechanism, undeclared for any other design)",
+    )
     parser.add_argument("--params", help="toleranced parameters, comma-separated (default: lengths and offsets)")
     parser.add_argument("--rss", action="store_true", help="statistical stack-up ||S t|| <= E / k")
     parser.add_argument("--k", type=float, default=3.0, help="rss: limit over k (default 3)")
@@ -83,9 +112,32 @@ def _finite(v):
     return None if isinstance(v, float) and not math.isfinite(v) else v
 
 
+def limits_from(args) -> dict:
+    """{quantity: limit} in the design's units: each quantity once, a suffixed length converted to the design's
+    length unit (--unit, or metres for the default design) or refused where that unit is not declared."""
+    from qropt.cli import CliError
+
+    default = args.target is None and not any(getattr(args, k) is not None for k in PARAM_NAMES)
+    design_unit = args.unit or (PAPER_UNIT if default else None)
+    out = {}
+    for name, value, unit in args.limit:
+        if name in out:
+            raise CliError(f"--limit {name} is given more than once; give each quantity one limit")
+        if unit is not None:
+            if design_unit is None:
+                raise CliError(
+                    f"--limit {name}={value:g}{unit}: this design's length unit is not declared (qropt "
+                    "lengths are in the design's own unit); give --unit, or the limit as a plain number "
+                    "in the design's unit"
+                )
+            value *= LENGTH_UNITS[unit] / LENGTH_UNITS[design_unit]
+        out[name] = value
+    return out
+
+
 def run(args) -> int:
     m = mechanism_from(args)
-    limits = dict(args.limit)
+    limits = limits_from(args)
     params = None if args.params is None else [p.strip() for p in args.params.split(",") if p.strip()]
     al = allocate(m, limits, params=params, method="rss" if args.rss else "worst-case", k=args.k, omega2=args.omega2)
     mc = None

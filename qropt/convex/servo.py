@@ -24,16 +24,18 @@ from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
-import scipy.optimize
 import scipy.sparse as sp
 
 from qropt.errors import InvalidParameter
+from qropt.io.paths import picture_path
 from qropt.mechanisms import Mechanism
 
 OBJECTIVES = ("min_cycle_time", "min_return_time")
 MIN_CELLS, MAX_CELLS = 36, 100_000
 BINDING_TOL = 1e-6  # a phase-one slack or dual above this (relative) names a limit as binding
 SQUARED = ("omega_max", "v_max", "v_cut")  # limits stated on squares in b
+MAGNITUDE = 1e100  # limits beyond this (or positive ones below its inverse) overflow the program's coefficients
+BADLY_SCALED = 1e8  # a row coefficient above this: the limit allows changes of b below 1e-8 of omega_max^2
 
 
 class ConstantSpeed(NamedTuple):
@@ -125,15 +127,7 @@ class SpeedProfile:
     def constant_speed(self) -> ConstantSpeed:
         """The reference without a servo: the crank at constant omega_max."""
         m = self.mechanism
-        peak = None
-        if self.force:
-            start, length = m.working_arc()
-            th = np.linspace(start, start + length, 2001)
-            k = int(np.argmax(np.abs(m.motion(th, 1.0, 0.0).v)))
-            lo, hi = th[max(k - 1, 0)], th[min(k + 1, th.size - 1)]
-            best = scipy.optimize.minimize_scalar(lambda t: -abs(m.motion(t, 1.0, 0.0).v[0]), bounds=(lo, hi),
-                                                  method="bounded", options={"xatol": 1e-12})  # fmt: skip
-            peak = float(self.force * max(-best.fun, abs(m.motion(th[k], 1.0, 0.0).v[0])))
+        peak = self.force * m.peak_velocity(1.0).torque_per_newton if self.force else None
         return ConstantSpeed(2 * math.pi / self.limits["omega_max"], m.time_ratio(), peak)
 
     def motion(self, refine: int = 10) -> ServoMotion:
@@ -192,9 +186,12 @@ class SpeedProfile:
         return out
 
     def plot(self, path) -> None:
-        """omega2, slider v and a (and the torque when given) against time, limits dashed, working stroke shaded."""
+        """omega2, slider v and a (and the torque when given) against time, limits dashed, working stroke shaded.
+
+        path: a file ending .png, .pdf or .svg in an existing directory (InvalidParameter otherwise)."""
         from qropt.io import plots
 
+        path = picture_path(path)  # checked before anything is drawn
         s = self.motion()
         rows = [("crank omega2 [rad/s]", s.omega, ["omega_max"]), ("slider v [length/s]", s.v, ["v_max", "v_cut"]),
                 ("slider a [length/s^2]", s.a, ["a_max"])]  # fmt: skip
@@ -229,9 +226,17 @@ def _limit(name, value, *, required=False, zero_ok=False):
         return None
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise InvalidParameter(f"{name} must be a number, got {value!r}")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:
+        v = math.inf
     if not math.isfinite(v) or v < 0 or (v == 0 and not zero_ok):
         raise InvalidParameter(f"{name} must be {'>= 0' if zero_ok else 'positive'} and finite, got {v:g}")
+    if v > MAGNITUDE or 0 < v < 1 / MAGNITUDE:
+        raise InvalidParameter(
+            f"{name} = {v:g} is out of range: limits lie in [1e-100, 1e100] (the program's variable is omega2^2 "
+            "and its rows hold squares and products of the limits, which would overflow)"
+        )
     return v
 
 
@@ -248,13 +253,9 @@ def _grid(m: Mechanism, n: int, cut_fraction: float | None) -> _Grid:
     start, length = m.working_arc()
     breaks = [start, start + length, start + 2 * math.pi]
     if cut_fraction is not None:
-        x0, x1 = (float(m.positions(t).x[0]) for t in (start, start + length))
-        ends = []
-        for f in ((1 - cut_fraction) / 2, (1 + cut_fraction) / 2):
-            target = x0 + f * (x1 - x0)
-            ends.append(scipy.optimize.brentq(lambda t, g=target: m.positions(t).x[0] - g, start, start + length,
-                                              xtol=1e-15))  # fmt: skip
-        breaks = [start, *ends, start + length, start + 2 * math.pi]
+        x0, x1 = m.positions([start, start + length]).x
+        f = np.array([(1 - cut_fraction) / 2, (1 + cut_fraction) / 2])
+        breaks = [start, *m.working_angle_at(x0 + f * (x1 - x0)).tolist(), start + length, start + 2 * math.pi]
     lengths = np.diff(breaks)
     raw = n * lengths / (2 * math.pi)
     cells = np.maximum(2, np.floor(raw).astype(int))
@@ -381,6 +382,12 @@ def speed_profile(
 
     if not isinstance(mechanism, Mechanism):
         raise InvalidParameter(f"speed_profile needs a qropt mechanism, got {mechanism!r}")
+    if mechanism.OUTPUT != "slider":
+        raise InvalidParameter(
+            f"speed_profile needs a slider output: {type(mechanism).__name__}'s output is the follower angle "
+            "theta4 (rad), to which the slider limits (v_max, a_max, v_cut in length/s) and the cutting-force "
+            "torque do not apply; give the slider type it drives (crank-rocker-slider, drag-link-slider)"
+        )
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_CELLS <= n <= MAX_CELLS:
         raise InvalidParameter(f"n (cells per turn) must be an integer in {MIN_CELLS}..{MAX_CELLS}, got {n!r}")
     if objective not in OBJECTIVES:
@@ -411,6 +418,13 @@ def speed_profile(
 
     nc = g.xp.size
     h = np.diff(g.theta)
+    top = _envelope(g, lim)
+    if _meets(top, groups, equal):  # the pointwise fastest speeds meet every other limit: the optimum
+        message = (
+            f"{objective}: the speed limits' envelope omega2 = min(omega_max, v_max / |dx/dtheta2|) meets "
+            f"every other limit, so it is the optimum ({nc} cells, no solver needed)"
+        )
+        return _profile("optimal", message, top, g, lim, base)
     beta = cp.Variable(nc, nonneg=True)
     G = sp.vstack([G for _, G, _ in groups], format="csr")
     c = np.concatenate([c for _, _, c in groups])
@@ -429,17 +443,57 @@ def speed_profile(
         binding, message = _diagnose(groups, equal, nc)
         return SpeedProfile("infeasible", message, binding=binding, **base)
     if status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE) or beta.value is None:
-        return SpeedProfile("failed", f"the conic solver did not solve the problem ({status})", **base)
-    b = np.maximum(beta.value, 0.0) * lim["omega_max"] ** 2
+        why = _scaling(groups, top, lim)
+        return SpeedProfile("failed", f"the conic solver did not solve the problem ({status})" + why, **base)
+    word = "optimal" if status == cp.OPTIMAL else "acceptable"
+    message = f"{objective} solved by CLARABEL with {nc} cells" + ("" if word == "optimal" else " (reduced accuracy)")
+    return _profile(word, message, np.maximum(beta.value, 0.0), g, lim, base)
+
+
+def _profile(word, message, beta, g: _Grid, lim, base) -> SpeedProfile:
+    """The SpeedProfile of beta = b / omega_max^2 at the n nodes (b linear on each cell)."""
+    h = np.diff(g.theta)
+    b = beta * lim["omega_max"] ** 2
     b = np.append(b, b[0])
     omega = np.sqrt(b)
     with np.errstate(divide="ignore"):
         time = np.concatenate([[0.0], np.cumsum(2 * h / (omega[:-1] + omega[1:]))])
     alpha = np.diff(b) / (2 * h)
-    word = "optimal" if status == cp.OPTIMAL else "acceptable"
-    message = f"{objective} solved by CLARABEL with {nc} cells" + ("" if word == "optimal" else " (reduced accuracy)")
     return SpeedProfile(word, message, theta=g.theta, omega=omega, alpha=alpha, time=time,
                         working_cells=g.working_cells, cut_cells=g.cut_cells, **base)  # fmt: skip
+
+
+def _envelope(g: _Grid, lim) -> np.ndarray:
+    """The largest beta = b / omega_max^2 each node allows under omega_max and v_max alone (every feasible
+    profile lies below it, and each cell's time falls as b grows)."""
+    top = np.ones(g.xp.size)
+    if lim.get("v_max") is not None:
+        with np.errstate(divide="ignore", over="ignore"):
+            top = np.minimum(top, (lim["v_max"] / (np.abs(g.xp) * lim["omega_max"])) ** 2)
+    return top
+
+
+def _meets(beta, groups, equal, tol: float = 1e-12) -> bool:
+    """Whether beta meets every limit's rows |G beta + c| <= 1 (and the cutting-speed rows, = 1)."""
+    if equal is not None and not np.all(np.abs(equal @ beta - 1.0) <= tol):
+        return False
+    return all(np.all(np.abs(G @ beta + c) <= 1.0 + tol) for _, G, c in groups)
+
+
+def _scaling(groups, top, lim) -> str:
+    """Why a solver may fail on these limits: rows whose coefficients are extreme, or speeds spanning many
+    orders of magnitude ('' if neither)."""
+    notes = []
+    for name in dict.fromkeys(name for name, _, _ in groups):
+        big = max(float(np.abs(sp.csr_matrix(G).data).max(initial=0.0)) for nm, G, _ in groups if nm == name)
+        if big > BADLY_SCALED and name != "omega_max":
+            what = "changes of omega2^2 per cell" if name == "alpha_max" else "omega2^2 where it binds"
+            notes.append(f"{name} = {lim[name]:g} bounds {what} by {1 / big:.2g} omega_max^2")
+    if top.min() < 1 / BADLY_SCALED:
+        notes.append(f"the speed limits allow omega2 down to {math.sqrt(top.min()):.2g} omega_max")
+    if not notes:
+        return ""
+    return "; the program is badly scaled (" + "; ".join(notes) + "): relax the tiny limits or scale the units"
 
 
 __all__ = ["speed_profile", "SpeedProfile", "ServoMotion", "ConstantSpeed", "OBJECTIVES"]

@@ -1,99 +1,99 @@
 """What leaves qropt for CAD and other tools: the mechanism at one crank angle as DXF (ezdxf) or SVG, and a
 design file (JSON) that ``load_design`` and ``qropt analyze --from`` read back.
 
-Drawings are in the mechanism's own length unit, x right and y up (the SVG flips y for the screen). Layers:
-LINKS (link centre lines at their true lengths), PIVOTS (ground pivots O2, O4), JOINTS (moving joints),
-SLIDE_LINE and SLIDER_PATH (the output joint's path over a turn).
+Drawings are in the mechanism's own length unit, x right and y up (the SVG flips y for the screen), and draw the
+bodies the type declares (``qropt.io.drawing``). Layers: LINKS (bar and lever centre lines at their true lengths;
+a plate as a closed polygon, hatched in DXF), PIVOTS (ground pivots), JOINTS (moving joints), SLIDE_LINE,
+SLIDER_PATH (the output joint's path over a turn) and BLOCKS (sliding blocks, rams and slots, as outlines).
 """
 
 from __future__ import annotations
 
 import json
 import math
+import os
 from pathlib import Path
 from xml.sax.saxutils import escape
 
-import numpy as np
-
 from qropt.errors import InvalidParameter, QroptError
-from qropt.mechanisms import FourBar, Mechanism, mechanism_type
+from qropt.io import drawing
+from qropt.io.paths import output_path
+from qropt.mechanisms import Mechanism, mechanism_type
 
-LAYERS = {"LINKS": 7, "PIVOTS": 1, "JOINTS": 5, "SLIDE_LINE": 8, "SLIDER_PATH": 4}  # name -> DXF colour
-GROUND = ("O2", "O4")
-
-
-def link_segments(points: dict) -> list[tuple[str, str]]:
-    """Joint pairs joined by a link at one configuration: crank, coupler, follower or slotted lever, rod.
-
-    A slotted lever runs from O4 through the crank-pin block at A to the farther of A and C."""
-    segs = [("O2", "A")]
-    if "B" in points:
-        segs += [("A", "B"), ("O4", "B"), ("O4", "C")]
-    elif "O4" in points:
-        a, c, o = (np.asarray(points[k], float) for k in ("A", "C", "O4"))
-        segs += [("O4", "A" if np.hypot(*(a - o)) > np.hypot(*(c - o)) else "C")]
-    segs += [("C", "D")] if "D" in points else [("A", "C")] if "O4" not in points else []
-    return [(a, b) for a, b in segs if a in points and b in points]
+LAYERS = drawing.LAYERS  # name -> DXF colour
+RESERVED = ("type", "params", "units")  # the design file's own fields
 
 
-def geometry(m: Mechanism, theta2: float = 0.0, n: int = 361) -> dict:
-    """Layer -> primitives of m at crank angle theta2 (rad): ('line', p, q), ('circle', centre, r) or
-    ('polyline', points)."""
-    pts = {k: tuple(float(c) for c in v[0]) for k, v in m.positions(np.array([theta2])).points.items()}
-    scale = max(np.ptp([p[0] for p in pts.values()]), np.ptp([p[1] for p in pts.values()]), 1e-12)
+def geometry(m: Mechanism, theta2: float = 0.0, n: int = drawing.TURN) -> dict:
+    """Layer -> primitives of m's declared bodies at crank angle theta2 (rad): ('line', p, q), ('circle', centre,
+    r), ('polyline', points) or ('polygon', points, filled) (closed; filled for a plate); n: crank angles of the
+    output's path over a turn."""
     out = {name: [] for name in LAYERS}
-    out["LINKS"] = [("line", pts[a], pts[b]) for a, b in link_segments(pts)]
-    for k, p in pts.items():
-        out["PIVOTS" if k in GROUND else "JOINTS"].append(("circle", p, 0.015 * scale))
-    if not isinstance(m, FourBar):
-        out_joint = "D" if "D" in pts else "C"
-        path = m.positions(np.linspace(0.0, 2 * math.pi, n)).points[out_joint]
-        out["SLIDER_PATH"] = [("polyline", [tuple(map(float, q)) for q in path])]
-        if np.ptp(path[:, 1]) <= 1e-9 * scale:
-            pad = 0.15 * scale
-            y = float(path[0, 1])
-            out["SLIDE_LINE"] = [("line", (float(path[:, 0].min()) - pad, y), (float(path[:, 0].max()) + pad, y))]
+    for s in drawing.at(drawing.scene(m, n), theta2):
+        if s.kind == "line":
+            out[s.layer].append(("line", *s.points))
+        elif s.kind == "circle":
+            out[s.layer].append(("circle", s.points[0], s.radius))
+        elif s.kind == "polyline":
+            out[s.layer].append(("polyline", list(s.points)))
+        else:
+            out[s.layer].append(("polygon", list(s.points), s.part == "plate"))
     return out
 
 
-def _path(path, suffix: str) -> Path:
-    p = Path(path)
-    if p.suffix.lower() != suffix:
-        raise InvalidParameter(f"{path}: expected a {suffix} file")
-    return p
+def _mechanism(m) -> Mechanism:
+    if not isinstance(m, Mechanism):
+        raise InvalidParameter(f"expected a qropt mechanism, got {type(m).__name__}")
+    return m
+
+
+def _write(p, write) -> None:
+    try:
+        write(p)
+    except OSError as e:
+        raise InvalidParameter(f"{p}: cannot write: {e.strerror or e}") from None
 
 
 def to_dxf(m: Mechanism, path, theta2: float = 0.0) -> None:
     """The mechanism at theta2 (rad) as a DXF drawing in its own length unit, one layer per kind of entity."""
     import ezdxf
 
-    p = _path(path, ".dxf")
+    _mechanism(m)
+    p = output_path(path, (".dxf",), "DXF drawing")
+    geo = geometry(m, theta2)
     doc = ezdxf.new("R2010")
     for name, colour in LAYERS.items():
         doc.layers.add(name, color=colour)
     msp = doc.modelspace()
-    for layer, items in geometry(m, theta2).items():
+    for layer, items in geo.items():
         for kind, *args in items:
             attribs = {"layer": layer}
             if kind == "line":
                 msp.add_line(args[0], args[1], dxfattribs=attribs)
             elif kind == "circle":
                 msp.add_circle(args[0], args[1], dxfattribs=attribs)
-            else:
+            elif kind == "polyline":
                 msp.add_lwpolyline(args[0], dxfattribs=attribs)
-    doc.saveas(p)
+            else:
+                msp.add_lwpolyline(args[0], close=True, dxfattribs=attribs)
+                if args[1]:  # a plate: filled
+                    hatch = msp.add_hatch(color=LAYERS[layer], dxfattribs=attribs)
+                    hatch.paths.add_polyline_path(args[0], is_closed=True)
+    _write(p, doc.saveas)
 
 
 def to_svg(m: Mechanism, path, theta2: float = 0.0) -> None:
     """The same drawing as SVG: one group per layer, lengths in the mechanism's unit (y up, flipped for screens)."""
-    p = _path(path, ".svg")
+    _mechanism(m)
+    p = output_path(path, (".svg",), "SVG drawing")
     geo = geometry(m, theta2)
     xs = [c for items in geo.values() for _, *a in items for c in _coords(a)[0]]
     ys = [c for items in geo.values() for _, *a in items for c in _coords(a)[1]]
     pad = 0.05 * max(max(xs) - min(xs), max(ys) - min(ys))
     x0, x1, y0, y1 = min(xs) - pad, max(xs) + pad, min(ys) - pad, max(ys) + pad
     width = (x1 - x0) / 200  # stroke widths relative to the drawing
-    colours = {"LINKS": "black", "PIVOTS": "red", "JOINTS": "blue", "SLIDE_LINE": "gray", "SLIDER_PATH": "teal"}
+    colours = {"LINKS": "black", "PIVOTS": "red", "JOINTS": "blue", "SLIDE_LINE": "gray", "SLIDER_PATH": "teal",
+               "BLOCKS": "dimgray"}  # fmt: skip
     body = []
     for layer, items in geo.items():
         parts = []
@@ -105,15 +105,19 @@ def to_svg(m: Mechanism, path, theta2: float = 0.0) -> None:
                 (cx, cy), r = a
                 parts.append(f'<circle cx="{cx:.12g}" cy="{cy:.12g}" r="{r:.12g}" fill="none"/>')
             else:
-                d = " ".join(f"{x:.9g},{y:.9g}" for x, y in a[0])
-                parts.append(f'<polyline points="{d}" fill="none"/>')
+                d = " ".join(f"{x:.12g},{y:.12g}" for x, y in a[0])
+                if kind == "polyline":
+                    parts.append(f'<polyline points="{d}" fill="none"/>')
+                else:
+                    fill = f'fill="{colours[layer]}" fill-opacity="0.25"' if a[1] else 'fill="none"'
+                    parts.append(f'<polygon points="{d}" {fill}/>')
         body.append(f'<g id="{layer}" stroke="{colours[layer]}" stroke-width="{width:.6g}">' + "".join(parts) + "</g>")
     title = escape(f"{m!r} at theta2 = {math.degrees(theta2):.6g} deg")
     svg = (
         f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="{x0:.12g} {-y1:.12g} {x1 - x0:.12g} {y1 - y0:.12g}">'
         f'<title>{title}</title><g transform="scale(1,-1)">{"".join(body)}</g></svg>\n'
     )
-    p.write_text(svg)
+    _write(p, lambda q: q.write_text(svg))
 
 
 def _coords(args):
@@ -126,29 +130,47 @@ def _coords(args):
 
 
 def save_design(m: Mechanism, path, **extra) -> None:
-    """A design file: the type (kind), every parameter, the units, and any extra JSON-ready fields."""
-    p = _path(path, ".json")
+    """A design file: the type (kind), every parameter, the units, and any extra JSON-ready fields (strict JSON:
+    finite numbers, strings, lists, dictionaries, booleans and null)."""
+    _mechanism(m)
+    p = output_path(path, (".json",), "design file")
+    clash = [k for k in extra if k in RESERVED]
+    if clash:
+        raise InvalidParameter(f"save_design: {', '.join(map(repr, clash))} is the design file's own field")
+    for k, v in extra.items():
+        try:
+            json.dumps(v, allow_nan=False)
+        except (ValueError, TypeError, RecursionError) as e:
+            why = "nan or infinite numbers" if isinstance(e, ValueError) else type(e).__name__
+            raise InvalidParameter(f"save_design: extra field {k!r} is not strict JSON ({why}): {v!r:.80}") from None
     d = {"type": m.KIND, "params": dict(m.params), "units": "lengths in one consistent unit, angles in rad", **extra}
-    p.write_text(json.dumps(d, indent=2, allow_nan=False) + "\n")
+    text = json.dumps(d, indent=2, allow_nan=False) + "\n"
+    _write(p, lambda q: q.write_text(text))
 
 
 def load_design(path) -> Mechanism:
     """The mechanism of a design file (``save_design``, or the JSON of ``qropt synth/analyze --json``)."""
+    if isinstance(path, bytes) or not isinstance(path, (str, os.PathLike)):
+        raise InvalidParameter(f"a design file path is a str or path-like, got {path!r}")
     p = Path(path)
     try:
         d = json.loads(p.read_text())
     except FileNotFoundError:
         raise InvalidParameter(f"no design file {path}") from None
+    except RecursionError:
+        raise InvalidParameter(f"{path} is not a JSON design: it is nested too deeply") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise InvalidParameter(f"{path} is not a JSON design: {e}") from None
     if not isinstance(d, dict) or not isinstance(d.get("params"), dict) or not d.get("type"):
         raise InvalidParameter(f"{path}: a design file has 'type' and 'params'")
+    if not isinstance(d["type"], str):
+        raise InvalidParameter(f"{path}: the design's 'type' is a type name, got {d['type']!r:.80}")
     try:
         return mechanism_type(d["type"])(**d["params"])
     except QroptError as e:
         raise InvalidParameter(f"{path}: {e}") from None
-    except TypeError as e:
-        raise InvalidParameter(f"{path}: {e}") from None
+    except (TypeError, RecursionError) as e:
+        raise InvalidParameter(f"{path}: {type(e).__name__}: {e}") from None
 
 
-__all__ = ["LAYERS", "link_segments", "geometry", "to_dxf", "to_svg", "save_design", "load_design"]
+__all__ = ["LAYERS", "geometry", "to_dxf", "to_svg", "save_design", "load_design"]

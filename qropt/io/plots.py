@@ -9,46 +9,67 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.colors import to_rgba  # noqa: E402
+from matplotlib.patches import Polygon  # noqa: E402
 
-from qropt.io.export import link_segments  # noqa: E402
-from qropt.mechanisms import FourBar, Mechanism  # noqa: E402
+from qropt.errors import InvalidParameter  # noqa: E402
+from qropt.io import drawing  # noqa: E402
+from qropt.io.paths import picture_path  # noqa: E402
+from qropt.mechanisms import Mechanism  # noqa: E402
 
 
-def _block(ax, centre, angle, size, color, alpha):
-    """A sliding block (a square of side size, turned by angle rad) at centre."""
-    c, s = math.cos(angle), math.sin(angle)
-    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]]) * size / 2
-    xy = corners @ np.array([[c, s], [-s, c]]) + np.asarray(centre)
-    ax.fill(xy[:, 0], xy[:, 1], facecolor="white", edgecolor=color, lw=1.5, alpha=alpha, zorder=3)
+def draw_shapes(ax, shapes, color="k", alpha=1.0, labels=True, joint_color=None) -> list:
+    """Draw shapes of ``qropt.io.drawing`` on a matplotlib axis (joints labelled if ``labels``); the artists."""
+    out = []
+    joint_color = joint_color or color
+    for s in shapes:
+        xy = np.array(s.points)
+        if s.part == "link":
+            out += ax.plot(xy[:, 0], xy[:, 1], color=color, lw=2, alpha=alpha, solid_capstyle="round", zorder=2)
+        elif s.part == "plate":
+            patch = Polygon(xy, closed=True, facecolor=to_rgba(color, 0.25 * alpha), edgecolor=to_rgba(color, alpha),
+                            lw=2, zorder=2)  # fmt: skip
+            out.append(ax.add_patch(patch))
+        elif s.part == "slot":
+            out.append(ax.add_patch(Polygon(xy, closed=True, fill=False, edgecolor=to_rgba(color, 0.8 * alpha),
+                                            lw=1, zorder=2.5)))  # fmt: skip
+        elif s.part in ("block", "ram"):
+            out.append(ax.add_patch(Polygon(xy, closed=True, facecolor="white", edgecolor=to_rgba(color, alpha),
+                                            lw=1.5, zorder=3)))  # fmt: skip
+        elif s.part == "slide":
+            out += ax.plot(xy[:, 0], xy[:, 1], color="0.5", lw=1, ls="-.", zorder=1)
+        elif s.part == "path":
+            out += ax.plot(xy[:, 0], xy[:, 1], color="tab:blue", lw=3, alpha=0.4, zorder=1.5)
+        else:  # a pivot or a joint
+            pivot = s.part == "pivot"
+            (x, y), c = s.points[0], color if pivot else joint_color
+            out += ax.plot(x, y, "s" if pivot else "o", color=c, ms=7 if pivot else 5, alpha=alpha, zorder=4)
+            if labels:
+                out.append(ax.annotate(s.name, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8,
+                                       alpha=alpha, zorder=5))  # fmt: skip
+    return out
 
 
 def draw_mechanism(ax, m: Mechanism, theta2: float, color="k", alpha=1.0):
-    """Draw the links and joints of m at crank angle theta2 (rad), with the slider path, on an axis."""
-    pts = {k: v[0] for k, v in m.positions(np.array([theta2])).points.items()}
-    for a, b in link_segments(pts):
-        ax.plot(*zip(pts[a], pts[b], strict=True), color=color, lw=2, alpha=alpha)
-    for k, (x, y) in pts.items():
-        ground = k in ("O2", "O4")
-        ax.plot(x, y, "s" if ground else "o", color=color, ms=7 if ground else 5, alpha=alpha)
-        ax.annotate(k, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8, alpha=alpha)
-    scale = max(np.ptp([p[0] for p in pts.values()]), np.ptp([p[1] for p in pts.values()]), 1e-12)
-    if "O4" in pts and "B" not in pts:  # the crank-pin block in the slotted lever
-        lever = math.atan2(pts["A"][1] - pts["O4"][1], pts["A"][0] - pts["O4"][0])
-        _block(ax, pts["A"], lever, 0.06 * scale, color, alpha)
-    if not isinstance(m, FourBar):
-        slider = "D" if "D" in pts else "C"
-        path = m.positions(np.linspace(0, 2 * math.pi, 361))
-        xs, ys = path.points[slider][:, 0], path.points[slider][:, 1]
-        ax.plot(xs, ys, color="tab:blue", lw=3, alpha=0.4)
-        if np.ptp(ys) <= 1e-9 * scale:  # a slide line: draw it and the slider block on it
-            pad = 0.15 * scale
-            ax.plot([xs.min() - pad, xs.max() + pad], [ys[0], ys[0]], color="0.5", lw=1, ls="-.", zorder=1)
-            _block(ax, pts[slider], 0.0, 0.08 * scale, color, alpha)
+    """Draw the declared bodies of m at crank angle theta2 (rad), its joints and the output's path, on an axis;
+    the (x_min, x_max, y_min, y_max) of what was drawn."""
+    shapes = drawing.at(drawing.scene(m), theta2)
+    draw_shapes(ax, shapes, color, alpha)
+    ax.margins(0.08)  # room for the joints' labels
     ax.set_aspect("equal")
+    return drawing.bounds(shapes)
+
+
+def _mechanism(m) -> Mechanism:
+    if not isinstance(m, Mechanism):
+        raise InvalidParameter(f"expected a qropt mechanism, got {type(m).__name__}")
+    return m
 
 
 def cycle_figure(m: Mechanism, theta2: float = math.radians(60), omega2: float = 1.0, alpha2: float = 0.0, n=721):
     """Figure: mechanism at theta2 (left); x, v, a over a turn (right) with working/return strokes shaded."""
+    _mechanism(m)
+    drawing.check(m)
     fig = plt.figure(figsize=(12, 5.5))
     ax0 = fig.add_subplot(1, 2, 1)
     draw_mechanism(ax0, m, theta2)
@@ -59,8 +80,9 @@ def cycle_figure(m: Mechanism, theta2: float = math.radians(60), omega2: float =
     mo = m.motion(th, omega2, alpha2)
     d = m.dead_centres()
     a, b = m.stroke_angles()
-    unit = "rad" if isinstance(m, FourBar) else "length"
-    names = ("theta4", "omega4", "alpha4") if isinstance(m, FourBar) else ("slider x", "slider v", "slider a")
+    follower = m.OUTPUT == "follower"
+    unit = "rad" if follower else "length"
+    names = ("theta4", "omega4", "alpha4") if follower else ("slider x", "slider v", "slider a")
     rows = [(names[0], mo.x, unit), (names[1], mo.v, f"{unit}/s"), (names[2], mo.a, f"{unit}/s^2")]
     deg = np.degrees(th)
     for k, (name, y, u) in enumerate(rows):
@@ -73,9 +95,8 @@ def cycle_figure(m: Mechanism, theta2: float = math.radians(60), omega2: float =
             ax.plot(np.degrees([d.theta_max, d.theta_min]), [d.x_max, d.x_min], "kv", ms=6, label="dead centres")
             ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncol=3, fontsize=8, frameon=False)
     ax.set_xlabel(f"theta2 [deg] (omega2 = {omega2:g} rad/s)")
-    travel = "swing" if isinstance(m, FourBar) else "stroke"
     fig.suptitle(
-        f"TR = {m.time_ratio():.4f}, {travel} = {m.stroke():.4g} {unit}, "
+        f"TR = {m.time_ratio():.4f}, {m.TRAVEL} = {m.stroke():.4g} {unit}, "
         f"gamma_min = {math.degrees(m.gamma_min().value):.2f} deg, omega2 = {omega2:g} rad/s"
     )
     fig.tight_layout()
@@ -101,9 +122,15 @@ def _shade(ax, t_max, t_min, a, b, omega2):
     ax.set_xlim(0, 360)
 
 
-def save(fig, path):
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+def save(fig, path, dpi: int = 110):
+    """Write fig to path (the format by its extension, checked first) and close it."""
+    try:
+        picture_path(path)
+        fig.savefig(path, dpi=dpi)
+    except OSError as e:
+        raise InvalidParameter(f"{path}: cannot write the picture: {e.strerror or e}") from None
+    finally:
+        plt.close(fig)
 
 
 def reachable_figure(r, time_ratios=()):
@@ -198,8 +225,8 @@ def comparison_figure(cmp):
     nrows = math.ceil(n / cols)
     fig, axes = plt.subplots(nrows, cols, figsize=(4.2 * cols, 4.6 * nrows), squeeze=False)
     axes = axes.ravel()
-    boxes = [r.result.mechanism.bounding_box() for r in rows if r.success]
-    span = max((max(b.x_max - b.x_min, b.y_max - b.y_min) for b in boxes), default=1.0) * 1.15
+    boxes = {id(r): _extent(r.result.mechanism) for r in rows if r.success}
+    span = max((max(x1 - x0, y1 - y0) for x0, x1, y0, y1 in boxes.values()), default=1.0) * 1.15
     for ax, r in zip(axes, rows, strict=False):
         if not r.success:
             ax.text(0.5, 0.5, "no design:\n" + _wrap(r.reason, 40), transform=ax.transAxes, ha="center",
@@ -209,8 +236,8 @@ def comparison_figure(cmp):
             continue
         m = r.result.mechanism
         draw_mechanism(ax, m, _drawn_at(m))
-        b = m.bounding_box()
-        cx, cy = (b.x_min + b.x_max) / 2, (b.y_min + b.y_max) / 2
+        x0, x1, y0, y1 = boxes[id(r)]
+        cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
         ax.set_xlim(cx - span / 2, cx + span / 2)
         ax.set_ylim(cy - span / 2, cy + span / 2)
         ax.set_title(r.type, fontsize=10)
@@ -247,9 +274,9 @@ def _wrap(text, width):
 
 
 def _label(q):
-    from qropt.synthesis.criteria import UNITS
+    from qropt.synthesis.criteria import units
 
-    return f"{q} [{'deg' if q == 'gamma_min' else UNITS[q]}]"
+    return f"{q} [{'deg' if q == 'gamma_min' else units()[q]}]"
 
 
 def _front_xy(front, va, vb):
@@ -279,14 +306,14 @@ def front_figure(front, designs: int = 3):
     ax.set_title(f"{front.problem.mechanism.__name__}: {front.objectives[0]} vs {front.objectives[1]}")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="best")
-    boxes = [front.points[i].mechanism.bounding_box() for i in picks]
-    span = max((max(bx.x_max - bx.x_min, bx.y_max - bx.y_min) for bx in boxes), default=1.0) * 1.15
+    boxes = [_extent(front.points[i].mechanism) for i in picks]
+    span = max((max(x1 - x0, y1 - y0) for x0, x1, y0, y1 in boxes), default=1.0) * 1.15
     for k, i in enumerate(picks):
         axm = fig.add_subplot(gs[1 + k])
         m = front.points[i].mechanism
         draw_mechanism(axm, m, _drawn_at(m), color=colors[k])
-        bx = m.bounding_box()
-        cx, cy = (bx.x_min + bx.x_max) / 2, (bx.y_min + bx.y_max) / 2
+        x0, x1, y0, y1 = boxes[k]
+        cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
         axm.set_xlim(cx - span / 2, cx + span / 2)
         axm.set_ylim(cy - span / 2, cy + span / 2)
         axm.set_title(f"{k + 1}: {_short(a, va[i])}, {_short(b, vb[i])}", fontsize=9)
@@ -297,6 +324,13 @@ def front_figure(front, designs: int = 3):
 
 def _short(q, v):
     return f"{q} {math.degrees(v):.1f} deg" if q == "gamma_min" else f"{q} {v:.3g}"
+
+
+def _extent(m) -> tuple[float, float, float, float]:
+    """(x_min, x_max, y_min, y_max) of every joint's path over a turn and of the drawing at ``_drawn_at``."""
+    b = m.bounding_box()
+    x0, x1, y0, y1 = drawing.bounds(drawing.at(drawing.scene(m), _drawn_at(m)))
+    return min(b.x_min, x0), max(b.x_max, x1), min(b.y_min, y0), max(b.y_max, y1)
 
 
 def _drawn_at(m) -> float:

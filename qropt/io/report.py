@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from qropt.errors import InvalidParameter
+from qropt.io.paths import output_path
 from qropt.synthesis import analytic
 
 # The paper's printed values (its claims, shown beside the exact ones). Table 5: theta2 = 60 deg, omega2 = 10 rad/s.
@@ -185,16 +186,24 @@ def render(problem=None, path=None, progress=None) -> str:
 
     if problem is not None and not isinstance(problem, Problem):
         raise InvalidParameter(f"render takes a qropt.Problem or None, got {type(problem).__name__}")
+    if path is not None:
+        report_path(path)  # before any section is computed
     tick = progress if callable(progress) else (lambda: None)
     body = _paper(tick) if problem is None else _problem(problem)
     title = "qropt report" if problem is None else f"qropt report: {problem.name or problem.mechanism.__name__}"
     head = f"<meta charset='utf-8'><title>{html.escape(title)}</title><style>{CSS}</style>"
     text = f"<!DOCTYPE html><html><head>{head}</head><body>{body}</body></html>\n"
     if path is not None:
-        if Path(path).suffix.lower() not in (".html", ".htm"):
-            raise InvalidParameter(f"{path}: the report is an .html file")
-        Path(path).write_text(text)
+        try:
+            Path(path).write_text(text)
+        except OSError as e:
+            raise InvalidParameter(f"{path}: cannot write the report: {e.strerror or e}") from None
     return text
 
 
-__all__ = ["render"]
+def report_path(path) -> Path:
+    """A path for the report: an .html (or .htm) file in an existing directory that can be written."""
+    return output_path(path, (".html", ".htm"), "report")
+
+
+__all__ = ["render", "report_path"]

@@ -1,9 +1,9 @@
-"""Exact extremes of smooth functions of the crank angle over a full turn.
+"""Crank-angle grids and the safeguarded refinement of stationary points over a full turn.
 
-A function is given as ``fun(theta2) -> Jet`` (value, d/dtheta2, d2/dtheta2^2).
-Stationary points are bracketed on a uniform grid by sign changes of the first
-derivative and refined to machine precision by a vectorised Newton iteration,
-safeguarded by false position inside the bracket.
+A function is given as ``fun(theta2) -> Jet`` (value, d/dtheta2, d2/dtheta2^2). ``stationary`` refines
+stationary points bracketed in given cells to machine precision by a vectorised Newton iteration,
+safeguarded by false position inside the bracket (the compiled kernel's fallback); ``negative_intervals``
+finds where an assembly margin is negative.
 """
 
 from __future__ import annotations
@@ -18,7 +18,6 @@ TWO_PI = 2.0 * np.pi
 GRID = 720
 GRIDS = (180, 720, 2880)  # grids tried in turn for the compiled analysis (the first that resolves)
 MARGIN_TOL = 1e-12  # an assembly margin this far below zero is rounding (a change point), not a failure
-FD_XTOL = 1e-10
 
 
 @functools.lru_cache(maxsize=16)
@@ -39,19 +38,6 @@ def jet_of(fun, theta):
     if not isinstance(j, Jet):
         return Jet.of(np.broadcast_to(np.asarray(j, float), np.shape(theta)), 0.0, 0.0)
     return Jet(np.broadcast_to(j.c, (3,) + np.shape(theta)))
-
-
-def brackets(theta, d1, kind):
-    """Cells [theta_i, theta_i+1] (cyclic) where d1 changes sign: kind 'max' (+ to -) or 'min' (- to +)."""
-    n = theta.size
-    pos = d1 >= 0
-    nxt = np.roll(pos, -1)
-    hit = (pos & ~nxt) if kind == "max" else (~pos & nxt)
-    hit &= np.isfinite(d1) & np.isfinite(np.roll(d1, -1))
-    i = np.flatnonzero(hit)
-    lo = theta[i]
-    hi = np.where(i + 1 < n, theta[(i + 1) % n], theta[0] + TWO_PI)
-    return lo, hi
 
 
 def stationary(fun, lo, hi, iters: int = 100, xtol: float = 0.0):
@@ -83,64 +69,6 @@ def stationary(fun, lo, hi, iters: int = 100, xtol: float = 0.0):
         bad = ~np.isfinite(xn) | (xn <= lo) | (xn >= hi)
         x = np.where(done, x, np.where(bad, xf, xn))
     return x
-
-
-def wrap(theta):
-    """Crank angles reduced to [0, 2pi), with values within 1e-12 of 2pi sent to 0."""
-    t = np.mod(theta, TWO_PI)
-    return np.where(t > TWO_PI - 1e-12, 0.0, t)
-
-
-def stack(jets, shape) -> np.ndarray:
-    """Jets (or constants) as one array (Q, 3, *shape)."""
-    out = np.zeros((len(jets), 3) + tuple(shape))
-    for k, j in enumerate(jets):
-        if isinstance(j, Jet):
-            out[k] = j.c
-        else:
-            out[k, 0] = j
-    return out
-
-
-def extremes_many(fun, specs, n: int = GRID, xtol: float = 0.0):
-    """Local extremes of several quantities at once, from one grid evaluation and one Newton run.
-
-    fun(theta_jet) -> array (Q, 3, m) of the Q quantities' jets; specs: [(q, 'max' | 'min')].
-    Returns ([(theta2 array, value array) per spec], grid values (Q, n)).
-    """
-    theta = grid(n)
-    g = fun(Jet.seed(theta))
-    parts = [brackets(theta, g[q, 1], kind) for q, kind in specs]
-    lo = np.concatenate([p[0] for p in parts])
-    hi = np.concatenate([p[1] for p in parts])
-    which = np.concatenate([np.full(p[0].size, q, int) for (q, _), p in zip(specs, parts, strict=True)])
-
-    def selected(t):
-        return Jet(fun(t)[which, :, np.arange(which.size)].T)
-
-    x = wrap(stationary(selected, lo, hi, xtol=xtol)) if which.size else lo
-    vals = jet_of(selected, x).v if which.size else lo
-    out, start = [], 0
-    for p in parts:
-        out.append((x[start : start + p[0].size], vals[start : start + p[0].size]))
-        start += p[0].size
-    return out, g[:, 0]
-
-
-def difference_jet(values, h: float = 1e-4):
-    """A function of theta -> values as a jet fun(theta_jet) with central-difference derivatives.
-
-    Used where exact second derivatives are not available (extremes of an acceleration):
-    the derivative error O(h^2) moves a stationary point by O(h^2), its value only by O(h^4).
-    Refine with ``xtol = FD_XTOL``: a location error of 1e-10 changes the extreme value by ~1e-20.
-    """
-
-    def fun(t):
-        th = t.v
-        f0, fp, fm = values(th), values(th + h), values(th - h)
-        return Jet.of(f0, (fp - fm) / (2 * h), (fp - 2 * f0 + fm) / (h * h))
-
-    return fun
 
 
 def negative_intervals(margin, n: int = 3600):

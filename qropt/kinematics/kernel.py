@@ -268,14 +268,77 @@ class Kernel:
 
         return cycle.stationary(fun, lo, hi, iters=60, xtol=1e-14)
 
+    # ---- parameter sensitivities, and many nearby mechanisms at once ---------------------------------------
+    TRACK_STEPS = 5  # from a nearby mechanism's stationary point (~1e-3 rad off): 1e-3 -> 1e-6 -> 1e-12 -> rounding
+    TRACK_TOL = 1e-11  # rad: a tracked point whose last step is larger is analysed on its own
 
-def discrete_extremes(v, kind):
-    """Mask of the cyclic grid's discrete local maxima (or minima) of each row of v (Q, n)."""
-    prev = np.concatenate([v[:, -1:], v[:, :-1]], axis=1)
-    nxt = np.concatenate([v[:, 1:], v[:, :1]], axis=1)
-    with np.errstate(invalid="ignore"):
-        hit = (v >= prev) & (v > nxt) if kind == "max" else (v <= prev) & (v < nxt)
-    return hit & np.isfinite(prev) & np.isfinite(nxt)
+    def parametric(self, what: str) -> Batched:
+        """Exact values and parameter gradients at given crank angles, z = (theta2, p) -> one row (compiled on
+        first use). 'x': x, x', x'' (primes d/dtheta2), then dx/dp, dx'/dp, dx''/dp (3 + 3 n entries); a varying
+        joint's name: its transmission angle (rad) and d/dp (1 + n)."""
+        key = "parametric " + what
+        f = self._groups.get(key)
+        if f is None:
+            t, P, lp = self._t, self._P, self._lp
+            if what == "x":
+                d = [casadi.SX(lp.x) + 0 * t]
+                for _ in range(2):
+                    d.append(casadi.jacobian(d[-1], t))
+                outs = [*d, *(casadi.jacobian(q, P).T for q in d)]
+            elif what in self.joints:
+                g = transmission_angle(CASADI, lp.transmission[what])
+                outs = [g, casadi.jacobian(g, P).T]
+            else:
+                raise KeyError(f"no parametric quantity {what!r}: 'x' or one of {self.joints}")
+            z = casadi.SX.sym("z", 1 + P.numel())
+            fn = casadi.Function("par", [t, P], [casadi.vertcat(*outs)])
+            f = self._groups[key] = Batched(casadi.Function(f"parametric_{what}", [z], [fn(z[0], z[1:])], CSE))
+        return f
+
+    def tracker(self, group: str, index: int) -> Batched:
+        """z = (theta0, p) -> (theta, last Newton step, d2q/dtheta2 there, precise value): TRACK_STEPS exact
+        Newton steps on the stationary condition of quantity ``index`` of ``group`` from theta0, unbracketed
+        (for a stationary point followed from a nearby mechanism's)."""
+        key = f"track {group} {index}"
+        f = self._groups.get(key)
+        if f is None:
+            q = self.group(group)[index]
+            d, value = q.derivs.f, q.value.f
+            z = casadi.SX.sym("z", 1 + self._P.numel())
+            x, p = z[0], z[1:]
+            step = casadi.SX(0)
+            for _ in range(self.TRACK_STEPS):
+                g = d(casadi.vertcat(x, p))
+                step = g[1] / g[2]
+                x = x - step
+            g = d(casadi.vertcat(x, p))
+            out = casadi.vertcat(x, step, g[2], value(casadi.vertcat(x, p)))
+            f = self._groups[key] = Batched(casadi.Function(f"track_{group}_{index}", [z], [out], CSE))
+        return f
+
+    def track(self, group: str, index: int, theta0, P: np.ndarray, sign: float):
+        """The stationary points of a quantity near the crank angles theta0 (K,) for the parameter rows P (K, n),
+        a maximum (sign +1) or minimum (-1): theta (rad, unwrapped), precise values, and whether each converged
+        (last step <= TRACK_TOL rad with the curvature of its kind)."""
+        theta0 = np.broadcast_to(np.asarray(theta0, float), (P.shape[0],))
+        res = self.tracker(group, index)(np.column_stack([theta0, P]))
+        with np.errstate(invalid="ignore"):
+            ok = (np.abs(res[:, 1]) <= self.TRACK_TOL) & (sign * res[:, 2] < 0)
+        return res[:, 0], res[:, 3], ok
+
+    def grid_many(self, P: np.ndarray, n: int, transmission: bool = True):
+        """The loop on ``cycle.grid(n)`` for every parameter row of P (K, n_params), one numpy evaluation:
+        x (n, K), each varying joint's transmission angle (n, K) in ``joints`` order (if ``transmission``, else
+        []) and each assembly margin."""
+        theta = cycle.grid(n)[:, None]
+        params = {k: P[:, i][None, :] for i, k in enumerate(self.names)}
+        shape = (theta.size, P.shape[0])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            lp = self.cls.loop(NUMPY, theta, params)
+            lines = [lp.transmission[j] for j in self.joints] if transmission else []
+            gammas = [np.broadcast_to(transmission_angle(NUMPY, v), shape) for v in lines]
+        margins = [np.broadcast_to(m, shape) for _, m in lp.margins]
+        return np.broadcast_to(lp.x, shape), gammas, margins
 
 
 RESOLVED = 1e-9  # spectrum tail / largest mode below which the grid resolves a quantity
@@ -302,4 +365,4 @@ def derivative_on_grid(x, order: int):
     return np.fft.irfft((1j * k) ** order * c, x.size)
 
 
-__all__ = ["kernel", "Kernel", "Extremes", "discrete_extremes", "resolved", "derivative_on_grid"]
+__all__ = ["kernel", "Kernel", "Extremes", "resolved", "derivative_on_grid"]

@@ -170,18 +170,61 @@ class GammaMin(NamedTuple):
     joint: str
 
 
+BODY_KINDS = ("bar", "plate", "slot-lever", "block", "ram", "yoke")
+
+
+class Body(NamedTuple):
+    """A moving body of a type, declared once on the type (``Mechanism.BODIES``) for its pictures and mass model.
+
+    name: what it is ('crank', 'coupler', 'lever', 'rod', 'ram', ...); joints: the joints it carries, its frame's
+    origin first (the body's x axis points from it towards the second joint, or along the ray through it);
+    kind, one of BODY_KINDS:
+
+    - 'bar': a rigid straight link, a binary link or a lever carrying collinear joints (the four-bar sliders'
+      follower O4, B, C); drawn from its first joint to the farthest of the others;
+    - 'plate': a rigid link over three or more joints that are not collinear (a coupler carrying a coupler
+      point); drawn as a filled polygon over its joints in order;
+    - 'slot-lever': a lever about its first joint (a ground pivot) along the ray through its second, which slides
+      in the lever's slot; drawn from the pivot to the farthest its joints reach over a turn, with the slot;
+    - 'block': a block on a pin sliding in a slot: (the pin, a second point on the slot's line);
+    - 'ram': the slider on the slide line (along +x): (its pin,);
+    - 'yoke': a ram driven by a pin sliding in a slot normal to the slide line: (the pin,).
+    """
+
+    name: str
+    joints: tuple[str, ...]
+    kind: str
+
+
 class Mechanism:
     """Base of every quick-return type; instances are immutable."""
 
     PARAMS: ClassVar[dict[str, Any]] = {}
     LENGTHS: ClassVar[tuple[str, ...]] = ()
     REQUIRES_FULL_TURN: ClassVar[bool] = True
-    OUTPUT: ClassVar[str] = "slider"
+    OUTPUT: ClassVar[str] = "slider"  # 'slider' (x in length along +x) or 'follower' (an angle in rad)
+    TRAVEL: ClassVar[str] = "stroke"  # the output's travel target: 'stroke' (slider) or 'swing' (follower)
+    BRANCHES: ClassVar[tuple[str, ...]] = ()  # branch-sign parameters (default: PARAMS named sigma...)
+    FOUR_BAR: ClassVar[bool] = False  # driven by a four-bar whose Grashof class is a problem condition
+    CLASS: ClassVar[str] = ""  # the Grashof class the type requires ('' any)
+    EXACT_TRANSMISSION: ClassVar[dict[str, tuple[float, ...]]] = {}  # joint -> crank angles of its extremes
+    RULED_MARGINS: ClassVar[tuple[str, ...]] = ()  # closures that assemble wherever the type's rules hold
+    ACCEL_EXTREMES: ClassVar[int] = 2  # acceleration extremes the NLP lifts for the peak acceleration
+    BODIES: ClassVar[tuple[Body, ...]] = ()  # every moving body (see Body): pictures and the mass model read them
+    GROUND: ClassVar[tuple[str, ...]] = ()  # the joints fixed to the frame (ground pivots)
+    OUTPUT_JOINT: ClassVar[str | None] = None  # the joint whose x is a slider output; None for a follower angle
 
     def __init_subclass__(cls, **kw):
         super().__init_subclass__(**kw)
+        if "BRANCHES" not in cls.__dict__:
+            cls.BRANCHES = tuple(k for k in cls.PARAMS if k.startswith("sigma"))
         if getattr(cls, "KIND", None):
             REGISTRY[cls.KIND] = cls
+
+    @classmethod
+    def completed(cls, params: dict) -> dict:
+        """Defaults that depend on which parameters are given (override; e.g. a rod's slide line at h = 0)."""
+        return {}
 
     def __init__(self, **params):
         name = type(self).__name__
@@ -226,6 +269,14 @@ class Mechanism:
     @classmethod
     def required(cls) -> list[str]:
         return [k for k, v in cls.PARAMS.items() if v is REQUIRED]
+
+    def bodies(self) -> tuple[Body, ...]:
+        """The moving bodies of this mechanism (BODIES; a type overrides it where they depend on its options)."""
+        return self.BODIES
+
+    def output_joint(self) -> str | None:
+        """The joint whose x is the output (OUTPUT_JOINT; a type overrides it where it depends on its options)."""
+        return self.OUTPUT_JOINT
 
     @classmethod
     def rules(cls, xp, p, grashof: str | None = None) -> list[Rule]:
@@ -585,3 +636,222 @@ class Mechanism:
                 found = [(at, at)]
             return tuple((what, lo, hi) for lo, hi in found)
         return ()
+
+    # ---- exact sensitivities, many nearby mechanisms at once, the crank angle of an output position -------
+    TIE: ClassVar[float] = 1e-9  # rad (relative for accelerations): stationary values this close share the extreme
+    NEARBY_GRID: ClassVar[int] = 180  # crank angles on which every tracked nearby mechanism is checked
+    ACCEL_CHECK: ClassVar[float] = 0.02  # a tracked peak |x''| must reach the grid's second differences within this
+
+    def sensitivity(self, quantity: str, omega2: float | None = None) -> Sensitivity:
+        """Exact derivatives of 'time_ratio', 'stroke', 'gamma_min' (rad) or 'peak_acceleration' (over the turn,
+        length/s^2 at omega2 rad/s) with respect to every parameter but the branch signs, in ``params`` order.
+
+        A dead centre solves x'(theta*; p) = 0, so d theta*/dp = -(dx'/dp) / x'' (implicit function theorem); the
+        stroke, gamma_min and the peak acceleration are values at stationary points, so their derivatives are
+        partial derivatives at the fixed crank angle (envelope theorem), all by AD of the type's loop. Where the
+        quantity is the larger or least of equal pieces it has a kink (TR = 1 where both strokes take pi; a
+        transmission minimum or an acceleration peak reached at two crank angles): ``branches`` then holds every
+        piece's gradient, ``left`` and ``right`` the one-sided derivatives and ``kink`` says why."""
+        if quantity not in SENSITIVE:
+            raise InvalidParameter(f"sensitivity: unknown quantity {quantity!r}; one of {list(SENSITIVE)}")
+        if quantity == "peak_acceleration" and (omega2 is None or _finite("omega2", omega2) == 0.0):
+            raise InvalidParameter(f"the peak acceleration's sensitivity needs a nonzero omega2 (rad/s), got {omega2}")
+        self._require_full_turn()
+        k, p = self._kernel, self._kernel.vector(self.params)
+        n = p.size
+        names = tuple(q for q in self.params if not q.startswith("sigma"))
+        cols = [list(self.params).index(q) for q in names]
+        combine, kink = "max", ""
+        if quantity in ("time_ratio", "stroke"):
+            d = self.dead_centres()
+            r = k.parametric("x")(np.column_stack([[d.theta_max, d.theta_min], np.broadcast_to(p, (2, n))]))
+            x2, dx, dv = r[:, 2], r[:, 3 : 3 + n], r[:, 3 + n : 3 + 2 * n]
+            if quantity == "stroke":
+                rows = [dx[0] - dx[1]]
+            else:
+                if x2[0] == 0.0 or x2[1] == 0.0:
+                    raise DegenerateMechanism(f"{self!r}: a dead centre has x'' = 0; its time ratio is not smooth")
+                a, b = self.stroke_angles()
+                da = dv[0] / x2[0] - dv[1] / x2[1]  # a = theta_min - theta_max
+                slow_a, slow_b = 2 * math.pi / b**2 * da, -2 * math.pi / a**2 * da  # TR = a / b, or b / a
+                if abs(a - b) <= self.TIE:
+                    rows = [slow_a, slow_b]
+                    kink = "both strokes take pi (TR = 1, its least): TR - 1 grows as |dTR| either way"
+                else:
+                    rows = [slow_a if a >= b else slow_b]
+        elif quantity == "gamma_min":
+            combine, least = "min", self.gamma_min().value
+            minima = self.transmission_minima_by_joint()
+            tied = []
+            for j in k.joints:
+                ts, vs = minima.get(j, ((), ()))
+                tied += [(j, t) for t, v in zip(ts, vs, strict=True) if v <= least + self.TIE]
+            rows = [k.parametric(j)(np.append(t, p)[None, :])[0, 1:] for j, t in tied] or [np.zeros(n)]
+            if len(rows) > 1:
+                kink = f"gamma_min is reached at {len(rows)} crank angles: it falls either way from a ridge"
+        else:
+            ex = self.acceleration_extremes()
+            ts, vs = np.concatenate([ex.maxima[0], ex.minima[0]]), np.concatenate([ex.maxima[1], ex.minima[1]])
+            if not ts.size:
+                raise DegenerateMechanism(f"{self!r}: the slider acceleration has no regular extremes")
+            tied = np.abs(vs) >= np.abs(vs).max() * (1 - self.TIE)
+            r = k.parametric("x")(np.column_stack([ts[tied], np.broadcast_to(p, (int(tied.sum()), n))]))
+            w2 = float(omega2) ** 2
+            rows = list(np.sign(vs[tied])[:, None] * w2 * r[:, 3 + 2 * n :])
+            if len(rows) > 1:
+                kink = f"the peak |acceleration| is reached at {len(rows)} crank angles"
+        return Sensitivity(quantity, names, np.array(rows)[:, cols], combine, kink)
+
+    def nearby(self, P, quantities=("time_ratio", "stroke"), omega2: float | None = None) -> np.ndarray:
+        """Exact 'time_ratio', 'stroke', 'gamma_min' and 'peak_acceleration' (over the turn, at omega2) of many
+        mechanisms of this type near this one, all at once: P holds one parameter set per row, (K, len(params)) in
+        ``params`` order (branch signs included). Returns (len(quantities), K); nan where one cannot be analysed.
+
+        Every stationary point (dead centres, transmission minima, acceleration extremes) is followed from this
+        mechanism's by exact Newton steps, one compiled call per point; each must converge and hold the global
+        extreme of a NEARBY_GRID-point grid (the peak acceleration within ACCEL_CHECK of the grid's second
+        differences), else that mechanism is analysed on its own through this API."""
+        qs = [quantities] if isinstance(quantities, str) else list(quantities)
+        if not qs or any(q not in SENSITIVE for q in qs):
+            raise InvalidParameter(f"nearby: quantities are among {list(SENSITIVE)}, got {quantities!r}")
+        if "peak_acceleration" in qs:
+            if omega2 is None or _finite("omega2", omega2) == 0.0:
+                raise InvalidParameter("nearby: the peak acceleration needs a nonzero omega2 (rad/s)")
+            omega2 = float(omega2)
+        P = np.asarray(P)
+        if P.dtype.kind not in "iuf" or P.ndim != 2 or P.shape[1] != len(self.params) or not np.isfinite(P).all():
+            raise InvalidParameter(f"nearby: P must be finite numbers, one row of {list(self.params)} per mechanism")
+        P = P.astype(float)
+        self._require_full_turn()
+        k, N = self._kernel, P.shape[0]
+        d = self.dead_centres()
+        tmax, xmax, ok = k.track("cycle", 0, d.theta_max, P, 1.0)
+        tmin, xmin, conv = k.track("cycle", 0, d.theta_min, P, -1.0)
+        ok &= conv
+        xg, gammas, margins = k.grid_many(P, self.NEARBY_GRID, "gamma_min" in qs)
+        with np.errstate(invalid="ignore"):
+            slack = 1e-12 * (np.abs(xg).max(axis=0) + 1.0)
+            ok &= (xmax >= xg.max(axis=0) - slack) & (xmin <= xg.min(axis=0) + slack)
+            for m in margins:
+                ok &= np.all(m >= -cycle.MARGIN_TOL, axis=0)
+        out = np.full((len(qs), N), np.nan)
+        for i, q in enumerate(qs):
+            if q == "stroke":
+                out[i] = xmax - xmin
+            elif q == "time_ratio":
+                s = np.mod(tmin - tmax, cycle.TWO_PI)
+                out[i] = np.maximum(s, cycle.TWO_PI - s) / np.minimum(s, cycle.TWO_PI - s)
+            elif q == "gamma_min":
+                best, on_grid = np.full(N, math.pi / 2), np.full(N, math.pi / 2)
+                minima = self.transmission_minima_by_joint()
+                for j, g in zip(k.joints, gammas, strict=True):
+                    on_grid = np.minimum(on_grid, g.min(axis=0))
+                    for t0 in minima.get(j, ((),))[0]:
+                        _, v, conv = k.track("cycle", 1 + k.joints.index(j), t0, P, 1.0)
+                        ok &= conv
+                        best = np.minimum(best, v)
+                with np.errstate(invalid="ignore"):
+                    ok &= best <= on_grid + 1e-12
+                out[i] = best
+            else:
+                peak, ex = np.zeros(N), self.acceleration_extremes()
+                for sign, (ts, _) in ((1.0, ex.maxima), (-1.0, ex.minima)):
+                    for t0 in ts:
+                        _, v, conv = k.track("accel", 0, t0, P, sign)
+                        ok &= conv
+                        peak = np.maximum(peak, np.abs(v))
+                x2 = (np.roll(xg, 1, axis=0) - 2 * xg + np.roll(xg, -1, axis=0)) / (cycle.TWO_PI / xg.shape[0]) ** 2
+                with np.errstate(invalid="ignore"):
+                    ok &= peak >= np.abs(x2).max(axis=0) * (1 - self.ACCEL_CHECK)
+                out[i] = peak * omega2 * omega2
+        for j in np.flatnonzero(~ok):  # one at a time through the API
+            out[:, j] = self._nearby_one(P[j], qs, omega2)
+        return out
+
+    def _nearby_one(self, row, qs, omega2) -> np.ndarray:
+        from qropt.errors import QroptError
+
+        try:
+            m = type(self)(**dict(zip(self.params, row.tolist(), strict=True)))
+            vals = {
+                "time_ratio": m.time_ratio,
+                "stroke": m.stroke,
+                "gamma_min": lambda: m.gamma_min().value,
+                "peak_acceleration": lambda: m.peak_acceleration(omega2).value,
+            }
+            return np.array([vals[q]() for q in qs])
+        except QroptError:
+            return np.full(len(qs), np.nan)
+
+    def working_angle_at(self, x) -> np.ndarray:
+        """Crank angles (rad, from ``working_arc()``'s start to its end, not reduced mod 2 pi) at which the output
+        passes the positions x (length; rad for FourBar) on the working stroke, exact: Newton on the exact x and
+        dx/dtheta2, safeguarded by bisection (the output is monotone between the dead centres)."""
+        if isinstance(x, (str, bytes)) or np.asarray(x).dtype.kind not in "iuf" or not np.isfinite(x).all():
+            raise InvalidParameter(f"working_angle_at: x must be finite positions, got {x!r}")
+        target = np.atleast_1d(np.asarray(x, float))
+        start, length = self.working_arc()
+        d = self.dead_centres()
+        lo_x, hi_x = d.x_min, d.x_max
+        slack = 1e-12 * max(abs(lo_x), abs(hi_x), hi_x - lo_x)
+        if np.any(target < lo_x - slack) or np.any(target > hi_x + slack):
+            raise InvalidParameter(f"working_angle_at: x must lie within the stroke [{lo_x:.12g}, {hi_x:.12g}]")
+        q, p = self._kernel.group("cycle")[0], self._kernel.vector(self.params)
+        x0, x1 = (d.x_max, d.x_min) if start == d.theta_max else (d.x_min, d.x_max)
+        rising = x1 > x0
+        a, b = np.full(target.shape, start), np.full(target.shape, start + length)
+        t = start + length * np.clip((target - x0) / (x1 - x0), 0.0, 1.0)
+        eps = 4 * np.finfo(float).eps
+        for _ in range(100):
+            v, dv, _ = q.at(t, p)
+            g = (v - target) if rising else (target - v)  # increasing along the arc
+            a, b = np.where(g < 0, t, a), np.where(g > 0, t, b)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                tn = t - (v - target) / dv
+            bad = ~np.isfinite(tn) | (tn < a) | (tn > b)
+            tn = np.where(bad, 0.5 * (a + b), tn)
+            done = (g == 0) | (np.abs(tn - t) <= eps * np.maximum(1.0, np.abs(t)))
+            t = np.where(g == 0, t, tn)
+            if done.all():
+                break
+        return t
+
+
+SENSITIVE = ("time_ratio", "stroke", "gamma_min", "peak_acceleration")  # quantities with exact sensitivities
+
+
+class Sensitivity(NamedTuple):
+    """Exact derivatives of a cycle quantity Q with respect to the parameters ``names``.
+
+    ``branches`` (J, len(names)): the gradients of the smooth pieces of which Q is, near these parameters, the
+    largest (``combine`` 'max') or least ('min'); J = 1 and ``kink`` '' where Q is differentiable, else ``kink``
+    says why it is not (the one-sided derivatives ``left`` and ``right`` then differ)."""
+
+    quantity: str
+    names: tuple
+    branches: np.ndarray
+    combine: str = "max"
+    kink: str = ""
+
+    @property
+    def gradient(self) -> np.ndarray:
+        """Per parameter the one-sided derivative of larger magnitude: the derivative where Q is smooth, and a
+        slope whose magnitude bounds either side at a kink (a safe coefficient for a worst-case stack-up)."""
+        g = self.branches
+        return g[np.argmax(np.abs(g), axis=0), np.arange(g.shape[1])]
+
+    @property
+    def right(self) -> np.ndarray:
+        """dQ/dp_i from above (p_i increased)."""
+        return self.branches.max(axis=0) if self.combine == "max" else self.branches.min(axis=0)
+
+    @property
+    def left(self) -> np.ndarray:
+        """dQ/dp_i from below (p_i decreased)."""
+        return self.branches.min(axis=0) if self.combine == "max" else self.branches.max(axis=0)
+
+    def change(self, delta) -> np.ndarray:
+        """First-order change of Q for parameter changes delta (len(names),) or (len(names), K): the largest
+        (or least) of the pieces' linear changes, exact to second order even at a kink."""
+        lin = self.branches @ np.asarray(delta, float)
+        return lin.max(axis=0) if self.combine == "max" else lin.min(axis=0)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from qropt.errors import InvalidParameter
 from qropt.kinematics.closures import RIGHT_ANGLE, on_ray, pin_in_slot, rod_lines, rod_to_line
-from qropt.mechanisms.base import REQUIRED, Loop, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Body, Loop, Mechanism, Rule
 
 
 class CrankShaper(Mechanism):
@@ -16,6 +16,28 @@ class CrankShaper(Mechanism):
     KIND = "crank-shaper"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r4": REQUIRED, "r6": None, "h": None, "sigma_slider": 1.0}
     LENGTHS = ("r1", "r2", "r4", "r6")
+    BODIES = (  # with the yoke (no rod r6): the yoke-ram moves along x with x_C
+        Body("crank", ("O2", "A"), "bar"),
+        Body("block", ("A", "O4"), "block"),  # the crank-pin block in the lever's slot
+        Body("lever", ("O4", "A", "C"), "slot-lever"),  # length max(r4, r1 + r2)
+        Body("yoke", ("C",), "yoke"),
+    )
+    ROD_BODIES = (*BODIES[:3], Body("rod", ("C", "D"), "bar"), Body("ram", ("D",), "ram"))  # with a rod r6
+    GROUND = ("O2", "O4")
+    OUTPUT_JOINT = "C"
+
+    def bodies(self):
+        """BODIES with the yoke; ROD_BODIES with a rod r6."""
+        return self.ROD_BODIES if "r6" in self.params else self.BODIES
+
+    def output_joint(self):
+        """C (the yoke-ram follows x_C) without a rod; D with a rod r6."""
+        return "D" if "r6" in self.params else "C"
+
+    @classmethod
+    def completed(cls, params):
+        """With a rod r6 the slide line defaults to h = 0 (through O4)."""
+        return {"h": 0.0} if "r6" in params and "h" not in params else {}
 
     @classmethod
     def rules(cls, xp, p, grashof=None):

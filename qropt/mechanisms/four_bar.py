@@ -8,7 +8,7 @@ from typing import ClassVar, NamedTuple
 
 from qropt.errors import GrashofError
 from qropt.kinematics.closures import circle_circle, joint_lines, on_ray, rod_lines, rod_to_line
-from qropt.mechanisms.base import REQUIRED, Loop, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Body, Loop, Mechanism, Rule
 
 LINKS = ("r1", "r2", "r3", "r4")
 
@@ -64,6 +64,9 @@ def grashof_rules(xp, p, kind: str) -> list[Rule]:
 
 class _FourBarBase(Mechanism):
     LENGTHS: ClassVar[tuple[str, ...]] = LINKS
+    FOUR_BAR = True
+    EXACT_TRANSMISSION = {"B": (0.0, math.pi)}  # coupler-follower extremes with the crank along the ground line
+    RULED_MARGINS = ("four-bar closure at B",)  # the Grashof rules make it assemble
 
     def grashof(self) -> Grashof:
         """Grashof class and shortest link of r1..r4."""
@@ -92,6 +95,13 @@ class FourBar(_FourBarBase):
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r3": REQUIRED, "r4": REQUIRED, "sigma": -1.0}
     REQUIRES_FULL_TURN = False
     OUTPUT = "follower"
+    TRAVEL = "swing"
+    BODIES = (
+        Body("crank", ("O2", "A"), "bar"),
+        Body("coupler", ("A", "B"), "bar"),
+        Body("follower", ("O4", "B"), "bar"),
+    )
+    GROUND = ("O2", "O4")
 
     @staticmethod
     def loop(xp, theta2, p):
@@ -128,8 +138,17 @@ class FourBarSlider(_FourBarBase):
         "sigma_slider": 1.0,
     }
     LENGTHS = ("r1", "r2", "r3", "r4", "r5", "r6")
-    CLASS: ClassVar[str] = ""
     SHORTEST: ClassVar[str] = ""
+    BODIES = (
+        Body("crank", ("O2", "A"), "bar"),
+        Body("coupler", ("A", "B"), "bar"),
+        Body("follower", ("O4", "B", "C"), "bar"),  # along ray O4->B, length max(r4, r5)
+        Body("rod", ("C", "D"), "bar"),
+        Body("ram", ("D",), "ram"),
+    )
+    GROUND = ("O2", "O4")
+    OUTPUT_JOINT = "D"
+    ACCEL_EXTREMES = 4  # the four-bar adds acceleration extremes of note
 
     @classmethod
     def rules(cls, xp, p, grashof=None):

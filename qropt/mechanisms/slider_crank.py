@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from qropt.kinematics.closures import rod_lines, rod_to_line
-from qropt.mechanisms.base import REQUIRED, Loop, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Body, Loop, Mechanism, Rule
 
 
 class SliderCrank(Mechanism):
@@ -12,6 +12,9 @@ class SliderCrank(Mechanism):
     KIND = "slider-crank"
     PARAMS = {"r2": REQUIRED, "r3": REQUIRED, "e": 0.0, "sigma_slider": 1.0}
     LENGTHS = ("r2", "r3")
+    BODIES = (Body("crank", ("O2", "A"), "bar"), Body("rod", ("A", "C"), "bar"), Body("ram", ("C",), "ram"))
+    GROUND = ("O2",)
+    OUTPUT_JOINT = "C"
 
     @classmethod
     def rules(cls, xp, p, grashof=None):

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from qropt.kinematics.closures import RIGHT_ANGLE, on_ray, pin_in_slot, rod_lines, rod_to_line
-from qropt.mechanisms.base import REQUIRED, Loop, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Body, Loop, Mechanism, Rule
 
 
 class Whitworth(Mechanism):
@@ -12,6 +12,15 @@ class Whitworth(Mechanism):
     KIND = "whitworth"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r5": REQUIRED, "r6": REQUIRED, "h": 0.0, "sigma_slider": 1.0}
     LENGTHS = ("r1", "r2", "r5", "r6")
+    BODIES = (
+        Body("crank", ("O2", "A"), "bar"),
+        Body("block", ("A", "O4"), "block"),  # the crank-pin block in the lever's slot
+        Body("lever", ("O4", "A", "C"), "slot-lever"),  # length max(r5, r1 + r2)
+        Body("rod", ("C", "D"), "bar"),
+        Body("ram", ("D",), "ram"),
+    )
+    GROUND = ("O2", "O4")
+    OUTPUT_JOINT = "D"
 
     @classmethod
     def rules(cls, xp, p, grashof=None):

@@ -1,7 +1,8 @@
 """Studies built on single solves: type synthesis (``design``), trade-off fronts (``pareto``), one-parameter
 families (``family``), reachable ranges (``reachable``) and design charts (``chart``)."""
 
-from qropt.studies._chart import Chart, chart
+from qropt.studies._chart import Chart
+from qropt.studies._chart_run import chart
 from qropt.studies._design import Comparison, design
 from qropt.studies._family import Family, family
 from qropt.studies._pareto import Front, pareto

@@ -1,33 +1,32 @@
-"""Design charts: a synthesis problem solved at every cell of a grid of target or fixed-parameter values.
+"""Design charts, the model: axes, solved cells and the Chart (lookups, grids, files, the picture).
 
-Cells are solved by continuation inside tiles (blocks of cells): each cell starts one local solve from the
-design of its best certified neighbour and is certified like any solve. The full default solve (closed forms
-and multi-start) runs at the first cell of every tile, on a check lattice (every ``check``-th cell each way),
-and wherever the warm start fails or jumps branch; a better design found that way is carried to the cells
-around it. Tiles are independent and described by plain numbers, so they run in-process or on a Dask cluster
-(``qropt.chart_dask``) with the same results. Angles in radians, lengths in the problem's units.
+A chart is made by ``qropt.chart`` (``qropt.studies._chart_run``): its cells are solved by continuation inside
+tiles (``_continuation``), in-process or on a Dask cluster (``_dask``). This module imports neither, so both can
+use its Axis and Cell. Angles in radians, lengths in the problem's units.
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import math
-import sys
-import time
+import os
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, NamedTuple
 
 import numpy as np
 
-from qropt.errors import ChartError, ProblemError
+from qropt.errors import ChartError, QroptError
+from qropt.io.paths import picture_path
 from qropt.synthesis.criteria import maximises
 from qropt.synthesis.problem import Problem
-from qropt.synthesis.result import Result
+from qropt.synthesis.result import STATUSES, Result
 
-TILE = (10, 10)  # cells per tile along x and y
-CHECK = 10  # the full solve also runs at the centre of every CHECK x CHECK block of cells
-MAX_CELLS = 1_000_000
+METHODS = ("continued", "full")
+STATS = ("cells", "certified", "no_design", "continued", "full", "needed", "jumps", "switched", "seconds",
+         "cells_per_second", "tiles", "scheduler")  # fmt: skip
 
 
 class Axis(NamedTuple):
@@ -71,9 +70,12 @@ class Cell:
 
     @property
     def result(self) -> Result:
-        """The cell's Result (rebuilt from its dictionary on first use for cells solved on a cluster)."""
+        """The cell's Result (rebuilt from its dictionary on first use for cells solved on a cluster or read)."""
         if self._result is None:
-            object.__setattr__(self, "_result", Result.from_dict(self._data))
+            try:
+                object.__setattr__(self, "_result", Result.from_dict(self._data))
+            except QroptError as e:
+                raise ChartError(f"cell ({self.i}, {self.j}): {e}") from None
         return self._result
 
     @property
@@ -93,7 +95,35 @@ class Cell:
 
     @classmethod
     def from_dict(cls, d: dict) -> Cell:
+        """The cell of ``to_dict``; ChartError naming the first field that is missing or of the wrong type."""
+        _fields(
+            d,
+            "cell",
+            {
+                "i": _is_index,
+                "j": _is_index,
+                "method": (lambda v: v in METHODS, "continued or full"),
+                "why": _is_str,
+                "source": (lambda v: v is None or _is_pair(v), "null or a pair of indices"),
+                "jump": _is_bool,
+                "switched": _is_bool,
+                "seconds": _is_number,
+                "result": _is_dict,
+            },
+        )
         r = d["result"]
+        where = f"cell ({d['i']}, {d['j']}) result"
+        _fields(
+            r,
+            where,
+            {
+                "status": (lambda v: v in STATUSES, "a Result status"),
+                "objective": (lambda v: v is None or _is_number(v), "null or a finite number"),
+                "params": _is_numbers,
+                "quantities": _is_dict,
+                "message": _is_str,
+            },
+        )
         return cls(d["i"], d["j"], r["status"], r["objective"], dict(r["params"]), dict(r["quantities"]),
                    r["message"], d["method"], d["why"], tuple(d["source"]) if d["source"] else None, d["jump"],
                    d["switched"], d["seconds"], _data=r)  # fmt: skip
@@ -137,7 +167,16 @@ class Chart:
         return (len(self.y.values) if self.y else 1, len(self.x.values))
 
     def cell(self, i: int, j: int = 0) -> Cell:
-        return self.cells[j * self.shape[1] + i]
+        """The cell at x index i and y index j (0 <= i < len(x values), 0 <= j < len(y values); j = 0 without y)."""
+        ny, nx = self.shape
+        for name, k, n in (("i", i, nx), ("j", j, ny)):
+            if not _is_index(k):
+                raise ChartError(f"cell index {name} must be an integer, got {k!r}")
+            if not 0 <= k < n:
+                axis = self.x if name == "i" else self.y
+                span = f"0..{n - 1} ({n} {axis.name} values)" if axis else "0 (this chart has no y axis)"
+                raise ChartError(f"cell index {name} = {k} is out of range: {span}")
+        return self.cells[j * nx + i]
 
     def result(self, xv: float, yv: float | None = None) -> Result:
         """The Result of the cell at these axis values (as given; swing in rad)."""
@@ -153,6 +192,8 @@ class Chart:
     def grid(self, quantity: str = "objective") -> np.ndarray:
         """'objective', a quantity of the Results (gamma_min, time_ratio, swing, stroke, size, peak_accel), a
         parameter, or a ratio of two of them ('r3/r1'); nan where a cell has no design."""
+        if not isinstance(quantity, str):
+            raise ChartError(f"a chart quantity is a name or a ratio 'a/b', got {quantity!r}")
         parts = quantity.split("/")
         if len(parts) > 2 or not all(parts):
             raise ChartError(f"a chart quantity is a name or a ratio 'a/b', got {quantity!r}")
@@ -182,7 +223,7 @@ class Chart:
                 "continued": lambda c: c.method == "continued", "full": lambda c: c.method == "full",
                 "needed": lambda c: c.needed_full, "jump": lambda c: c.jump,
                 "switched": lambda c: c.switched}  # fmt: skip
-        if flag not in test:
+        if not isinstance(flag, str) or flag not in test:
             raise ChartError(f"unknown chart flag {flag!r}; flags: {', '.join(self.FLAGS)}")
         return np.array([test[flag](c) for c in self.cells]).reshape(self.shape)
 
@@ -214,7 +255,7 @@ class Chart:
         """Every cell as a CSV row (angles in rad, lengths in the problem's units)."""
         rows = self.rows()
         keys = list(dict.fromkeys(k for r in rows for k in r))
-        with open(path, "w", newline="") as fh:
+        with _writing(path, "CSV") as fh:
             w = csv.DictWriter(fh, fieldnames=keys)
             w.writeheader()
             w.writerows(rows)
@@ -226,156 +267,183 @@ class Chart:
 
     def to_json(self, path) -> None:
         """The whole chart (every cell's Result) as strict JSON; ``Chart.from_json`` reads it back."""
-        with open(path, "w") as fh:
-            json.dump(self.to_dict(), fh, allow_nan=False, default=float)
+        text = json.dumps(self.to_dict(), allow_nan=False, default=float)
+        with _writing(path, "JSON") as fh:
+            fh.write(text)
 
     @classmethod
     def from_json(cls, path) -> Chart:
+        """A chart written by ``to_json``, checked whole on load: its axes, every cell in place, its stats
+        (ChartError naming the file and what is wrong)."""
+        _path(path, "JSON")
         try:
             with open(path) as fh:
                 d = json.load(fh)
-            axes = [None if a is None else Axis(a["name"], tuple(a["values"]), a["kind"]) for a in (d["x"], d["y"])]
-            cells = tuple(Cell.from_dict(c) for c in d["cells"])
-            return cls(Problem.from_dict(d["problem"]), axes[0], axes[1], cells, d["stats"])
-        except (OSError, ValueError, KeyError, TypeError) as e:
+        except (OSError, UnicodeDecodeError, ValueError) as e:
             raise ChartError(f"{path}: not a qropt chart file ({type(e).__name__}: {e})") from None
+        try:
+            return cls._from_dict(d)
+        except QroptError as e:
+            raise ChartError(f"{path}: not a qropt chart file ({e})") from None
+        except (KeyError, TypeError, AttributeError) as e:  # a malformed problem table
+            raise ChartError(f"{path}: not a qropt chart file ({type(e).__name__}: {e})") from None
+
+    @classmethod
+    def _from_dict(cls, d) -> Chart:
+        _fields(
+            d,
+            "chart",
+            {
+                "problem": _is_dict,
+                "x": _is_dict,
+                "y": (lambda v: v is None or _is_dict(v), "null or an axis"),
+                "stats": _is_dict,
+                "cells": (lambda v: isinstance(v, list), "a list"),
+            },
+        )
+        problem = Problem.from_dict(d["problem"])
+        x, y = (None if d[k] is None else _axis_of(problem, d[k], k) for k in ("x", "y"))
+        if y is not None and y.name == x.name:
+            raise ChartError(f"x and y are both {x.name!r}")
+        _fields(d["stats"], "stats", {k: _is_str if k == "scheduler" else _is_number for k in STATS})
+        nx, ny = len(x.values), len(y.values) if y else 1
+        if len(d["cells"]) != nx * ny:
+            raise ChartError(f"{len(d['cells'])} cells for {nx} x {ny} axis values: the file is incomplete")
+        cells = tuple(Cell.from_dict(c) for c in d["cells"])
+        for k, c in enumerate(cells):
+            if (c.i, c.j) != (k % nx, k // nx):
+                raise ChartError(f"cell {k} is ({c.i}, {c.j}), not ({k % nx}, {k // nx}): cells are in row order")
+        return cls(problem, x, y, cells, dict(d["stats"]))
 
     def plot(self, path, dpi: int = 90) -> None:
         """Contour charts of the objective and the optimal free parameters beside how each cell was solved;
         cells without a design are crossed, branch changes ringed (PNG, PDF or SVG by the path's suffix)."""
         import matplotlib.pyplot as plt
 
+        picture_path(path)
+        if isinstance(dpi, bool) or not isinstance(dpi, (int, float, np.integer, np.floating)) or not 10 <= dpi <= 1200:
+            raise ChartError(f"dpi must be a number from 10 to 1200, got {dpi!r}")
         fig = chart_figure(self)
-        fig.savefig(path, dpi=dpi)
-        plt.close(fig)
+        try:
+            fig.savefig(path, dpi=dpi)
+        except OSError as e:
+            raise ChartError(f"cannot write the chart picture {path}: {e.strerror or e}") from None
+        finally:
+            plt.close(fig)
+
+
+def _path(path, what):
+    if isinstance(path, (bytes, bytearray)) or not isinstance(path, (str, os.PathLike)) or not str(path).strip():
+        raise ChartError(f"the chart {what} file must be a path (str or pathlib.Path), got {path!r}")
+    parent = Path(path).parent
+    if what != "JSON" and not parent.is_dir():  # JSON: read, the open names a missing file
+        raise ChartError(f"cannot write the chart {what} file {str(path)!r}: no directory {str(parent)!r}")
+
+
+@contextlib.contextmanager
+def _writing(path, what):
+    """open(path, 'w') for a chart file: a bad path or a failed write is a ChartError naming the file."""
+    _path(path, what)
+    try:
+        with open(path, "w", newline="") as fh:
+            yield fh
+    except OSError as e:
+        raise ChartError(f"cannot write the chart {what} file {str(path)!r}: {e.strerror or e}") from None
+
+
+# ---- checks of a chart read from a file -------------------------------------------------------------------
+def _is_str(v) -> bool:
+    return isinstance(v, str)
+
+
+def _is_bool(v) -> bool:
+    return isinstance(v, bool)
+
+
+def _is_dict(v) -> bool:
+    return isinstance(v, dict)
+
+
+def _is_index(v) -> bool:
+    return isinstance(v, (int, np.integer)) and not isinstance(v, bool)
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _is_pair(v) -> bool:
+    return isinstance(v, (list, tuple)) and len(v) == 2 and all(_is_index(k) for k in v)
+
+
+def _is_numbers(v) -> bool:
+    return isinstance(v, dict) and all(isinstance(k, str) and _is_number(x) for k, x in v.items())
+
+
+def _fields(d, what, checks) -> None:
+    """ChartError naming the first of the fields that is missing or fails its check (a predicate, or a predicate
+    and what it wants)."""
+    if not isinstance(d, dict):
+        raise ChartError(f"{what} is {_shown_value(d)}, not an object")
+    for k, check in checks.items():
+        ok, wanted = check if isinstance(check, tuple) else (check, _WANTED[check])
+        if k not in d:
+            raise ChartError(f"{what} has no {k!r}")
+        if not ok(d[k]):
+            raise ChartError(f"{what} {k!r} is {_shown_value(d[k])}, not {wanted}")
+
+
+def _shown_value(v) -> str:
+    text = json.dumps(v, default=repr) if v is None or isinstance(v, (bool, int, float, str)) else type(v).__name__
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+_WANTED = {
+    _is_str: "a string",
+    _is_bool: "true or false",
+    _is_dict: "an object",
+    _is_index: "an integer",
+    _is_number: "a finite number",
+    _is_numbers: "an object of finite numbers",
+}
+
+
+def _axis_of(problem, d, which) -> Axis:
+    _fields(
+        d,
+        f"axis {which}",
+        {
+            "name": _is_str,
+            "values": (
+                lambda v: isinstance(v, list) and len(v) >= 2 and all(map(_is_number, v)),
+                "2 or more finite numbers",
+            ),
+            "kind": (lambda v: v in ("target", "fixed"), "target or fixed"),
+        },
+    )
+    axis = Axis(d["name"], tuple(float(v) for v in d["values"]), d["kind"])
+    if axis.name not in problem.targets and axis.name not in problem.fixed:
+        raise ChartError(f"axis {which} {axis.name!r} is no target or fixed parameter of the chart's problem")
+    if axis.kind != axis_kind(problem, axis.name):
+        raise ChartError(f"axis {which} {axis.name!r} is a {axis_kind(problem, axis.name)}, not a {axis.kind}")
+    steps = np.diff(axis.values)
+    if not (np.all(steps > 0) or np.all(steps < 0)):
+        raise ChartError(f"the values of axis {which} are not distinct and in order")
+    return axis
 
 
 def _index(axis: Axis, v) -> int:
     vals = np.asarray(axis.values)
     try:
-        k = int(np.argmin(np.abs(vals - float(v))))
+        f = float(v)
     except (TypeError, ValueError):
         raise ChartError(f"{axis.name} value must be a number, got {v!r}") from None
-    if abs(vals[k] - float(v)) > 1e-9 * max(1.0, np.ptp(vals)):
+    if isinstance(v, bool) or not math.isfinite(f):
+        raise ChartError(f"{axis.name} value must be a finite number, got {v!r}")
+    k = int(np.argmin(np.abs(vals - f)))
+    if abs(vals[k] - f) > 1e-9 * max(1.0, np.ptp(vals)):
         raise ChartError(f"{axis.name} = {v!r} is not a chart value; the nearest is {vals[k]:.12g}")
     return k
-
-
-# ---- building a chart --------------------------------------------------------------------------------------
-def chart(problem: Problem, x, y=None, *, scheduler=None, workers=None, progress=True, solver=None,
-          tile=TILE, check=CHECK) -> Chart:  # fmt: skip
-    """``problem`` solved at every cell of x (and y): each ``(name, values)``, the name a target of the problem
-    (time_ratio, stroke, swing in rad) or one of its fixed parameters, at least 2 distinct monotone values.
-
-    scheduler: None (in-process), 'local' (a LocalCluster of ``workers`` processes, one thread each) or the
-    address of a running Dask scheduler ('tcp://host:8786'); ``workers`` alone means 'local'. solver: the Solver
-    (default ``qropt.solve.DEFAULT``; workers rebuild it from its options); tile: cells per tile (x, y); check:
-    the full solve also runs where both cell indices are multiples of it. A tqdm bar on standard error when
-    ``progress`` and it is a terminal.
-    """
-    from qropt.studies import _tiles as chart_dask
-    from qropt.synthesis.solver import DEFAULT, Solver
-
-    if not isinstance(problem, Problem):
-        raise ChartError(f"chart takes a qropt.Problem, got {type(problem).__name__}")
-    solver = DEFAULT if solver is None else solver
-    if not isinstance(solver, Solver):
-        raise ChartError(f"solver must be a qropt.Solver, got {type(solver).__name__}")
-    ax_x = _axis(problem, x, "x")
-    ax_y = None if y is None else _axis(problem, y, "y")
-    if ax_y is not None and ax_y.name == ax_x.name:
-        raise ChartError(f"x and y are both {ax_x.name!r}: give two different axes")
-    nx, ny = len(ax_x.values), len(ax_y.values) if ax_y else 1
-    if nx * ny > MAX_CELLS:
-        raise ChartError(f"{nx} x {ny} cells is more than {MAX_CELLS:,}: split the chart")
-    tile, check = _tile_shape(tile), _positive_int("check", check)
-    mode = _mode(scheduler, workers)
-    for a in (ax_x, ax_y):  # every axis value gives a valid problem
-        for v in a.values if a else ():
-            try:
-                problem_at(problem, [a], [v])
-            except ProblemError as e:
-                raise ChartError(f"{a.name} = {v:g} on the chart's axis: {e}") from None
-    specs = [{"problem": problem.to_dict(), "x": [ax_x.name, list(ax_x.values)],
-              "y": None if ax_y is None else [ax_y.name, list(ax_y.values)],
-              "block": [i0, min(i0 + tile[0], nx), j0, min(j0 + tile[1], ny)], "check": check}
-             for j0 in range(0, ny, tile[1]) for i0 in range(0, nx, tile[0])]  # fmt: skip
-    t0 = time.perf_counter()
-    bar = _bar(progress, nx * ny)
-    try:
-        if mode is None:
-            tiles, where = chart_dask.run_here(specs, solver, bar.update), "in-process"
-        else:
-            tiles, where = chart_dask.run_dask(specs, solver, mode, workers, bar.update)
-    finally:
-        bar.close()
-    cells = sorted((c for t in tiles for c in t), key=lambda c: (c.j, c.i))
-    seconds = time.perf_counter() - t0
-    return Chart(problem, ax_x, ax_y, tuple(cells), _stats(cells, seconds, len(specs), where))
-
-
-def _stats(cells, seconds, tiles, where) -> dict:
-    n = len(cells)
-    return {"cells": n, "certified": sum(c.success for c in cells), "no_design": sum(not c.success for c in cells),
-            "continued": sum(c.method == "continued" for c in cells), "full": sum(c.method == "full" for c in cells),
-            "needed": sum(c.needed_full for c in cells), "jumps": sum(c.jump for c in cells),
-            "switched": sum(c.switched for c in cells), "seconds": seconds, "cells_per_second": n / seconds,
-            "tiles": tiles, "scheduler": where}  # fmt: skip
-
-
-def _axis(problem, spec, which) -> Axis:
-    if not (isinstance(spec, (tuple, list)) and len(spec) == 2 and isinstance(spec[0], str)):
-        raise ChartError(f"{which} is (name, values), got {spec!r}")
-    name, values = spec
-    if name in problem.free:
-        raise ChartError(f"{name!r} is free in the problem: a chart axis is a target or a fixed parameter "
-                         f"(fix {name} to chart it)")  # fmt: skip
-    names = list(problem.targets) + list(problem.fixed)
-    if name not in names:
-        raise ChartError(f"unknown chart axis {name!r}; this problem's targets and fixed parameters: {names}")
-    try:
-        vals = tuple(float(v) for v in values)
-    except (TypeError, ValueError):
-        raise ChartError(f"the values of {name} must be numbers, got {values!r}") from None
-    if len(vals) < 2:
-        raise ChartError(f"a chart axis needs at least 2 values; {name} has {len(vals)}")
-    if not all(math.isfinite(v) for v in vals):
-        raise ChartError(f"the values of {name} must be finite numbers")
-    steps = np.diff(vals)
-    if not (np.all(steps > 0) or np.all(steps < 0)):
-        raise ChartError(f"the values of {name} must be distinct and in increasing or decreasing order")
-    return Axis(name, vals, axis_kind(problem, name))
-
-
-def _positive_int(name, v) -> int:
-    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
-        raise ChartError(f"{name} must be an integer >= 1, got {v!r}")
-    return int(v)
-
-
-def _tile_shape(tile) -> tuple:
-    if not (isinstance(tile, (tuple, list)) and len(tile) == 2):
-        raise ChartError(f"tile is (cells along x, cells along y), got {tile!r}")
-    return _positive_int("tile size", tile[0]), _positive_int("tile size", tile[1])
-
-
-def _mode(scheduler, workers):
-    """None (in-process), 'local' or a scheduler address; checks workers."""
-    if workers is not None:
-        _positive_int("workers", workers)
-    if scheduler is None:
-        return "local" if workers is not None else None
-    if not isinstance(scheduler, str) or not scheduler.strip():
-        raise ChartError(f"scheduler is None, 'local' or a Dask scheduler address, got {scheduler!r}")
-    if scheduler != "local" and workers is not None:
-        raise ChartError(f"workers sets the size of a local cluster; the cluster at {scheduler} has its own")
-    return scheduler
-
-
-def _bar(progress, total):
-    from tqdm import tqdm
-
-    return tqdm(total=total, desc="chart", unit="cell", leave=False, disable=not (progress and sys.stderr.isatty()))
 
 
 # ---- the picture ---------------------------------------------------------------------------------------------
@@ -478,4 +546,4 @@ def chart_figure(ch: Chart):
     return fig
 
 
-__all__ = ["chart", "Chart", "Cell", "Axis", "ChartError", "chart_figure"]
+__all__ = ["Chart", "Cell", "Axis", "ChartError", "axis_kind", "problem_at", "chart_figure"]

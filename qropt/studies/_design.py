@@ -26,7 +26,6 @@ TYPES = {
     "crank-rocker-slider": ("crank-rocker-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}),
     "drag-link-slider": ("drag-link-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}),
 }
-CRITERIA = ("gamma_min", "footprint", "sum", "peak_accel", "peak_velocity", "torque_per_newton")
 
 
 def type_problem(kind: str, time_ratio: float, stroke: float, *, objective="max_gamma_min", bounds=None,
@@ -63,7 +62,7 @@ class Row:
     def record(self) -> dict:
         """Flat, JSON-ready: type, status, objective, each criterion, the parameters, the reason."""
         d = {"type": self.type, "status": self.result.status, "objective": self.result.objective}
-        d |= {k: self.criteria.get(k) for k in CRITERIA}
+        d |= {k: self.criteria.get(k) for k in columns()}
         d["params"] = dict(self.result.params)
         d["reason"] = self.reason
         return d
@@ -99,7 +98,7 @@ class Comparison:
 
     def to_json(self) -> str:
         d = {"time_ratio": self.time_ratio, "stroke": self.stroke, "objective": self.objective,
-             "omega2": self.omega2, "units": criteria.UNITS, "rows": self.table()}  # fmt: skip
+             "omega2": self.omega2, "units": criteria.units(), "rows": self.table()}  # fmt: skip
         return json.dumps(json_safe(d), indent=2, allow_nan=False)
 
     def to_csv(self, path) -> None:
@@ -107,9 +106,9 @@ class Comparison:
         names = sorted({k for r in rows for k in r["params"]})
         with open(path, "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["type", "status", "objective", *CRITERIA, *names, "reason"])
+            w.writerow(["type", "status", "objective", *columns(), *names, "reason"])
             for r in rows:
-                w.writerow([r["type"], r["status"], _cell(r["objective"]), *(_cell(r[k]) for k in CRITERIA),
+                w.writerow([r["type"], r["status"], _cell(r["objective"]), *(_cell(r[k]) for k in columns()),
                             *(_cell(r["params"].get(k)) for k in names), r["reason"]])  # fmt: skip
 
     def plot(self, path) -> None:
@@ -159,18 +158,24 @@ def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min"
         if progress:
             progress(1)
     maximise = criteria.maximises(objective)
-    ok = sorted((r for r in rows if r.success), key=lambda r: r.result.objective, reverse=maximise)
+    ok = [r for r in rows if r.success]
+    if objective:
+        ok.sort(key=lambda r: r.result.objective, reverse=maximise)
     return Comparison(time_ratio, stroke, objective, omega2, tuple(ok + [r for r in rows if not r.success]), fronts)
 
 
 def _row(kind, problem, r: Result) -> Row:
     if r.status not in SOLUTION_PRESENT:
         return Row(kind, r, {}, r.message)
-    m, q = r.mechanism, r.quantities
-    c = {"gamma_min": q["gamma_min"], "footprint": m.footprint(), "sum": m.size("sum"),
-         "peak_accel": q["peak_accel"], "peak_velocity": q["peak_velocity"],
-         "torque_per_newton": q["torque_per_newton"]}  # fmt: skip
-    return Row(kind, r, c, "")
+    values = {name: c.value(problem, r.mechanism) for name, c in criteria.CRITERIA.items()
+              if c.applies(problem.mechanism)}  # fmt: skip
+    values["torque_per_newton"] = r.quantities["torque_per_newton"]
+    return Row(kind, r, {k: values.get(k) for k in columns()}, "")
+
+
+def columns() -> tuple:
+    """The criteria a comparison reports, in registry order, and the torque per newton of cutting force."""
+    return (*criteria.CRITERIA, "torque_per_newton")
 
 
 def _types(types) -> list[str]:
@@ -189,4 +194,4 @@ def _cell(v):
     return "" if v is None else f"{v:.12g}" if isinstance(v, float) else v
 
 
-__all__ = ["TYPES", "CRITERIA", "type_problem", "design", "Comparison", "Row", "QroptError"]
+__all__ = ["TYPES", "columns", "type_problem", "design", "Comparison", "Row", "QroptError"]

@@ -19,6 +19,7 @@ import casadi
 import numpy as np
 
 from qropt.errors import ProblemError, QroptError
+from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.certificate import quantities
 from qropt.synthesis.problem import Problem
@@ -80,15 +81,19 @@ class Family:
         pts = self.points()
         step = max(1, len(pts) // sample)
         chosen = pts[::step] + [b[-1] for b in self.branches]
+        if not isinstance(objective, str) or objective not in criteria.objectives():
+            raise ProblemError(f"best takes an objective from {criteria.objectives()[1:]}, got {objective!r}")
+        if isinstance(sample, bool) or not isinstance(sample, (int, np.integer)) or sample < 1:
+            raise ProblemError(f"sample is how many family points to score, an integer >= 1; got {sample!r}")
         changes = {"objective": objective, **({"size": size} if size else {})}
         problem = self.problem.replace(**changes)
+        c = criteria.of_problem(problem)
 
         def score(p):
-            q = p.quantities
-            if not q:
+            if not p.quantities:
                 return -math.inf
-            v = {"max_gamma_min": q["gamma_min"], "min_size": -q["size"], "min_peak_accel": -(q["peak_accel"] or 0)}
-            return v[objective] if objective != "min_size" or not size else -p.mechanism.size(size)
+            v = c.value(problem, p.mechanism)
+            return v if c.maximise else -v
 
         top = sorted(chosen, key=score, reverse=True)[:3]
         free = list(self.problem.free)
@@ -102,8 +107,8 @@ class _Curve:
 
     def __init__(self, problem, branch, orientation, solver):
         self.form = form = solver.formulation(problem.replace(objective=None), branch, orientation)
-        n = form.nx + 2
-        u = form.w_sym[:n]
+        u = form.design_sym  # the free parameters and the dead centres
+        n = u.numel()
         eq = np.flatnonzero(form.lbg == form.ubg)
         ineq = np.flatnonzero(form.lbg != form.ubg)
         f = form.g_sym[eq.tolist()] - casadi.DM(form.lbg[eq])
@@ -113,10 +118,10 @@ class _Curve:
         self.ineq_rows = [form.rows[i] for i in ineq]
         self.glo, self.ghi = form.lbg[ineq], form.ubg[ineq]
         self.n = n
-        lo, hi = form.bounds()
-        self.lo, self.hi = lo[:n], hi[:n]
+        lo, hi = form.bounds(problem)
+        self.lo, self.hi = lo[form.design], hi[form.design]
         samples, fractions = form.base_samples()
-        self.p = form.param_vector(dict(problem.targets), samples, fractions)
+        self.p = form.param_vector(problem, dict(problem.targets), samples, fractions)
         self.free = form.free
 
     def eval(self, u):

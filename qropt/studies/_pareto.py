@@ -18,7 +18,6 @@ from qropt.synthesis import criteria
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import SOLUTION_PRESENT, Result
 
-OBJECTIVES = tuple(o for o in criteria.OBJECTIVES if o)
 MAX_POINTS = 1000
 
 
@@ -73,8 +72,9 @@ def pareto(problem: Problem, objectives=("max_gamma_min", "min_peak_accel"), n: 
 
     solver = solver or DEFAULT
     a, b = _check(problem, objectives, n)
-    qa, qb = criteria.measured(a, problem.size), criteria.measured(b, problem.size)
-    bound_b = criteria.bound_of(b, problem.size)
+    ca, cb = criteria.of(a, problem.size), criteria.of(b, problem.size)
+    qa, qb = ca.name, cb.name
+    bound_b = cb.bound
     base = problem.replace(conditions={k: v for k, v in problem.conditions.items() if k != bound_b})
     end_a = solver.solve(base.replace(objective=a))
     end_b = solver.solve(base.replace(objective=b))
@@ -107,20 +107,20 @@ LEXICOGRAPHIC = 1e-7  # relative give on an end's own optimum while the other cr
 def _lexicographic(solver, base, end, first, second, size):
     """The design optimising ``second`` among those within LEXICOGRAPHIC of ``end``'s optimum of ``first`` (the
     end itself if that solve does not improve on it)."""
-    q1, q2 = criteria.measured(first, size), criteria.measured(second, size)
-    v1 = criteria.value(base, q1, end.mechanism)
+    c1, c2 = criteria.of(first, size), criteria.of(second, size)
+    v1 = c1.value(base, end.mechanism)
     give = LEXICOGRAPHIC * max(1.0, abs(v1))
-    bound = v1 - give if q1 == "gamma_min" else v1 + give
-    p = base.replace(objective=second, conditions={**base.conditions, criteria.bound_of(first, size): bound})
+    bound = v1 - give if c1.maximise else v1 + give
+    p = base.replace(objective=second, conditions={**base.conditions, c1.bound: bound})
     r = solver.solve(p, extra_starts=[_free(p, end)], starts_n=0, use_analytic=False, diagnose=False)
     if r.status not in SOLUTION_PRESENT:
         return end
-    better = criteria.better(p, criteria.value(base, q2, r.mechanism), criteria.value(base, q2, end.mechanism))
+    better = c2.better(c2.value(base, r.mechanism), c2.value(base, end.mechanism))
     return r if better else end
 
 
 def _front(problem, objectives, names, runs) -> Front:
-    sa, sb = (1.0 if q == "gamma_min" else -1.0 for q in names)  # both maximised after the sign
+    sa, sb = (1.0 if criteria.CRITERIA[q].maximise else -1.0 for q in names)  # both maximised after the sign
     pts, removed = [], []
     for eps, r in runs:
         if r.status not in SOLUTION_PRESENT:
@@ -153,7 +153,7 @@ def _dominates(a1, b1, a2, b2, tol=1e-9) -> bool:
 
 
 def _value(problem, quantity, r: Result) -> float:
-    return criteria.value(problem, quantity, r.mechanism)
+    return criteria.CRITERIA[quantity].value(problem, r.mechanism)
 
 
 def _free(problem, r: Result) -> dict:
@@ -163,19 +163,27 @@ def _free(problem, r: Result) -> dict:
 def _check(problem, objectives, n):
     if not isinstance(problem, Problem):
         raise ProblemError(f"pareto takes a qropt.Problem, got {type(problem).__name__}")
-    if isinstance(objectives, str) or not hasattr(objectives, "__len__") or len(objectives) != 2:
-        raise ProblemError(f"objectives is a pair of objective names from {OBJECTIVES}, got {objectives!r}")
+    names = objective_names()
+    if not isinstance(objectives, (tuple, list)) or len(objectives) != 2:
+        raise ProblemError(
+            f"objectives is a pair (a tuple or list) of objective names from {names}, got {objectives!r}"
+        )
     a, b = objectives
     for o in (a, b):
-        if o not in OBJECTIVES:
-            raise ProblemError(f"unknown objective {o!r}; objectives are {OBJECTIVES}")
-    if criteria.measured(a, problem.size) == criteria.measured(b, problem.size):
+        if not isinstance(o, str) or o not in names:
+            raise ProblemError(f"unknown objective {o!r}; objectives are {names}")
+    if criteria.of(a, problem.size) is criteria.of(b, problem.size):
         raise ProblemError(f"the two objectives must differ, got {a!r} twice")
-    if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= MAX_POINTS:
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 2 <= n <= MAX_POINTS:
         raise ProblemError(f"n is the number of front points, an integer in [2, {MAX_POINTS}]; got {n!r}")
     problem.replace(objective=a)  # the type supports both (a slider for the acceleration and velocity)
     problem.replace(objective=b)
     return a, b
 
 
-__all__ = ["Front", "pareto", "OBJECTIVES"]
+def objective_names() -> tuple:
+    """The objectives a front can trade (every registered criterion's)."""
+    return tuple(o for o in criteria.objectives() if o)
+
+
+__all__ = ["Front", "pareto", "objective_names"]

@@ -14,13 +14,16 @@ from scipy.optimize import brentq, minimize_scalar
 from qropt.errors import InvalidParameter, QroptError
 from qropt.kinematics.ops import NUMPY
 from qropt.mechanisms import FourBar, Mechanism
+from qropt.mechanisms.base import MAGNITUDE
+
+SPAN = 1000.0  # given bounds may span at most this many times the mechanism's largest other parameter
 
 
-def _rule_interval(m: Mechanism, free: str):
-    """The free parameter's interval where the type's rules hold (each rule is linear in one length)."""
-    lo, hi = 0.0, math.inf
+def _rule_interval(m: Mechanism, free: str, kind=None):
+    """The free parameter's interval where the type's rules hold (each rule is linear in one parameter): lengths
+    are positive, offsets (e, h) take either sign."""
+    lo, hi = (0.0 if free in m.LENGTHS else -math.inf), math.inf
     p = dict(m.params)
-    kind = "crank-rocker" if isinstance(m, FourBar) else None  # a bare four-bar: the class problems default to
     at0 = type(m).rules(NUMPY, {**p, free: 0.0}, kind)
     at1 = type(m).rules(NUMPY, {**p, free: 1.0}, kind)
     for r0, r1 in zip(at0, at1, strict=True):
@@ -72,6 +75,7 @@ class Reachable:
 
     def solutions(self, time_ratio: float) -> list[float]:
         """Every value of the free parameter giving this TR (roots refined by brentq)."""
+        time_ratio = _time_ratio(time_ratio)
         out = []
         ok = np.isfinite(self.tr)
         d = self.tr - time_ratio
@@ -112,7 +116,12 @@ class Reachable:
     def adjustable(self, tr_low: float, tr_high: float | None = None) -> Adjustable:
         """The shortest travel of the free link reaching every TR in [tr_low, tr_high] on one monotone branch,
         preferring the branch with the best worst-case gamma_min; alternatives are listed."""
-        tr_high = tr_low if tr_high is None else tr_high
+        tr_low = _time_ratio(tr_low, "tr_low")
+        tr_high = tr_low if tr_high is None else _time_ratio(tr_high, "tr_high")
+        if tr_low > tr_high:
+            raise InvalidParameter(
+                f"adjustable TR range {tr_low:g}..{tr_high:g} runs backwards: give the lower time ratio first"
+            )
         cands = []
         for a, b, ya, yb in self.branches():
             lo_tr, hi_tr = min(ya, yb), max(ya, yb)
@@ -134,6 +143,48 @@ class Reachable:
                 f"{c[0][0]:.6g}..{c[0][1]:.6g} (worst gamma_min {math.degrees(c[1]):.2f} deg)" for c in cands[1:]
             )
         return Adjustable((x0, x1), (tr_low, tr_high), g, why, [c[0] for c in cands[1:]])
+
+
+def _time_ratio(v, name="time ratio") -> float:
+    """A time ratio given to a Reachable: a finite number (InvalidParameter otherwise)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
+        raise InvalidParameter(f"{name} must be a finite number, got {v!r}")
+    return float(v)
+
+
+def _bounds(mechanism, free, bounds) -> tuple[float, float]:
+    """The scanned interval: the given bounds (within the type's own rules: outside them no value works), or the
+    rules' interval; InvalidParameter when it is empty, unbounded, beyond MAGNITUDE or too wide to scan."""
+    if bounds is None:
+        lo, hi = _rule_interval(mechanism, free, "crank-rocker" if isinstance(mechanism, FourBar) else None)
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            side = " and ".join(w for w, v in (("below", lo), ("above", hi)) if not math.isfinite(v))
+            raise InvalidParameter(f"give bounds for {free}: the type's rules do not bound it {side}")
+        if not lo < hi:
+            raise InvalidParameter(f"empty interval for {free}: ({lo:g}, {hi:g})")
+        return lo, hi
+    try:
+        lo, hi = (float(b) for b in bounds)
+    except (TypeError, ValueError):
+        raise InvalidParameter(f"bounds of {free} must be two numbers (low, high), got {bounds!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise InvalidParameter(f"empty interval for {free}: ({lo:g}, {hi:g})")
+    if max(abs(lo), abs(hi)) > MAGNITUDE:
+        raise InvalidParameter(f"bounds of {free} ({lo:g}, {hi:g}) are out of range: |bound| <= {MAGNITUDE:g}")
+    rlo, rhi = _rule_interval(mechanism, free)  # the rules every value must satisfy: nothing works outside
+    lo, hi = max(lo, rlo), min(hi, rhi)
+    if not lo < hi:
+        raise InvalidParameter(
+            f"no value of {free} in the bounds {bounds!r} satisfies {type(mechanism).__name__}'s rules "
+            f"(they leave {rlo:g}..{rhi:g})"
+        )
+    size = max((abs(v) for k, v in mechanism.params.items() if k != free and not k.startswith("sigma")), default=0)
+    if hi - lo > SPAN * size:
+        raise InvalidParameter(
+            f"bounds of {free} ({lo:g}, {hi:g}) span more than {SPAN:g} times the mechanism's largest other "
+            f"parameter ({size:g}): a scan that coarse steps over whole working intervals; give narrower bounds"
+        )
+    return lo, hi
 
 
 def _evaluate(base, free, x):
@@ -180,9 +231,10 @@ def reachable(mechanism: Mechanism, free: str = "r3", bounds: tuple | None = Non
               progress=None) -> Reachable:  # fmt: skip
     """TR and stroke reachable by varying ``free`` (the mechanism supplies the other parameters).
 
-    bounds: the parameter's interval; without it the interval the type's rules leave it (e.g. its Grashof
-    class); progress: callable() once per scanned point. TR extremes are refined (bounded Brent) and interval
-    ends located by bisection.
+    bounds: the parameter's interval (cut to where the type's rules hold: no value works outside; at most SPAN
+    times the mechanism's largest other parameter wide); without it the interval the type's rules leave it (e.g.
+    its Grashof class; offsets such as e and h take either sign); progress: callable() once per scanned point.
+    TR extremes are refined (bounded Brent) and interval ends located by bisection.
     """
     if not isinstance(mechanism, Mechanism):
         raise InvalidParameter(
@@ -192,16 +244,7 @@ def reachable(mechanism: Mechanism, free: str = "r3", bounds: tuple | None = Non
         raise InvalidParameter(f"{type(mechanism).__name__} has no continuous parameter {free!r}")
     if isinstance(n, bool) or not isinstance(n, int) or not 3 <= n <= 100_000:
         raise InvalidParameter(f"n (scan points) must be an integer in [3, 100000], got {n!r}")
-    if bounds is None:
-        bounds = _rule_interval(mechanism, free)
-        if not math.isfinite(bounds[1]):
-            raise InvalidParameter(f"give bounds for {free}: the type's rules do not bound it above")
-    try:
-        lo, hi = (float(b) for b in bounds)
-    except (TypeError, ValueError):
-        raise InvalidParameter(f"bounds of {free} must be two numbers (low, high), got {bounds!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-        raise InvalidParameter(f"empty interval for {free}: ({lo:g}, {hi:g})")
+    lo, hi = _bounds(mechanism, free, bounds)
     grid = np.linspace(lo, hi, n)
     tick = progress if callable(progress) else (lambda k=1: None)
     vals = np.array([(_evaluate(mechanism, free, x), tick())[0] for x in grid])

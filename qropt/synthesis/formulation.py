@@ -1,22 +1,23 @@
-"""Problem -> CasADi NLP for IPOPT, built once per problem structure.
+"""Problem structure -> CasADi NLP, built once and immutable; a problem's numbers travel with each solve.
 
-Decision variables: the free parameters, the dead-centre crank angles
-(theta_max, theta_min) and epigraph variables z. The dead centres are lifted:
-the output velocity vanishes there and its curvature has the right sign, so
-TR is the linear equality ``theta_min - theta_max = 2 pi TR / (TR + 1)`` (or
-``2 pi / (TR + 1)``, by orientation) and the stroke a difference of two
-positions. Continuous-cycle quantities (transmission cosines, rod assembly
-margins, accelerations, joint coordinates) enter through sample angles that
-are CasADi parameters, so an exchange loop can add angles without a rebuild;
-the four-bar joint's transmission extremes are exact at theta2 = 0 and pi.
-Fixed parameters and targets are CasADi parameters too.
+Decision variables (named blocks, see ``Point``): the free parameters, the dead-centre crank angles (theta_max,
+theta_min), the criteria's epigraph variables z, their lifted crank angles phi and the footprint's box sides psi.
+The dead centres are lifted: the output velocity vanishes there and its curvature has the right sign, so TR is
+the linear equality ``theta_min - theta_max = 2 pi TR / (TR + 1)`` (or ``2 pi / (TR + 1)``, by orientation) and
+the stroke a difference of two positions. Continuous-cycle quantities enter through sample angles that are CasADi
+parameters, so the exchange loop adds angles without a rebuild; a type's exact transmission hints
+(``EXACT_TRANSMISSION``) are evaluated where they are. Parameters (named blocks too): fixed values, targets, sample
+angles, working-arc fractions, bound values and the box sides' coordinate picks. Each criterion states its own
+terms (``qropt.synthesis.criteria``).
 """
 
 from __future__ import annotations
 
+import enum
 import functools
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import casadi
 import numpy as np
@@ -24,13 +25,93 @@ import numpy as np
 from qropt.errors import QroptError
 from qropt.kinematics.closures import RIGHT_ANGLE, transmission_cos
 from qropt.kinematics.ops import CASADI
-from qropt.mechanisms import FourBar, FourBarSlider
-from qropt.synthesis.criteria import BOUNDS, in_nlp_terms, measured
+from qropt.synthesis import criteria
+from qropt.synthesis.criteria import Role
 
 TWO_PI = 2.0 * math.pi
 BASE_SAMPLES = 8  # uniform sample angles of the epigraphs; the exchange loop adds what binds
-LIFTED = 2  # lifted acceleration extremes for min_peak_accel
 EXTRA_SAMPLES = 8  # slots for the exchange loop's angles
+BOX_SIDES = ("x_max", "-x_min", "y_max", "-y_min")  # the footprint's epigraph order (BoundingBox order differs)
+
+
+def slow_interval(time_ratio, orientation):
+    """theta_min - theta_max (rad): the slow interval if orientation = +1, else the fast one."""
+    return TWO_PI * (time_ratio if orientation > 0 else 1.0) / (time_ratio + 1.0)
+
+
+class RowKind(enum.Enum):
+    """What a constraint row states; residuals report every kind but EPIGRAPH and LIFT."""
+
+    DEAD_CENTRE = "dead centre"
+    TARGET = "target"
+    ORIENTATION = "orientation"
+    CONDITION = "condition"
+    LIFT = "lift"
+    EPIGRAPH = "epigraph"
+    ASSEMBLY = "assembly"
+    BOUND = "bound"
+
+
+INTERNAL = (RowKind.EPIGRAPH, RowKind.LIFT)  # rows of the formulation's own variables, not of the design
+
+
+@dataclass(frozen=True)
+class Row:
+    name: str
+    kind: RowKind
+    expr: object
+    lb: float
+    ub: float
+
+
+class Kin(NamedTuple):
+    """The kinematic function's outputs at one crank angle (derivatives in theta2, i.e. at omega2 = 1): output x and
+    its first three derivatives (v, a, j), the transmission cosines of the exact-hint joints then the sampled
+    ones (cos, dcos), the assembly margins, and every joint's coordinates (coords, dcoords)."""
+
+    x: object
+    v: object
+    a: object
+    j: object
+    cos: object
+    dcos: object
+    margins: object
+    coords: object
+    dcoords: object
+
+
+class Blocks:
+    """Named contiguous blocks of a vector: ``split`` a vector into them, ``join`` them into one."""
+
+    def __init__(self, **sizes: int):
+        self.sizes, self.slices, at = dict(sizes), {}, 0
+        for k, n in sizes.items():
+            self.slices[k] = slice(at, at + n)
+            at += n
+        self.size = at
+
+    def split(self, vec) -> dict:
+        vec = np.asarray(vec, float).ravel()
+        return {k: vec[s] for k, s in self.slices.items()}
+
+    def join(self, **parts) -> np.ndarray:
+        out = np.zeros(self.size)
+        for k, v in parts.items():
+            out[self.slices[k]] = v
+        return out
+
+
+class Point(NamedTuple):
+    """A point of the NLP: free parameter values (dict), the dead centres (theta_max, theta_min), epigraph
+    values z, lifted angles phi and box-side angles psi (arrays)."""
+
+    values: dict
+    theta: np.ndarray
+    z: np.ndarray
+    phi: np.ndarray
+    psi: np.ndarray
+
+
 IPOPT = {
     "ipopt.print_level": 0,
     "ipopt.sb": "yes",
@@ -45,332 +126,263 @@ IPOPT = {
     "calc_lam_p": False,
 }
 
-WARM = {"ipopt.bound_push": 1e-8, "ipopt.bound_frac": 1e-8}
-
-
-def slow_interval(time_ratio, orientation):
-    """theta_min - theta_max (rad): the slow interval if orientation = +1, else the fast one."""
-    return TWO_PI * (time_ratio if orientation > 0 else 1.0) / (time_ratio + 1.0)
-
-
-@dataclass
-class Row:
-    name: str
-    expr: object
-    lb: float
-    ub: float
-
 
 class Formulation:
-    """The NLP of one problem structure: branch signs, orientation and (optionally) a target to range.
+    """The NLP of one problem structure (type, free/fixed/target names, conditions' structure, objective, size,
+    accel_over, branch signs, TR orientation; optionally a target to range). Nothing of a problem's numbers is
+    kept: bounds, fixed values, targets and bound values are passed to each call that needs them.
 
-    ``range_target``: drop that target's equality and make its value the objective (``sense`` +1
-    minimises, -1 maximises); used for reachable ranges.
+    ``range_target``: drop that target's equality and make its value the objective (``sense`` +1 minimises, -1
+    maximises); used for reachable ranges.
     """
 
-    def __init__(self, problem, branch: dict, orientation: int, range_target: str | None = None, sense: int = 1,
-                 base_samples: int = BASE_SAMPLES, extra_samples: int = EXTRA_SAMPLES,
-                 ipopt: dict | None = None):  # fmt: skip
-        self.problem, self.branch, self.orientation = problem, dict(branch), orientation
-        self.range_target, self.sense = range_target, sense
-        cls = problem.mechanism
+    def __init__(
+        self,
+        problem,
+        branch: dict,
+        orientation: int,
+        range_target: str | None = None,
+        sense: int = 1,
+        base_samples: int = BASE_SAMPLES,
+        extra_samples: int = EXTRA_SAMPLES,
+    ):
+        cls = self.mechanism = problem.mechanism
+        self.branch, self.orientation = dict(branch), orientation
+        self.range_target, self.sense, self.accel_over = range_target, sense, problem.accel_over
         self.free, self.fixed = list(problem.free), list(problem.fixed)
         self.targets = [k for k in problem.targets if k != range_target]
+        self.lengths = [k for k in cls.LENGTHS if k in problem.free or k in problem.fixed]
         self.n_base, self.n_extra = base_samples, extra_samples
-        self.n_samples = base_samples + extra_samples
-        X = casadi.SX.sym("x", len(self.free))
-        TH = casadi.SX.sym("th", 2)
-        PF = casadi.SX.sym("pf", len(self.fixed))
-        PT = casadi.SX.sym("pt", len(self.targets))
-        S = casadi.SX.sym("s", self.n_samples)
-        W = casadi.SX.sym("w", self.n_samples)  # fractions of the working arc
-        self._W = W
-        params = {k: X[i] for i, k in enumerate(self.free)}
-        params.update({k: PF[i] for i, k in enumerate(self.fixed)})
-        params.update(self.branch)
-        t = casadi.SX.sym("t")
-        lp = cls.loop(CASADI, t, params)
-        four_bar = issubclass(cls, (FourBar, FourBarSlider))
-        exact_joints = ["B"] if four_bar else []
-        self.sampled_joints = [j for j, v in lp.transmission.items() if v is not RIGHT_ANGLE and j not in exact_joints]
-        self.exact_joints = exact_joints
-        margins = [m for what, m in lp.margins if not (four_bar and "four-bar" in what)]
-        dx = casadi.jacobian(lp.x, t)
-        ddx = casadi.jacobian(dx, t)
-        dddx = casadi.jacobian(ddx, t)
-        cos_all = [transmission_cos(CASADI, lp.transmission[j]) for j in self.exact_joints + self.sampled_joints]
-        coords = [c for pt in lp.points.values() for c in pt]
-        kin = casadi.Function(
-            "kin",
-            [t, X, PF],
-            [lp.x, dx, ddx, casadi.vertcat(*cos_all, 0), casadi.vertcat(*margins, 0), casadi.vertcat(*coords), dddx,
-             casadi.jacobian(casadi.vertcat(*cos_all, 0), t), casadi.jacobian(casadi.vertcat(*coords), t)],
-        )  # fmt: skip
-        self.n_coords = len(coords)
-        moving = [i for i, c in enumerate(coords) if casadi.depends_on(casadi.SX(c), t)]
+        self.n_samples = n = base_samples + extra_samples
+        self.objective = None if range_target else criteria.of_problem(problem)
+        self.bound_keys = [k for k in criteria.bounds() if k in problem.conditions]
+        used = ([self.objective] if self.objective else []) + [criteria.bounds()[k] for k in self.bound_keys]
+        self.box = any(isinstance(c, criteria.Footprint) for c in used)
+        self.rows: list[Row] = []
+
+        X, TH = casadi.SX.sym("x", len(self.free)), casadi.SX.sym("th", 2)
+        PF, PT = casadi.SX.sym("pf", len(self.fixed)), casadi.SX.sym("pt", len(self.targets))
+        S, W = casadi.SX.sym("s", n), casadi.SX.sym("w", n)  # sample angles; fractions of the working arc
+        params = {k: X[i] for i, k in enumerate(self.free)} | {k: PF[i] for i, k in enumerate(self.fixed)}
+        self.params = params | self.branch
+        self._kinematics(X, PF)
+        self.dead = [self.at(TH[0]), self.at(TH[1])]  # the output's extremes
+        self.sampled = [self.at(S[k]) for k in range(n)]
+        self.exact = [self.at(a) for a in sorted({a for v in cls.EXACT_TRANSMISSION.values() for a in v})]
+        self._start = TH[0] if orientation > 0 else TH[1]
+        self._length = (TH[1] - TH[0]) if orientation > 0 else TWO_PI - (TH[1] - TH[0])
+        self._W, self._working = W, None
+        travel, span = self._core_rows(TH, PT)
+        self._condition_rows(problem)
+
+        # the criteria: the objective's epigraph group first, then each bound's (each criterion's group once)
+        self.z_names, self._z_of, epi = [], {}, []
+        for c in used:
+            if c.name not in self._z_of:
+                groups = c.epigraph(self)
+                self._z_of[c.name] = list(range(len(self.z_names), len(self.z_names) + len(groups)))
+                for name, exprs in groups:
+                    epi += [(len(self.z_names), e) for e in exprs]
+                    self.z_names.append(name)
+        Z = casadi.SX.sym("z", len(self.z_names))
+        # lifted extremes, like the dead centres: crank angles of a criterion's worst values that move with the design
+        # faster than samples follow them (each criterion says how many, and their rows)
+        self.lifts = []
+        for c in used:
+            role = Role.OBJECTIVE if c is self.objective else Role.BOUND
+            if not any(l0 is c for l0, _ in self.lifts):
+                self.lifts += [(c, k) for k in range(c.lifts(self, role))]
+        PHI = casadi.SX.sym("phi", len(self.lifts))
+        for i, (c, k) in enumerate(self.lifts):
+            exprs = c.lift_terms(self, k, PHI[i], self.at(PHI[i]))
+            epi += [(self._z_of[c.name][0], e) for e in exprs]
+        # the footprint's box: each side lifted at the extreme of the coordinate that reaches it (parameters SEL pick
+        # that coordinate, one-hot per side, from the last exact box), like the dead centres
+        n_box = 4 if self.box else 0
+        PSI, SEL = casadi.SX.sym("psi", n_box), casadi.SX.sym("sel", n_box * self.n_coords)
+        for s in range(n_box):
+            out, pick = self.at(PSI[s]), SEL[s * self.n_coords : (s + 1) * self.n_coords]
+            zi = self._z_of["footprint"][s]
+            self.row(
+                f"lifted box side {self.z_names[zi]}: stationary", casadi.dot(pick, out.dcoords), 0.0, 0.0, RowKind.LIFT
+            )
+            epi.append((zi, (1 if s % 2 == 0 else -1) * casadi.dot(pick, out.coords)))
+        for zi, e in epi:
+            self.row(f"epigraph {self.z_names[zi]}", e - Z[zi], -casadi.inf, 0.0, RowKind.EPIGRAPH)
+        for k in range(n):
+            for m in range(self.n_margins):
+                self.row(f"rod assembly at sample {k}", self.sampled[k].margins[m], 0.0, casadi.inf, RowKind.ASSEMBLY)
+        PB = casadi.SX.sym("pb", len(self.bound_keys))
+        for i, key in enumerate(self.bound_keys):
+            c = criteria.bounds()[key]
+            self.row(f"{key} bound", self._measure(c, Z) - PB[i], -casadi.inf, 0.0, RowKind.BOUND)
+        f = self._objective(Z, travel, span)
+
+        self.w_blocks = Blocks(free=len(self.free), theta=2, z=len(self.z_names), phi=len(self.lifts), psi=n_box)
+        self.p_blocks = Blocks(
+            fixed=len(self.fixed),
+            targets=len(self.targets),
+            samples=n,
+            fractions=n,
+            bounds=len(self.bound_keys),
+            select=n_box * self.n_coords,
+        )
+        self.w_sym, self.p_sym = casadi.vertcat(X, TH, Z, PHI, PSI), casadi.vertcat(PF, PT, S, W, PB, SEL)
+        self.g_sym, self.f_sym = casadi.vertcat(*[r.expr for r in self.rows]), f
+        self.design_sym = casadi.vertcat(X, TH)  # the free parameters and the dead centres
+        self.design = slice(0, self.w_blocks.slices["theta"].stop)  # where design_sym sits in w
+        self.nlp = {"x": self.w_sym, "p": self.p_sym, "f": f, "g": self.g_sym}
+        self.epi_fun = casadi.Function("epi", [self.w_sym, self.p_sym], [casadi.vertcat(*[e for _, e in epi], 0)])
+        self.epi_index = np.array([zi for zi, _ in epi], int)
+        self.lbg = np.array([r.lb for r in self.rows], float)
+        self.ubg = np.array([r.ub for r in self.rows], float)
+        self.nx, self.nz, self.n_lift, self.n_box = len(self.free), len(self.z_names), len(self.lifts), n_box
+        del self.params, self.dead, self.sampled, self.exact, self._working  # symbols of the build only
+
+    # ---- the build -----------------------------------------------------------------------------------
+    def _kinematics(self, X, PF):
+        """The type's loop as one CasADi function of (theta2, free, fixed) with named outputs (``Kin``)."""
+        cls, t = self.mechanism, casadi.SX.sym("t")
+        lp = cls.loop(CASADI, t, self.params)
+        self.exact_joints = [j for j in cls.EXACT_TRANSMISSION if lp.transmission.get(j) is not RIGHT_ANGLE]
+        self.sampled_joints = [
+            j for j, v in lp.transmission.items() if v is not RIGHT_ANGLE and j not in self.exact_joints
+        ]
+        margins = [m for what, m in lp.margins if what not in cls.RULED_MARGINS]
+        self.n_margins = len(margins)
+        v = casadi.jacobian(lp.x, t)
+        a = casadi.jacobian(v, t)
+        cos = casadi.vertcat(
+            *[transmission_cos(CASADI, lp.transmission[j]) for j in self.exact_joints + self.sampled_joints], 0
+        )
+        coords = casadi.vertcat(*[c for pt in lp.points.values() for c in pt])
+        outs = [
+            lp.x,
+            v,
+            a,
+            casadi.jacobian(a, t),
+            cos,
+            casadi.jacobian(cos, t),
+            casadi.vertcat(*margins, 0),
+            coords,
+            casadi.jacobian(coords, t),
+        ]
+        kin = casadi.Function("kin", [t, X, PF], outs, ["theta2", "free", "fixed"], list(Kin._fields))
+        self.n_coords = coords.shape[0]
+        moving = [i for i in range(self.n_coords) if casadi.depends_on(casadi.SX(coords[i]), t)]
         # a box side's default coordinate (before a design names the one that reaches it): the first moving x, y
         self._default_coord = [next((i for i in moving if i % 2 == a), moving[0]) for a in (0, 0, 1, 1)]
-        n_exact = len(self.exact_joints)
+        self.at = lambda theta: Kin(*kin(theta, X, PF))
 
-        def at(theta):
-            return kin(theta, X, PF)
+    def row(self, name, expr, lb, ub, kind=RowKind.CONDITION) -> Row:
+        """Add a constraint row lb <= expr <= ub (kind: a RowKind or its value)."""
+        r = Row(name, RowKind(kind), expr, lb, ub)
+        self.rows.append(r)
+        return r
 
-        self._dead = [at(TH[0]), at(TH[1])]  # the output's extremes: two sides of the path's box, exactly
-        x_max, v_max, a_max, *_ = self._dead[0]
-        x_min, v_min, a_min, *_ = self._dead[1]
+    def working(self) -> list[Kin]:
+        """The outputs at the working-arc fractions (the working stroke's samples)."""
+        if self._working is None:
+            self._working = [self.at(self._start + self._W[k] * self._length) for k in range(self.n_samples)]
+        return self._working
+
+    def in_working(self, phi):
+        """A lifted angle's place in the working stroke (0..1 inside it)."""
+        return (phi - self._start) / self._length
+
+    def _core_rows(self, TH, PT):
+        (x_max, v_max, a_max, *_), (x_min, v_min, a_min, *_) = self.dead
+        self.row("dead centre theta_max: output velocity", v_max, 0.0, 0.0, RowKind.DEAD_CENTRE)
+        self.row("dead centre theta_min: output velocity", v_min, 0.0, 0.0, RowKind.DEAD_CENTRE)
+        self.row("dead centre theta_max: a maximum", a_max, -casadi.inf, 0.0, RowKind.DEAD_CENTRE)
+        self.row("dead centre theta_min: a minimum", a_min, 0.0, casadi.inf, RowKind.DEAD_CENTRE)
         span = TH[1] - TH[0]
-        rows = [
-            Row("dead centre theta_max: output velocity", v_max, 0.0, 0.0),
-            Row("dead centre theta_min: output velocity", v_min, 0.0, 0.0),
-            Row("dead centre theta_max: a maximum", a_max, -casadi.inf, 0.0),
-            Row("dead centre theta_min: a minimum", a_min, 0.0, casadi.inf),
-        ]
         tgt = {k: PT[i] for i, k in enumerate(self.targets)}
         if "time_ratio" in tgt:
-            rows.append(Row("time_ratio", span - slow_interval(tgt["time_ratio"], orientation), 0.0, 0.0))
-        elif orientation > 0:
-            rows.append(Row("time_ratio orientation", span, math.pi, TWO_PI))
+            self.row("time_ratio", span - slow_interval(tgt["time_ratio"], self.orientation), 0.0, 0.0, RowKind.TARGET)
+        elif self.orientation > 0:
+            self.row("time_ratio orientation", span, math.pi, TWO_PI, RowKind.ORIENTATION)
         else:
-            rows.append(Row("time_ratio orientation", span, 0.0, math.pi))
+            self.row("time_ratio orientation", span, 0.0, math.pi, RowKind.ORIENTATION)
         travel = x_max - x_min
         for k in ("stroke", "swing"):
             if k in tgt:
-                rows.append(Row(k, travel - tgt[k], 0.0, 0.0))
-        rows += self._conditions(params, problem)
-        # sample angles: absolute, or fractions of the working arc (working-stroke acceleration, velocity)
-        start = TH[0] if orientation > 0 else TH[1]
-        length = span if orientation > 0 else TWO_PI - span
-        self._sampled = [at(S[k]) for k in range(self.n_samples)]
-        self._exact = [at(a) for a in (0.0, math.pi)]
-        self._working = None
-        self._at, self._start, self._length, self._n_exact, self._params = at, start, length, n_exact, params
-        # criteria: the objective's epigraph group first (z[0]...), then those of the bound conditions
-        self.z_names, self._groups, epi = [], {}, []
-        obj = None if range_target else problem.objective
-        if obj:
-            self._group(measured(obj, problem.size), epi)
-        self.bounds_used = [k for k in BOUNDS if k in problem.conditions]
-        for k in self.bounds_used:
-            self._group(BOUNDS[k][0], epi)
-        Z = casadi.SX.sym("z", len(self.z_names))
-        # lifted extremes, like the dead centres: peak acceleration's largest (d3x/dtheta3 = 0 there) for its objective
-        # or bound, the working stroke's peak speeds (d2x/dtheta2 = 0) for theirs, and under a gamma_min bound each
-        # sampled joint's worst transmission (d cos/dtheta2 = 0): their crank angles move with the design faster
-        # than samples follow them
-        self.lifts = []
-        if "peak_accel" in self._groups:  # a four-bar-driven slider's acceleration has more extremes of note
-            self.lifts += [("accel", None)] * (2 * LIFTED if issubclass(cls, FourBarSlider) else LIFTED)
-        if obj == "min_peak_velocity":  # the objective only: as a bound, lifted speeds stall some footprint solves
-            self.lifts += [("velocity", None)] * LIFTED
-        if "gamma_min" in self.bounds_used:
-            self.lifts += [("gamma", joint) for joint in self.sampled_joints for _ in range(LIFTED)]
-        self.n_lift = len(self.lifts)
-        PHI = casadi.SX.sym("phi", self.n_lift)
-        for k, (kind, joint) in enumerate(self.lifts):
-            out = at(PHI[k])
-            if kind == "gamma":
-                j = n_exact + self.sampled_joints.index(joint)
-                rows.append(Row("lifted transmission extreme: stationary", out[7][j], 0.0, 0.0))
-                i0 = self._groups["gamma_min"]
-                epi += [(i0, out[3][j]), (i0, -out[3][j])]
-                continue
-            if kind == "velocity":  # the working stroke's largest speeds (d2x/dtheta2 = 0 there)
-                rows.append(Row("lifted velocity extreme: stationary", out[2], 0.0, 0.0))
-                rows.append(Row("lifted velocity extreme: in the working stroke", (PHI[k] - start) / length, 0, 1))
-                i0 = self._groups["peak_velocity"]
-                epi += [(i0, out[1]), (i0, -out[1])]
-                continue
-            rows.append(Row("lifted acceleration extreme: stationary", out[6], 0.0, 0.0))
-            i0 = self._groups["peak_accel"]
-            epi += [(i0, out[2]), (i0, -out[2])]
-            if problem.accel_over == "working":
-                rows.append(Row("lifted acceleration extreme: in the working stroke", (PHI[k] - start) / length, 0, 1))
-        # the footprint's box: each side lifted at the extreme of the coordinate that reaches it (parameters SEL pick
-        # that coordinate, one-hot per side, from the last exact box), like the dead centres
-        self.n_box = 4 if "box" in self._groups else 0
-        PSI = casadi.SX.sym("psi", self.n_box)
-        SEL = casadi.SX.sym("sel", self.n_box * self.n_coords)
-        for s in range(self.n_box):
-            out, pick = at(PSI[s]), SEL[s * self.n_coords : (s + 1) * self.n_coords]
-            rows.append(Row(f"lifted box side {self.z_names[self._groups['box'] + s]}: stationary",
-                            casadi.dot(pick, out[8]), 0.0, 0.0))  # fmt: skip
-            epi.append((self._groups["box"] + s, (1 if s % 2 == 0 else -1) * casadi.dot(pick, out[5])))
-        for zi, e in epi:
-            rows.append(Row(f"epigraph {self.z_names[zi]}", e - Z[zi], -casadi.inf, 0.0))
-        for k in range(self.n_samples):
-            for m in range(len(margins)):
-                rows.append(Row(f"rod assembly at sample {k}", self._sampled[k][4][m], 0.0, casadi.inf))
-        PB = casadi.SX.sym("pb", len(self.bounds_used))
-        for i, k in enumerate(self.bounds_used):
-            rows.append(Row(f"{k} bound", self._measure(BOUNDS[k][0], Z) - PB[i], -casadi.inf, 0.0))
-        f = self._objective_value(problem, Z, travel, span)
-        self.rows = rows
-        w = casadi.vertcat(X, TH, Z, PHI, PSI)
-        p = casadi.vertcat(PF, PT, S, W, PB, SEL)
-        g = casadi.vertcat(*[r.expr for r in rows])
-        self.w_sym, self.p_sym, self.g_sym = w, p, g
-        self._nlp, self._ipopt = {"x": w, "p": p, "f": f, "g": g}, {**IPOPT, **(ipopt or {})}
-        self.solver = casadi.nlpsol("qropt", "ipopt", self._nlp, self._ipopt)
-        self._f = f
-        self.epi_fun = casadi.Function("epi", [w, p], [casadi.vertcat(*[e for _, e in epi], 0)])
-        self.epi_index = np.array([zi for zi, _ in epi], int)
-        self.lbg = np.array([r.lb for r in rows], float)
-        self.ubg = np.array([r.ub for r in rows], float)
-        self.nx, self.nz = len(self.free), len(self.z_names)
+                self.row(k, travel - tgt[k], 0.0, 0.0, RowKind.TARGET)
+        return travel, span
 
-    @functools.cached_property
-    def functions(self):
-        """The same NLP as plain functions (f, g, df, dg) with exact derivatives, for other solvers."""
-        w, p, f, g = self.w_sym, self.p_sym, self._f, self.g_sym
-        return casadi.Function(
-            "fg", [w, p], [f, g, casadi.gradient(f, w), casadi.jacobian(g, w)], ["w", "p"], ["f", "g", "df", "dg"]
-        )
-
-    # ---- pieces --------------------------------------------------------------
-    @staticmethod
-    def _conditions(params, problem):
-        cls, c = problem.mechanism, problem.conditions
-        rows = [Row(r.name, r.value, 0.0, casadi.inf) for r in cls.rules(CASADI, params, c.get("grashof"))]
+    def _condition_rows(self, problem):
+        p, c = self.params, problem.conditions
+        for r in self.mechanism.rules(CASADI, p, c.get("grashof")):
+            self.row(r.name, r.value, 0.0, casadi.inf)
         for coeffs, lo, hi in c.get("linear", ()):
-            e = sum(v * params[k] for k, v in coeffs.items())
-            rows.append(Row(f"linear {dict(coeffs)}", e, lo, hi))
+            self.row(f"linear {dict(coeffs)}", sum(v * p[k] for k, v in coeffs.items()), lo, hi)
         for num, den, lo, hi in c.get("ratio", ()):
-            rows.append(Row(f"ratio {num}/{den} >= {lo:g}", params[num] - lo * params[den], 0.0, casadi.inf))
-            rows.append(Row(f"ratio {num}/{den} <= {hi:g}", params[num] - hi * params[den], -casadi.inf, 0.0))
-        return rows
+            self.row(f"ratio {num}/{den} >= {lo:g}", p[num] - lo * p[den], 0.0, casadi.inf)
+            self.row(f"ratio {num}/{den} <= {hi:g}", p[num] - hi * p[den], -casadi.inf, 0.0)
 
-    def _group(self, quantity, epi):
-        """The epigraph variables of one criterion (created once): z >= each sampled |value|."""
-        kind = {"sum": None, "footprint": "box"}.get(quantity, quantity)
-        if kind is None or kind in self._groups:
-            return
-        i0 = self._groups[kind] = len(self.z_names)
-        n_exact, sampled, exact = self._n_exact, self._sampled, self._exact
-        if kind == "gamma_min":
-            self.z_names.append("max |cos gamma|")
-            if not n_exact and not self.sampled_joints:  # every joint at a right angle (cos 0)
-                epi.append((i0, casadi.SX(0)))
-            for out in exact:
-                epi += [e for j in range(n_exact) for e in ((i0, out[3][j]), (i0, -out[3][j]))]
-            for out in sampled:
-                epi += [e for j in range(len(self.sampled_joints))
-                        for e in ((i0, out[3][n_exact + j]), (i0, -out[3][n_exact + j]))]  # fmt: skip
-        elif kind == "peak_accel":
-            self.z_names.append("peak |d2x/dtheta2|")
-            outs = self._working_outs() if self.problem.accel_over == "working" else sampled
-            epi += [e for out in outs for e in ((i0, out[2]), (i0, -out[2]))]
-        elif kind == "peak_velocity":
-            self.z_names.append("peak working |dx/dtheta2|")
-            epi += [e for out in self._working_outs() for e in ((i0, out[1]), (i0, -out[1]))]
-        elif kind == "longest":
-            self.z_names.append("longest link")
-            epi += [(i0, self._params[k]) for k in self.problem.mechanism.LENGTHS if k in self._params]
-        else:  # the bounding box of every joint's path
-            self.z_names += ["x_max", "-x_min", "y_max", "-y_min"]
-            for out in sampled + exact + self._dead:
-                xy = out[5]
-                for i in range(xy.shape[0] // 2):
-                    epi += [(i0, xy[2 * i]), (i0 + 1, -xy[2 * i]), (i0 + 2, xy[2 * i + 1]), (i0 + 3, -xy[2 * i + 1])]
+    def _measure(self, c, Z):
+        return c.measure(self, [Z[i] for i in self._z_of.get(c.name, [])])
 
-    def _working_outs(self):
-        if self._working is None:
-            self._working = [self._at(self._start + self._W[k] * self._length) for k in range(self.n_samples)]
-        return self._working
-
-    def _measure(self, quantity, Z):
-        """A criterion in the NLP's terms: cos gamma_min, size, |d2x/dtheta2|, |dx/dtheta2| (omega2 = 1)."""
-        if quantity == "sum":
-            return sum(self._params[k] for k in self.problem.mechanism.LENGTHS if k in self._params)
-        if quantity == "footprint":
-            i = self._groups["box"]
-            return (Z[i] + Z[i + 1]) * (Z[i + 2] + Z[i + 3])
-        return Z[self._groups[quantity]]
-
-    def _objective_value(self, problem, Z, travel, span):
+    def _objective(self, Z, travel, span):
         if self.range_target == "time_ratio":
             tr = span / (TWO_PI - span) if self.orientation > 0 else (TWO_PI - span) / span
             return self.sense * tr
         if self.range_target in ("stroke", "swing"):
             return self.sense * travel
-        if problem.objective:
-            return self._measure(measured(problem.objective, problem.size), Z)
-        return casadi.SX(0)
+        return self._measure(self.objective, Z) if self.objective else casadi.SX(0)
 
-    def bound_values(self, problem=None) -> np.ndarray:
-        """The bound conditions' values in the NLP's terms (cos of the gamma_min bound; accelerations and
-        velocities per omega2^2 and |omega2|)."""
-        problem = problem or self.problem
-        return np.array([in_nlp_terms(BOUNDS[k][0], problem.conditions[k], problem.omega2) for k in self.bounds_used],
-                        float)  # fmt: skip
+    # ---- points ---------------------------------------------------------------------------------------
+    def unpack(self, w) -> Point:
+        """The named blocks of an NLP point."""
+        b = self.w_blocks.split(w)
+        return Point(dict(zip(self.free, b["free"].tolist(), strict=True)), b["theta"], b["z"], b["phi"], b["psi"])
 
-    # ---- numbers -------------------------------------------------------------
-    def base_samples(self):
-        """(angles, working-arc fractions): uniform in the base slots; the extra slots repeat the first."""
-        angles = TWO_PI * np.arange(self.n_base) / self.n_base
-        fractions = np.linspace(0.0, 1.0, self.n_base)
-        pad = np.zeros(self.n_extra)
-        return np.concatenate([angles, pad]), np.concatenate([fractions, pad])
-
-    def pack(self, values: dict, th, z=None, phi=None, box=None):
-        """w from parameter values, dead-centre angles, epigraph values and the lifted angles: ``phi`` (peak
-        acceleration or transmission) and ``box`` (the sides' angles in BoundingBox order)."""
-        x = [values[k] for k in self.free] + list(th) + list(z if z is not None else np.zeros(self.nz))
+    def pack(self, values: dict, theta, z=None, phi=None, box=None) -> np.ndarray:
+        """w from free values, dead-centre angles, epigraph values and the lifted angles: ``phi`` (the criteria's
+        lifted extremes, spread over the turn where missing) and ``box`` (a BoundingBox, for the sides' angles)."""
         phi = list(phi if phi is not None else np.linspace(0.0, math.pi, self.n_lift))[: self.n_lift]
         phi += [0.0] * (self.n_lift - len(phi))
-        return np.array(x + phi + self.box_angles(box), float)
+        return self.w_blocks.join(
+            free=[values[k] for k in self.free],
+            theta=list(theta),
+            z=np.zeros(self.nz) if z is None else z,
+            phi=phi,
+            psi=self.box_angles(box),
+        )
 
-    def lifted_start(self, values: dict, build=None) -> tuple:
+    def with_box(self, w, box) -> np.ndarray:
+        """w with its box sides moved to a BoundingBox's angles."""
+        b = self.w_blocks.split(w)
+        b["psi"] = self.box_angles(box)
+        return self.w_blocks.join(**b)
+
+    def lifted_start(self, problem, values: dict, build=None) -> tuple:
         """(phi, box): the lifted angles' start at the design with free parameters ``values`` on this branch
-        (built by ``build(problem, values, branch)``, default ``Problem.build``; None where it does not build or
-        turn): its largest |d2x/dtheta2| (in the working stroke when asked), its working stroke's largest speeds
-        and each sampled joint's smallest transmission angles, spread over the turn where it has too few; and
-        its bounding box (the lifted sides' angles and coordinates)."""
+        (built by ``build(problem, values, branch)``, default ``Problem.build``; (None, None) where it does not
+        build or turn): each lifting criterion's worst angles, and the design's bounding box."""
         if not (self.n_lift or self.n_box):
             return None, None
         try:
-            m = (build or type(self.problem).build)(self.problem, values, self.branch)
+            m = (build or type(problem).build)(problem, values, self.branch)
             box = m.bounding_box() if self.n_box else None
-            if not self.n_lift:
-                return None, box
-            kinds = dict.fromkeys(self.lifts)
-            minima = m.transmission_minima_by_joint() if any(k == "gamma" for k, _ in kinds) else {}
             phi = []
-            for kind, joint in kinds:
-                if kind == "accel":
-                    worst = self._largest(m, m.acceleration_extremes(), self.problem.accel_over == "working")
-                elif kind == "velocity":
-                    worst = self._largest(m, m.velocity_extremes(), True)
-                else:
-                    t, v = minima.get(joint, (np.zeros(0), np.zeros(0)))
-                    worst = [float(a) for a, _ in sorted(zip(t.tolist(), v.tolist(), strict=True), key=lambda q: q[1])]
-                n = self.lifts.count((kind, joint))
-                phi += (worst + [float(a) for a in np.linspace(0.0, math.pi, n)])[:n]
-            return phi, box
+            for c in dict.fromkeys(c for c, _ in self.lifts):
+                n = sum(1 for c2, _ in self.lifts if c2 is c)
+                phi += (c.lift_start(self, problem, m, n) + [float(a) for a in np.linspace(0.0, math.pi, n)])[:n]
+            return (phi or None), box
         except QroptError:
             return None, None
 
-    @staticmethod
-    def _largest(m, extremes, working: bool) -> list:
-        """Crank angles of extremes (maxima, minima), largest magnitude first; only the working stroke's,
-        measured from its start (inside its lifted interval), if ``working``."""
-        ts = np.concatenate([extremes.maxima[0], extremes.minima[0]])
-        vs = np.concatenate([extremes.maxima[1], extremes.minima[1]])
-        order = np.argsort(-np.abs(vs))
-        if not working:
-            return [float(ts[i]) for i in order]
-        lo, length = m.working_arc()
-        return [lo + (ts[i] - lo) % TWO_PI for i in order if (ts[i] - lo) % TWO_PI <= length]
-
     def box_angles(self, box=None) -> list:
-        """The lifted box sides' angles (z order: x_max, -x_min, y_max, -y_min) from a BoundingBox's angles."""
+        """The lifted box sides' angles (BOX_SIDES order) from a BoundingBox's angles."""
         if not self.n_box:
             return []
         if box is None:
             return [0.0, math.pi, 0.5 * math.pi, -0.5 * math.pi]
         return [box.angles[i] for i in (1, 0, 3, 2)]
 
-    def box_select(self, box=None) -> np.ndarray:
-        """SEL: per side (z order), one-hot over the loop's coordinates: the one that reaches it in ``box``."""
+    def _box_select(self, box=None) -> np.ndarray:
+        """Per side, one-hot over the loop's coordinates: the one that reaches it in ``box``."""
         if not self.n_box:
             return np.zeros(0)
         which = [box.coords[i] for i in (1, 0, 3, 2)] if box is not None and box.coords else self._default_coord
@@ -378,82 +390,105 @@ class Formulation:
         sel[np.arange(4), which] = 1.0
         return sel.ravel()
 
-    def param_vector(self, targets: dict, samples, fractions, fixed=None, box=None):
-        """p: fixed values, targets, sample angles and working-arc fractions, bound values and the box sides'
-        coordinates (from ``box``, a BoundingBox of the design the solve is at)."""
-        fixed = self.problem.fixed if fixed is None else fixed
-        pf = [fixed[k] for k in self.fixed]
-        pt = [targets[k] for k in self.targets]
-        return np.concatenate([pf, pt, samples, fractions, self.bound_values(), self.box_select(box)]).astype(float)
+    def base_samples(self):
+        """(angles, working-arc fractions): uniform in the base slots; the extra slots repeat the first."""
+        angles = TWO_PI * np.arange(self.n_base) / self.n_base
+        fractions = np.linspace(0.0, 1.0, self.n_base)
+        pad = np.zeros(self.n_extra)
+        return np.concatenate([angles, pad]), np.concatenate([fractions, pad])
+
+    def param_vector(self, problem, targets: dict, samples, fractions, box=None) -> np.ndarray:
+        """p from the problem's fixed values and bound values (in the NLP's terms), the targets, the sample angles
+        and working-arc fractions, and the box sides' coordinates (from ``box``, a BoundingBox of the design the
+        solve is at)."""
+        bounds = [criteria.bounds()[k].to_nlp(problem.conditions[k], problem.omega2) for k in self.bound_keys]
+        return self.p_blocks.join(
+            fixed=[problem.fixed[k] for k in self.fixed],
+            targets=[targets[k] for k in self.targets],
+            samples=samples,
+            fractions=fractions,
+            bounds=bounds,
+            select=self._box_select(box),
+        )
 
     def epigraph_start(self, w0, p):
-        """z values that make every epigraph row feasible at w0."""
+        """w0 with z values that make every epigraph row feasible."""
         if not self.nz:
             return w0
         e = np.array(self.epi_fun(w0, p)).ravel()[: self.epi_index.size]
         z = np.full(self.nz, -np.inf)
         np.fmax.at(z, self.epi_index, e)
         z = np.where(np.isfinite(z), z, 0.0)
-        w = w0.copy()
-        w[self.nx + 2 : self.nx + 2 + self.nz] = z + 1e-9 * np.maximum(1.0, np.abs(z))
-        return w
+        b = self.w_blocks.split(w0)
+        b["z"] = z + 1e-9 * np.maximum(1.0, np.abs(z))
+        return self.w_blocks.join(**b)
 
-    def bounds(self):
-        lo = [self.problem.free[k][0] for k in self.free] + [-2 * TWO_PI, -2 * TWO_PI]
-        hi = [self.problem.free[k][1] for k in self.free] + [2 * TWO_PI, 3 * TWO_PI]
-        lo += [-np.inf] * self.nz + [-2 * TWO_PI] * (self.n_lift + self.n_box)
-        hi += [np.inf] * self.nz + [3 * TWO_PI] * (self.n_lift + self.n_box)
-        return np.array(lo, float), np.array(hi, float)
+    def bounds(self, problem):
+        """(lower, upper) of w: the problem's free bounds; the angles within a few turns."""
+        lo = self.w_blocks.join(
+            free=[problem.free[k][0] for k in self.free],
+            theta=[-2 * TWO_PI] * 2,
+            z=-np.inf,
+            phi=-2 * TWO_PI,
+            psi=-2 * TWO_PI,
+        )
+        hi = self.w_blocks.join(
+            free=[problem.free[k][1] for k in self.free],
+            theta=[2 * TWO_PI, 3 * TWO_PI],
+            z=np.inf,
+            phi=3 * TWO_PI,
+            psi=3 * TWO_PI,
+        )
+        return lo, hi
 
+    # ---- other views of the same NLP --------------------------------------------------------------------
     @functools.cached_property
-    def warm_solver(self):
-        """The same NLP for re-solves from a converged point (more samples, or IPOPT's iteration limit): its
-        start moves off a bound by 1e-8 only. IPOPT's default push (0.01, absolute for lengths below 1) can
-        move a small link across a Grashof or assembly limit, where the loop has no real solution."""
-        return casadi.nlpsol("qropt_warm", "ipopt", self._nlp, {**WARM, **self._ipopt})
-
-    def solve(self, w0, p, warm: bool = False):
-        """One IPOPT run: (w, objective, constraint values, stats); warm: a re-solve (see ``warm_solver``)."""
-        lbx, ubx = self.bounds()
-        w0 = np.clip(w0, lbx, ubx)
-        solver = self.warm_solver if warm else self.solver
-        r = solver(x0=w0, p=p, lbx=lbx, ubx=ubx, lbg=self.lbg, ubg=self.ubg)
-        st = solver.stats()
-        return np.array(r["x"]).ravel(), float(r["f"]), np.array(r["g"]).ravel(), st
+    def functions(self):
+        """The same NLP as plain functions (f, g, df, dg) with exact derivatives, for other backends."""
+        w, p, f, g = self.w_sym, self.p_sym, self.f_sym, self.g_sym
+        return casadi.Function(
+            "fg", [w, p], [f, g, casadi.gradient(f, w), casadi.jacobian(g, w)], ["w", "p"], ["f", "g", "df", "dg"]
+        )
 
     @functools.cached_property
     def square_rows(self) -> np.ndarray | None:
         """Indices of the equality rows in the free parameters and dead centres (targets, zero velocity), if
         they are as many as those unknowns: the system a closed-form enumeration is polished on."""
-        rows = [i for i, r in enumerate(self.rows) if r.lb == r.ub and not r.name.startswith("lifted")]
+        rows = [i for i, r in enumerate(self.rows) if r.lb == r.ub and r.kind is not RowKind.LIFT]
         return np.array(rows, int) if len(rows) == self.nx + 2 else None
 
     @functools.cached_property
     def square_system(self):
-        """z = [w, p] -> [residual of the square rows, their Jacobian in (free, theta_max, theta_min)
-        (column-major)], evaluated without conversions (see kernel.Batched)."""
-        from qropt.kinematics.kernel import Batched
-
-        rows, n = self.square_rows, self.nx + 2
+        """[w, p] -> [residual of the square rows, their Jacobian in (free, theta_max, theta_min) (column-major)],
+        evaluated without conversions (see kernel.Batched)."""
+        rows = self.square_rows
         r = self.g_sym[rows.tolist()] - casadi.DM(self.lbg[rows])
-        jac = casadi.jacobian(r, self.w_sym[:n])
-        z = casadi.SX.sym("z", self.w_sym.numel() + self.p_sym.numel())
-        f = casadi.Function("sq", [self.w_sym, self.p_sym], [casadi.vertcat(r, casadi.vec(jac))])
-        return Batched(casadi.Function("sqz", [z], [f(z[: self.w_sym.numel()], z[self.w_sym.numel() :])]))
+        return self._batched("sq", casadi.vertcat(r, casadi.vec(casadi.jacobian(r, self.design_sym))))
 
     @functools.cached_property
     def constraint_values(self):
-        """z = [w, p] -> g, evaluated without conversions."""
+        """[w, p] -> g, evaluated without conversions."""
+        return self._batched("g", self.g_sym)
+
+    def _batched(self, name, expr):
         from qropt.kinematics.kernel import Batched
 
         z = casadi.SX.sym("z", self.w_sym.numel() + self.p_sym.numel())
-        f = casadi.Function("g", [self.w_sym, self.p_sym], [self.g_sym])
-        return Batched(casadi.Function("gz", [z], [f(z[: self.w_sym.numel()], z[self.w_sym.numel() :])]))
+        f = casadi.Function(name, [self.w_sym, self.p_sym], [expr])
+        return Batched(casadi.Function(name + "z", [z], [f(z[: self.w_sym.numel()], z[self.w_sym.numel() :])]))
 
-    def violations(self, g):
-        """Named constraint violations (>= 0) of constraint values g."""
+    def violations(self, g) -> dict:
+        """Named constraint violations (>= 0) of constraint values g, the formulation's own rows left out."""
         v = np.maximum(np.maximum(self.lbg - g, g - self.ubg), 0.0)
         out = {}
         for row, val in zip(self.rows, v, strict=True):
-            out[row.name] = max(out.get(row.name, 0.0), float(val))
+            if row.kind not in INTERNAL:
+                out[row.name] = max(out.get(row.name, 0.0), float(val))
         return out
+
+    def exchange(self, problem, m, z, f, gap_tol) -> criteria.Exchange | None:
+        """The objective criterion's exchange at mechanism m (z: the NLP's epigraph values, f its objective)."""
+        c = self.objective
+        if c is None:
+            return None
+        return c.exchange(self, problem, m, [float(z[i]) for i in self._z_of.get(c.name, [])], f, gap_tol)

@@ -1,7 +1,7 @@
 """A synthesis problem: what the designer wants, validated and frozen.
 
 Lengths in any consistent unit, angles in radians. Targets are equality
-constraints, conditions inequalities, the objective one of ``OBJECTIVES``.
+constraints, conditions inequalities, the objective one of ``criteria.objectives()``.
 """
 
 from __future__ import annotations
@@ -14,11 +14,10 @@ from types import MappingProxyType
 from typing import Any
 
 from qropt.errors import ProblemError
-from qropt.mechanisms import FourBar, FourBarSlider, Mechanism, mechanism_type
+from qropt.mechanisms import Mechanism, mechanism_type
 from qropt.mechanisms.base import REQUIRED
-from qropt.synthesis.criteria import BOUNDS, OBJECTIVES, SIZES, SLIDER_ONLY, finite
-
-BRANCHES = ("sigma", "sigma_slider")
+from qropt.synthesis import criteria
+from qropt.synthesis.criteria import SIZES, finite
 
 
 def _frozen(d):
@@ -90,7 +89,7 @@ class Problem:
         if not self.free:
             raise self._err("no free parameter: give free={name: (lower, upper)}")
         for k in list(self.fixed) + list(self.free):
-            if k not in params or (k in BRANCHES and k in self.free):
+            if k not in params or (k in cls.BRANCHES and k in self.free):
                 raise self._err(f"unknown or non-continuous parameter {k!r}; {cls.__name__} takes {list(params)}")
         both = sorted(set(self.fixed) & set(self.free))
         if both:
@@ -118,9 +117,7 @@ class Problem:
 
     def _branches(self):
         out = {}
-        for k in BRANCHES:
-            if k not in self.mechanism.PARAMS:
-                continue
+        for k in self.mechanism.BRANCHES:
             vals = self.branches.get(k, (self.fixed.get(k, self.mechanism.PARAMS[k]),))
             vals = tuple(vals if isinstance(vals, (tuple, list)) else (vals,))
             if not vals or not all(finite(v) and v in (-1.0, 1.0) for v in vals):
@@ -132,18 +129,18 @@ class Problem:
         return out
 
     def _completed_fixed(self):
-        fixed = {k: float(v) for k, v in self.fixed.items() if k not in BRANCHES}
-        for k, v in self.mechanism.PARAMS.items():
-            if k in BRANCHES or k in fixed or k in self.free or v is None or v is REQUIRED:
+        cls = self.mechanism
+        fixed = {k: float(v) for k, v in self.fixed.items() if k not in cls.BRANCHES}
+        for k, v in cls.PARAMS.items():
+            if k in cls.BRANCHES or k in fixed or k in self.free or v is None or v is REQUIRED:
                 continue
             fixed[k] = float(v)
-        rod = "r6" in fixed or "r6" in self.free
-        if self.mechanism.__name__ == "CrankShaper" and rod and "h" not in self.free:
-            fixed.setdefault("h", 0.0)
+        given = {**fixed, **dict.fromkeys(self.free, 0.0)}
+        fixed.update({k: float(v) for k, v in cls.completed(given).items() if k not in self.free})
         return fixed
 
     def _check_targets(self):
-        allowed = ("time_ratio", "swing") if self.mechanism is FourBar else ("time_ratio", "stroke")
+        allowed = ("time_ratio", self.mechanism.TRAVEL)
         if not self.targets:
             raise self._err(f"no target: give targets from {allowed}")
         for k, v in self.targets.items():
@@ -161,17 +158,16 @@ class Problem:
 
     def _check_conditions(self):
         c = dict(self.conditions)
-        known = {"grashof", "linear", "ratio", *BOUNDS}
+        bounds = criteria.bounds()
+        known = {"grashof", "linear", "ratio", *bounds}
         for k in c:
             if k not in known:
                 raise self._err(f"unknown condition {k!r}; conditions are {sorted(known)}")
-        four_bar = issubclass(self.mechanism, (FourBar, FourBarSlider))
-        if four_bar:
-            default = getattr(self.mechanism, "CLASS", "") or "crank-rocker"
-            c.setdefault("grashof", default)
+        if self.mechanism.FOUR_BAR:
+            c.setdefault("grashof", self.mechanism.CLASS or "crank-rocker")
             if c["grashof"] not in ("drag-link", "crank-rocker"):
                 raise self._err(f"grashof condition is 'drag-link' or 'crank-rocker', got {c['grashof']!r}")
-            need = getattr(self.mechanism, "CLASS", "")
+            need = self.mechanism.CLASS
             if need and c["grashof"] != need:
                 raise self._err(f"{self.mechanism.__name__} is a {need} by definition, not {c['grashof']}")
         elif "grashof" in c:
@@ -179,13 +175,13 @@ class Problem:
         g = c.get("gamma_min")
         if g is not None and not (finite(g) and 0 <= g < math.pi / 2):
             raise self._err(f"gamma_min bound must be in [0, pi/2) rad, a number; got {g!r}")
-        for k in BOUNDS:
+        for k, crit in bounds.items():
             if k != "gamma_min" and k in c:
                 if not (finite(c[k]) and c[k] > 0):
                     raise self._err(f"{k} is an upper bound, a positive number; got {c[k]!r}")
                 c[k] = float(c[k])
-                if k in SLIDER_ONLY and self.mechanism is FourBar:
-                    raise self._err(f"FourBar has no slider: {k} does not apply")
+            if k in c and not crit.applies(self.mechanism):
+                raise self._err(f"{self.mechanism.__name__} has no slider: {k} does not apply")
         linear = []
         for row in c.get("linear", ()):
             if not (isinstance(row, (list, tuple)) and len(row) == 3 and isinstance(row[0], Mapping)
@@ -218,16 +214,17 @@ class Problem:
                 raise self._err(f"condition names {k!r}, which is not a parameter of this problem")
 
     def _check_objective(self):
-        if self.objective not in OBJECTIVES:
-            raise self._err(f"unknown objective {self.objective!r}; objectives are {OBJECTIVES}")
+        objectives = criteria.objectives()
+        if self.objective not in objectives:
+            raise self._err(f"unknown objective {self.objective!r}; objectives are {objectives}")
         if self.size not in SIZES:
             raise self._err(f"unknown size measure {self.size!r}; measures are {SIZES}")
         if self.accel_over not in ("cycle", "working"):
             raise self._err(f"accel_over is 'cycle' or 'working', got {self.accel_over!r}")
         if not (finite(self.omega2) and self.omega2 != 0):
             raise self._err(f"omega2 is the crank speed in rad/s, a nonzero finite number; got {self.omega2!r}")
-        if self.objective in SLIDER_ONLY and self.mechanism is FourBar:
-            raise self._err(f"FourBar has no slider: {self.objective} does not apply")
+        if self.objective and not criteria.of(self.objective, self.size).applies(self.mechanism):
+            raise self._err(f"{self.mechanism.__name__} has no slider: {self.objective} does not apply")
 
     # ---- equality and serialisation (angles in radians, lengths in the problem's units) -------------
     def to_dict(self) -> dict:

@@ -1,31 +1,19 @@
-"""Tiles of a design chart (``qropt.chart``): continuation over a block of cells, and the tiles run in-process
-or on a Dask cluster.
+"""The continuation over one tile of a design chart: plain data in (a tile spec), solved cells out.
 
 In a tile, cells are visited in a serpentine (each next to the last); a cell starts one local solve from the
 design of its best certified neighbour. The full default solve runs at the tile's first cell, at the centre of
 every ``check`` x ``check`` block (and the better of both designs stays), wherever the warm start fails or
 jumps branch, and where no neighbour has a design; a design better than the continuation's is carried to the
-cells around it while it stays better. A tile is plain numbers, so ``client.map`` sends it to a Dask worker,
-which builds its Solver once (IPOPT is not thread-safe: one thread per worker process).
-
-``'local'`` starts a ``dask.distributed.LocalCluster`` for the chart's duration; any other string is the
-address of a running scheduler (``dask scheduler`` and ``dask worker ADDRESS`` on the machines, or a
-dask-jobqueue cluster's ``scheduler_address``), which must answer within CONNECT_TIMEOUT seconds.
+cells around it while it stays better. A tile is plain numbers, so it runs in this process or on a Dask worker
+alike (``_dask``).
 """
 
 from __future__ import annotations
 
-import contextlib
 import inspect
-import json
-import logging
-import os
 import time
 
-import dask
-
-from qropt.errors import QroptError
-from qropt.studies._chart import Axis, Cell, ChartError, axis_kind, problem_at
+from qropt.studies._chart import Axis, Cell, axis_kind, problem_at
 from qropt.synthesis import starts
 from qropt.synthesis.certificate import better
 from qropt.synthesis.criteria import maximises
@@ -35,12 +23,6 @@ from qropt.synthesis.result import Result
 JUMP_FLOOR = 0.02  # a step moving the design by less (relative to its largest length) is never a jump
 JUMP_RATIO = 4.0  # a jump moves the design this many times faster than the step before it on the same line
 BETTER = 1e-7  # relative objective difference that counts as a better design
-CONNECT_TIMEOUT = 5  # s
-# Dask's workers return freed memory to the system at once (MALLOC_TRIM_THRESHOLD_=65536); a solve allocates
-# and frees many small arrays, and that setting makes a tile about 25% slower: the local cluster leaves glibc's
-# own threshold (give a running cluster's workers MALLOC_TRIM_THRESHOLD_=1073741824 for the same)
-LOCAL_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
-_SOLVERS: dict = {}  # per worker process: the Solver of each option set, built once
 
 
 def solve_tile(spec: dict, solver, progress=None) -> list[Cell]:
@@ -184,87 +166,4 @@ def _distance(problem, a: dict, b: dict) -> float:
     return max(abs(a[k] - b[k]) for k in problem.free) / size
 
 
-# ---- running the tiles ------------------------------------------------------------------------------------
-def run_here(specs: list, solver, progress) -> list:
-    """Every tile in this process, in order."""
-    return [solve_tile(s, solver, progress) for s in specs]
-
-
-def solver_options(solver) -> dict:
-    """A Solver's options as plain values (what a worker needs to build the same Solver)."""
-    return {"tolerances": dict(solver.tolerances), "ipopt_options": dict(solver.ipopt_options),
-            "samples": solver.samples, "extra": solver.extra, "starts_n": solver.starts_n, "seed": solver.seed,
-            "max_rounds": solver.max_rounds}  # fmt: skip
-
-
-def worker_tile(spec: dict, options: dict) -> list[dict]:
-    """Run on a worker: one tile with this process's Solver for ``options``; the cells as dictionaries."""
-    from qropt.synthesis.solver import Solver
-
-    key = json.dumps(options, sort_keys=True, default=str)
-    if key not in _SOLVERS:
-        _SOLVERS[key] = Solver(**options)
-    return [c.to_dict() for c in solve_tile(spec, _SOLVERS[key])]
-
-
-@contextlib.contextmanager
-def _client(mode: str, workers: int | None):
-    from distributed import Client, LocalCluster
-
-    if mode == "local":
-        n = workers or os.cpu_count() or 1
-        with dask.config.set(LOCAL_CONFIG):
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                                   silence_logs=logging.ERROR)  # fmt: skip
-        with cluster, Client(cluster) as client:
-            yield client, f"local cluster of {n} worker processes"
-        return
-    try:
-        client = Client(mode, timeout=CONNECT_TIMEOUT)
-    except (OSError, TimeoutError, ValueError, TypeError) as e:
-        first = str(e).splitlines()[0] if str(e) else ""
-        raise ChartError(f"cannot reach the Dask scheduler at {mode!r} within {CONNECT_TIMEOUT} s "
-                         f"({type(e).__name__}: {first})") from None  # fmt: skip
-    with client:
-        yield client, f"Dask cluster at {mode} ({len(client.scheduler_info().get('workers', {}))} workers)"
-
-
-def run_dask(specs: list, solver, mode: str, workers: int | None, progress) -> tuple[list, str]:
-    """Every tile on a Dask cluster, the largest first and one tile per worker thread at a time (each worker takes
-    the next tile when it is free, so the load balances without work stealing); (tiles of Cells in the order of
-    specs, the cluster)."""
-    from distributed import as_completed
-
-    options = solver_options(solver)
-    order = sorted(range(len(specs)), key=lambda k: -_size(specs[k]))
-    with _client(mode, workers) as (client, where):
-        slots = max(1, sum(client.nthreads().values()))
-        out: list = [None] * len(specs)
-        futures = {}
-
-        def submit(k):
-            futures[client.submit(worker_tile, specs[k], options, pure=False)] = k
-
-        pending = iter(order)
-        for k in [k for _, k in zip(range(slots), pending, strict=False)]:
-            submit(k)
-        try:
-            running = as_completed(list(futures))
-            for fut in running:
-                k = futures.pop(fut)
-                out[k] = fut.result()
-                progress(_size(specs[k]))
-                nxt = next(pending, None)
-                if nxt is not None:
-                    submit(nxt)
-                    running.add(next(f for f, j in futures.items() if j == nxt))
-        except QroptError:  # raised by a tile: as it is
-            raise
-        except Exception as e:  # noqa: BLE001 - a lost worker or a broken cluster: one line naming it
-            raise ChartError(f"the Dask cluster failed to solve a tile ({type(e).__name__}: {e})") from None
-    return [[Cell.from_dict(d) for d in tile] for tile in out], where
-
-
-def _size(spec) -> int:
-    i0, i1, j0, j1 = spec["block"]
-    return (i1 - i0) * (j1 - j0)
+__all__ = ["solve_tile"]

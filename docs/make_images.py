@@ -1,0 +1,89 @@
+"""Draws every picture README.md and docs/*.md show, into docs/images/. Run from the repository root:
+
+python docs/make_images.py            # all of them (about half a minute on two cores)
+python docs/make_images.py types      # only the ones whose names start with 'types'
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+IMAGES = ROOT / "docs" / "images"
+sys.path.insert(0, str(ROOT))  # the chart problem files live in problems/
+
+import qropt  # noqa: E402
+from qropt.examples import paper_mechanism  # noqa: E402
+from qropt.io import plots  # noqa: E402
+
+
+def types(path):
+    qropt.design(1.5, 0.3).plot(path)
+
+
+def front(path):
+    p = qropt.Problem("CrankRockerSlider", fixed={"r1": 0.3, "r2": 0.1, "r6": 0.5},
+                      free={"r3": (0.15, 0.6), "r4": (0.15, 0.45), "r5": (0.02, 0.45)},
+                      targets={"time_ratio": 1.2, "stroke": 0.15}, omega2=2.0)  # fmt: skip
+    qropt.pareto(p, ("max_gamma_min", "min_size"), n=20).plot(path)
+
+
+def crank_rocker_chart(path):
+    from problems import chart_crank_rocker as cr
+
+    qropt.chart(cr.build(), cr.X, cr.Y, progress=False).plot(path)
+
+
+def slider_crank_chart(path):
+    from problems import chart_slider_crank as sc
+
+    qropt.chart(sc.build(), sc.X, sc.Y, progress=False).plot(path)
+
+
+def paper_mechanism_cycle(path):
+    plots.save(plots.cycle_figure(paper_mechanism(), math.radians(60), 10.0), path)
+
+
+def family(path):
+    p = qropt.Problem("DragLinkSlider", fixed={"r2": 0.225, "r4": 0.275, "r5": 0.15, "r6": 0.3},
+                      free={"r1": (0.02, 0.2), "r3": (0.05, 0.6)}, targets={"time_ratio": 1.5})  # fmt: skip
+    f = qropt.family(p)
+    plots.save(plots.family_figure(f, best=f.best("max_gamma_min")), path)
+
+
+def reachable(path):
+    plots.save(plots.reachable_figure(qropt.reachable(paper_mechanism(), "r3"), (1.5, 2.0)), path)
+
+
+def servo(path):
+    m = qropt.SliderCrank(r2=0.1, r3=0.4)
+    qropt.speed_profile(m, omega_max=20, v_cut=0.5, a_max=40, alpha_max=400, v_max=2).plot(path)
+
+
+PICTURES = {
+    "types.png": types,
+    "front.png": front,
+    "crank_rocker_chart.png": crank_rocker_chart,
+    "slider_crank_chart.png": slider_crank_chart,
+    "paper_mechanism.png": paper_mechanism_cycle,
+    "family.png": family,
+    "reachable.png": reachable,
+    "servo.png": servo,
+}
+
+
+def main(argv: list[str]) -> None:
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    for name, draw in PICTURES.items():
+        if argv and not any(name.startswith(a) for a in argv):
+            continue
+        start = time.perf_counter()
+        draw(IMAGES / name)
+        print(f"docs/images/{name}  {time.perf_counter() - start:.1f} s")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

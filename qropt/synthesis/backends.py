@@ -1,0 +1,181 @@
+"""NLP backends behind one small protocol: a Formulation, a start, parameters and bounds in; a ``Run`` out.
+
+IPOPT (through CasADi) is the default; ``Scipy`` runs SLSQP or trust-constr on the same Formulation with its
+exact derivatives (the benchmarks' baselines). Each backend reads its own statuses here, once, into ``Status``.
+"""
+
+from __future__ import annotations
+
+import enum
+import weakref
+from dataclasses import dataclass
+from typing import Protocol
+
+import casadi
+import numpy as np
+
+from qropt.synthesis.formulation import IPOPT
+
+
+class Status(enum.Enum):
+    """How a local run ended, whatever the backend."""
+
+    SOLVED = "solved"
+    ACCEPTABLE = "acceptable"  # to the backend's looser tolerance
+    ITERATION_LIMIT = "iteration limit"
+    INFEASIBLE = "infeasible"  # the backend found the constraints locally infeasible
+    FAILED = "failed"  # invalid numbers, a failed restoration, an error
+
+
+CONVERGED = (Status.SOLVED, Status.ACCEPTABLE)
+PROVES = (Status.SOLVED, Status.ACCEPTABLE, Status.INFEASIBLE)  # ends that say something of the problem
+
+
+@dataclass(frozen=True)
+class Run:
+    """One local run: the point w, objective f and constraint values g; its Status, the backend's own word for
+    it (``message``), iterations and wall time (s)."""
+
+    w: np.ndarray
+    f: float
+    g: np.ndarray
+    status: Status
+    message: str
+    iterations: int
+    seconds: float
+
+    @property
+    def converged(self) -> bool:
+        return self.status in CONVERGED
+
+
+class Backend(Protocol):
+    """A local NLP solver: ``run(form, w0, p, lbx, ubx, warm)``; warm: a re-solve from a converged point."""
+
+    name: str
+
+    def run(self, form, w0, p, lbx, ubx, warm: bool = False) -> Run: ...
+
+
+IPOPT_STATUS = {
+    "Solve_Succeeded": Status.SOLVED,
+    "Solved_To_Acceptable_Level": Status.ACCEPTABLE,
+    "Maximum_Iterations_Exceeded": Status.ITERATION_LIMIT,
+    "Infeasible_Problem_Detected": Status.INFEASIBLE,
+}
+WARM = {"ipopt.bound_push": 1e-8, "ipopt.bound_frac": 1e-8}
+
+
+class Ipopt:
+    """IPOPT through CasADi, one compiled solver per formulation (two: re-solves move a start off a bound by
+    1e-8 only, since IPOPT's default push of 0.01 is absolute and can move a small link across a Grashof or
+    assembly limit, where the loop has no real solution)."""
+
+    name = "ipopt"
+
+    def __init__(self, options: dict | None = None):
+        self.options = {**IPOPT, **(options or {})}
+        self._solvers: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+    def solver(self, form, warm: bool = False):
+        pair = self._solvers.setdefault(form, [None, None])
+        if pair[warm] is None:
+            opts = {**WARM, **self.options} if warm else self.options
+            pair[warm] = casadi.nlpsol("qropt_warm" if warm else "qropt", "ipopt", form.nlp, opts)
+        return pair[warm]
+
+    def run(self, form, w0, p, lbx, ubx, warm: bool = False) -> Run:
+        solver = self.solver(form, warm)
+        r = solver(x0=np.clip(w0, lbx, ubx), p=p, lbx=lbx, ubx=ubx, lbg=form.lbg, ubg=form.ubg)
+        st = solver.stats()
+        word = st.get("return_status", "?")
+        status = IPOPT_STATUS.get(word, Status.SOLVED if st.get("success") else Status.FAILED)
+        return Run(
+            np.array(r["x"]).ravel(),
+            float(r["f"]),
+            np.array(r["g"]).ravel(),
+            status,
+            word,
+            int(st.get("iter_count", 0)),
+            float(st.get("t_wall_total", 0.0)),
+        )
+
+
+class Scipy:
+    """scipy.optimize.minimize (SLSQP or trust-constr) on a Formulation's functions with exact derivatives."""
+
+    def __init__(self, method: str = "SLSQP"):
+        self.method, self.name = method, method.lower()
+
+    def run(self, form, w0, p, lbx, ubx, warm: bool = False) -> Run:
+        import time
+
+        from scipy.optimize import NonlinearConstraint, minimize
+
+        fn, calls, t0 = form.functions, [0], time.perf_counter()
+
+        def f(w):
+            calls[0] += 1
+            return float(fn(w, p)[0])
+
+        def df(w):
+            return np.array(fn(w, p)[2]).ravel()
+
+        def g(w):
+            return np.array(fn(w, p)[1]).ravel()
+
+        def dg(w):
+            return np.array(fn(w, p)[3])
+
+        w0 = np.clip(w0, lbx, ubx)
+        bounds = list(zip(np.where(np.isfinite(lbx), lbx, None), np.where(np.isfinite(ubx), ubx, None), strict=True))
+        lb, ub = form.lbg, form.ubg
+        with np.errstate(all="ignore"):
+            try:
+                if self.method == "SLSQP":
+                    eq, lo, hi = lb == ub, (lb != ub) & np.isfinite(lb), (lb != ub) & np.isfinite(ub)
+                    cons = [
+                        {"type": "eq", "fun": lambda w: g(w)[eq] - lb[eq], "jac": lambda w: dg(w)[eq]},
+                        {"type": "ineq", "fun": lambda w: g(w)[lo] - lb[lo], "jac": lambda w: dg(w)[lo]},
+                        {"type": "ineq", "fun": lambda w: ub[hi] - g(w)[hi], "jac": lambda w: -dg(w)[hi]},
+                    ]
+                    r = minimize(
+                        f,
+                        w0,
+                        jac=df,
+                        bounds=bounds,
+                        constraints=cons,
+                        method="SLSQP",
+                        options={"ftol": 1e-12, "maxiter": 300},
+                    )
+                    status = Status.SOLVED if r.success else Status.ITERATION_LIMIT if r.status == 9 else Status.FAILED
+                else:
+                    con = NonlinearConstraint(g, lb, ub, jac=dg)
+                    r = minimize(
+                        f,
+                        w0,
+                        jac=df,
+                        bounds=bounds,
+                        constraints=[con],
+                        method="trust-constr",
+                        options={"gtol": 1e-10, "xtol": 1e-12, "maxiter": 200},
+                    )
+                    status = Status.SOLVED if r.success else Status.FAILED
+            except (ValueError, np.linalg.LinAlgError) as e:
+                return Run(
+                    np.full(w0.size, np.nan),
+                    np.nan,
+                    np.full(lb.size, np.nan),
+                    Status.FAILED,
+                    str(e),
+                    calls[0],
+                    time.perf_counter() - t0,
+                )
+        w = np.asarray(r.x, float)
+        if not np.all(np.isfinite(w)):
+            status = Status.FAILED
+        gv = g(w) if np.all(np.isfinite(w)) else np.full(lb.size, np.nan)
+        return Run(w, float(r.fun), gv, status, str(r.message), calls[0], time.perf_counter() - t0)
+
+
+__all__ = ["Status", "CONVERGED", "PROVES", "Run", "Backend", "Ipopt", "Scipy"]

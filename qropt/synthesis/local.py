@@ -1,0 +1,237 @@
+"""The local solve: one start -> one certified (or refused) candidate.
+
+A backend run (IPOPT by default) on the problem's Formulation, then an exchange loop: the exact evaluation of
+the design names the crank angles where it disagrees with the NLP's samples, they become sample angles, and the
+NLP is solved again from where it stopped. ``polish`` is Newton on the target and dead-centre equations from a
+closed-form point of a square problem.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from qropt.synthesis import starts as starts_
+from qropt.synthesis.backends import CONVERGED, Status
+from qropt.synthesis.certificate import Designs, certify, residuals
+from qropt.synthesis.formulation import TWO_PI, Formulation
+
+RESTARTS = 2  # runs continued from their last iterate when they hit the iteration limit
+
+
+@dataclass
+class Candidate:
+    """One local solve's outcome: the design, its certificate data and the backend's statistics."""
+
+    ok: bool
+    values: dict
+    branch: dict
+    orientation: int
+    mechanism: object = None
+    info: dict = field(default_factory=dict)
+    residuals: dict = field(default_factory=dict)
+    statuses: list = field(default_factory=list)  # the backend's own word for each run
+    ends: list = field(default_factory=list)  # each run's Status
+    iterations: int = 0
+    t_ipopt: float = 0.0
+    rounds: int = 0
+    origin: str = ""
+    q: dict | None = None
+    pruned: bool = False
+
+    @property
+    def converged(self) -> bool:
+        return bool(self.ends) and self.ends[-1] in CONVERGED
+
+
+class Formulations:
+    """The NLPs of a Solver, one per problem structure, built on first use (immutable; numbers are passed)."""
+
+    def __init__(self, samples: int, extra: int):
+        self.samples, self.extra, self._built = samples, extra, {}
+
+    def __len__(self):
+        return len(self._built)
+
+    def get(self, problem, branch: dict, orientation: int, range_target=None, sense=1) -> Formulation:
+        c = problem.conditions
+        bounds = tuple(k for k in c if k not in ("grashof", "linear", "ratio"))
+        cond = (c.get("grashof"), bounds, repr(c.get("linear")), repr(c.get("ratio")))
+        key = (
+            problem.mechanism,
+            tuple(problem.free),
+            tuple(problem.fixed),
+            tuple(problem.targets),
+            cond,
+            problem.objective,
+            problem.size,
+            problem.accel_over,
+            tuple(sorted(branch.items())),
+            orientation,
+            range_target,
+            sense,
+        )
+        f = self._built.get(key)
+        if f is None:
+            f = self._built[key] = Formulation(
+                problem, branch, orientation, range_target, sense, self.samples, self.extra
+            )
+        return f
+
+
+class LocalSolve:
+    """One start to one candidate, on a backend, with the exchange loop. tolerances: {'feasibility', 'gap'}."""
+
+    def __init__(self, formulations: Formulations, backend, tolerances: dict, max_rounds: int):
+        self.formulations, self.backend = formulations, backend
+        self.tolerances, self.max_rounds = tolerances, max_rounds
+
+    def run(
+        self,
+        problem,
+        values0,
+        branch,
+        targets,
+        *,
+        orientation=None,
+        max_rounds=None,
+        range_target=None,
+        sense=1,
+        designs=None,
+        bound=None,
+    ) -> Candidate:
+        """From values0 on branch; orientation: which way the TR equality is met (+1, -1), None for the start's
+        own; designs: the solve's memo of built mechanisms; bound: the incumbent's NLP objective value, above
+        which the exchange loop stops (the start is pruned)."""
+        max_rounds = self.max_rounds if max_rounds is None else max_rounds
+        designs = designs or Designs()
+        th0, orientation = starts_.dead_centre_start(
+            problem, values0, branch, targets, orientation, range_target, designs
+        )
+        form = self.formulations.get(problem, branch, orientation, range_target, sense)
+        samples, fractions = form.base_samples()
+        used = used_f = form.n_base
+        phi, box = form.lifted_start(problem, values0, designs)
+        p = form.param_vector(problem, targets, samples, fractions, box=box)
+        w = form.epigraph_start(form.pack(values0, th0, phi=phi, box=box), p)
+        lbx, ubx = form.bounds(problem)
+        c = Candidate(False, dict(values0), branch, orientation)
+        gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
+        g, info, m, restarts = None, {}, None, 0
+        while c.rounds < max_rounds:
+            c.rounds += 1
+            run = self.backend.run(form, w, p, lbx, ubx, warm=c.rounds > 1)
+            w, g = run.w, run.g
+            c.t_ipopt += run.seconds
+            c.iterations += run.iterations
+            c.statuses.append(run.message)
+            c.ends.append(run.status)
+            pt = form.unpack(w)
+            c.values = pt.values
+            m, info, add, frac = certify(
+                problem, form, c.values, branch, pt.theta, pt.z, run.f, gap_tol, feas_tol, designs
+            )
+            if run.status is Status.ITERATION_LIMIT and restarts < RESTARTS and not range_target:
+                restarts += 1  # the iteration budget ran out on the way: go on from where it stopped
+                continue
+            if not run.converged and not range_target:
+                break
+            if not add and not frac:
+                break
+            if bound is not None and info.get("ok") and run.f > bound + 1e-9 * max(1.0, abs(bound)):
+                c.pruned = True  # more samples only raise this basin's NLP value: it cannot beat the incumbent
+                break
+            used = place(samples, used, add, TWO_PI, 0.05, form.n_base)
+            used_f = place(fractions, used_f, frac, 1.0, 0.01, form.n_base)
+            if form.n_box and m is not None:  # each box side lifted at the coordinate that reaches it now
+                box = m.bounding_box()
+                w = form.with_box(w, box)
+            p = form.param_vector(problem, targets, samples, fractions, box=box)
+            w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
+        c.mechanism, c.info = m, info
+        c.residuals = residuals(problem, form.violations(g), m, {k: targets[k] for k in form.targets})
+        c.ok = bool(info.get("ok")) and c.converged and self.within(c) and not c.pruned
+        return c
+
+    def polish(self, problem, values0, branch, targets, designs=None) -> Candidate:
+        """Newton on the target and dead-centre equations from a closed-form point of a square problem (as many
+        free parameters as targets): the point of the finite solution set that the closed form names."""
+        designs = designs or Designs()
+        th0, orientation = starts_.dead_centre_start(problem, values0, branch, targets, None, None, designs)
+        form = self.formulations.get(problem, branch, orientation)
+        rows = form.square_rows
+        if rows is None:
+            return self.run(problem, values0, branch, targets, orientation=orientation, designs=designs)
+        p = form.param_vector(problem, targets, *form.base_samples())
+        w = form.pack(values0, th0)
+        d = form.design  # the design block of w: free parameters and dead centres
+        c = Candidate(False, dict(values0), branch, orientation, origin="enumeration")
+        for _ in range(30):
+            out = form.square_system(np.concatenate([w, p])[None, :])[0]
+            try:
+                n = d.stop - d.start
+                step = np.linalg.solve(out[n:].reshape(n, n, order="F"), out[:n])
+            except np.linalg.LinAlgError:
+                break
+            w[d] -= step
+            c.iterations += 1
+            if np.max(np.abs(step)) <= 1e-14 * max(1.0, np.max(np.abs(w[d]))):
+                break
+        pt = form.unpack(w)
+        c.statuses, c.ends = ["enumerated point (Newton)"], [Status.SOLVED]
+        inside = all(lo - 1e-12 <= pt.values[k] <= hi + 1e-12 for k, (lo, hi) in problem.free.items())
+        if not np.all(np.isfinite(w[d])) or not inside:
+            c.info = {
+                "ok": False,
+                "reason": "Newton on the target equations leaves the bounds from the closed form's "
+                "point (it meets the targets only approximately: no design there)",
+            }
+            c.ends = [Status.FAILED]
+            return c
+        # the closed form's own values where Newton only moved them by rounding (one design built, not two)
+        c.values = {
+            k: values0[k] if abs(v - values0[k]) <= 4e-16 * abs(values0[k]) else v for k, v in pt.values.items()
+        }
+        w = form.epigraph_start(form.pack(c.values, pt.theta), p)
+        g = form.constraint_values(np.concatenate([w, p])[None, :])[0]
+        tol = self.tolerances
+        m, info, _, _ = certify(
+            problem, form, c.values, branch, pt.theta, None, None, tol["gap"], tol["feasibility"], designs
+        )
+        c.mechanism, c.info = m, info
+        c.residuals = residuals(problem, form.violations(g), m, {k: targets[k] for k in form.targets})
+        c.ok = bool(info.get("ok")) and self.within(c)
+        return c
+
+    def within(self, c: Candidate) -> bool:
+        tol = self.tolerances
+        return max(c.residuals.values(), default=0.0) <= tol["feasibility"] and c.info.get("gap", 0.0) <= tol["gap"]
+
+
+def place(slots, used, new, period, near, base):
+    """Put new sample angles into the extra slots: an angle close to an extra sample moves it there (the
+    worst angle drifts as the design changes), others take free slots; with every slot taken, the nearest
+    extra sample moves (an angle the exact evaluation names is never dropped). Returns the slots in use."""
+    for t in new:
+        extra = np.arange(base, used)
+        if extra.size:
+            d = np.abs((slots[extra] - t + period / 2) % period - period / 2)
+            k = int(np.argmin(d))
+            if d[k] < near or used == slots.size:
+                slots[extra[k]] = t
+                continue
+        if used < slots.size:
+            slots[used] = t
+            used += 1
+    return used
+
+
+def nlp_value(problem, info) -> float:
+    """A certified objective in the NLP's terms (what the backend minimises)."""
+    from qropt.synthesis import criteria
+
+    return criteria.of_problem(problem).to_nlp(info["certified"], problem.omega2)
+
+
+__all__ = ["Candidate", "Formulations", "LocalSolve", "place", "nlp_value"]

@@ -1,0 +1,128 @@
+"""The multi-start: a plan of starts -> local solves -> the distinct certified designs, best first.
+
+Closed forms first: a complete enumeration is polished point by point (no multi-start), a closed-form family is
+scanned by exact evaluation and only its best points refined; otherwise the closed-form points and a scrambled
+Sobol design. Each start is solved in its own TR orientation (both where it has none); the space-filling starts
+also try the other orientation until each has at least MIN_WAY of them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from qropt.errors import QroptError
+from qropt.synthesis import criteria
+from qropt.synthesis import starts as starts_
+from qropt.synthesis.local import Candidate, LocalSolve, nlp_value
+
+MIN_WAY = 3  # space-filling starts tried in each way of meeting the TR equality, at least
+MANY_STARTS = 6  # more closed-form points than this are scored exactly and only the best few refined
+
+
+class MultiStart:
+    """Runs a plan of starts through a LocalSolve; ``claim`` says what the best of them rests on."""
+
+    def __init__(self, local: LocalSolve):
+        self.local = local
+
+    def candidates(self, problem, plan, extra, targets, starts_n, seed, max_rounds, designs):
+        """(candidates, claim, whether space-filling starts were used)."""
+        runs = [("given", v) for v in extra]
+        cands: list[Candidate] = []
+        claim = ""
+        if plan.kind == "enumeration" and not extra:
+            for v in plan.analytic:
+                for br in starts_.branches(problem):
+                    cands.append(self.local.polish(problem, v, br, targets, designs))
+            claim = f"by enumeration: {plan.how}"
+        elif plan.kind == "family" and not extra:
+            runs += self.family_starts(problem, plan, designs)
+            claim = (
+                f"best along a closed-form family that holds every solution ({plan.how}; {len(plan.analytic)} points)"
+            )
+        else:
+            if len(plan.analytic) > MANY_STARTS and not extra:  # a sweep of closed-form points: the best few
+                runs += [("analytic", v, *b) for _, v, *b in self.family_starts(problem, plan, designs)]
+            else:
+                runs += [("analytic", v) for v in plan.analytic]
+            runs += [("multistart", v) for v in starts_.sobol(problem, starts_n, seed, designs)]
+        cands += self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
+        spread = any(o == "multistart" for o, *_ in runs)
+        if spread and not any(c.ok for c in cands):  # the other way of meeting the TR equality
+            cands += self.run(problem, [r for r in runs if r[0] == "multistart"], targets, max_rounds, designs, True)
+        return cands, claim, spread
+
+    def run(self, problem, runs, targets, max_rounds, designs, both_ways):
+        """A local solve from every start; the incumbent's NLP value prunes starts that cannot beat it."""
+        plans, count = [], {1: 0, -1: 0}
+        for origin, v, *br in runs:
+            for b in br or starts_.branches(problem):
+                own = starts_.orientation(problem, v, b, designs)
+                ways = [own] if own and not both_ways else [1, -1]
+                plans.append((origin, v, b, ways))
+                if origin == "multistart":
+                    for way in ways:
+                        count[way] += 1
+        for origin, _, _, ways in plans:
+            if origin == "multistart" and len(ways) == 1 and count[-ways[0]] < MIN_WAY:
+                ways.append(-ways[0])
+                count[-ways[0]] += 1
+        out, bound = [], None
+        for origin, v, b, ways in plans:
+            for way in ways:
+                c = self.local.run(
+                    problem, v, b, targets, orientation=way, max_rounds=max_rounds, designs=designs, bound=bound
+                )
+                c.origin = origin
+                out.append(c)
+                if c.ok and problem.objective:
+                    f = nlp_value(problem, c.info)
+                    bound = f if bound is None else min(bound, f)
+        return out
+
+    @staticmethod
+    def family_starts(problem, plan, designs):
+        """The best local optima of the objective along the closed-form family (exact evaluation), per branch."""
+        out = []
+        bounded = any(k in problem.conditions for k in criteria.bounds())
+        for br in starts_.branches(problem):
+            scored = [score(problem, v, br, designs) for v in plan.analytic]
+            best = starts_.local_best([s for s, _ in scored], criteria.maximises(problem.objective))
+            if bounded:  # and the point nearest to meeting the bounds, where the best may lie on a bound
+                near = starts_.local_best([v if v else None for _, v in scored], False, keep=1)
+                best += [i for i in near if i not in best]
+            out += [("family", plan.analytic[i], br) for i in best]
+        return out
+
+
+def score(problem, values, branch, build):
+    """(objective, 0.0) of a design that builds and meets every bound condition, (None, total violation) of one
+    that builds and does not, (None, None) of one that does not build or turn once."""
+    try:
+        m = build(problem, values, branch)
+        if m.dead_centres().reversals != 1:
+            return None, None
+        excess = sum(criteria.violations(problem, m).values())
+        if excess > 0:
+            return None, excess
+        return (criteria.objective_of(problem, m) if problem.objective else 0.0), 0.0
+    except QroptError:
+        return None, None
+
+
+def distinct(cands):
+    """Candidates that differ from every earlier one (another branch, or values apart by more than 1e-6
+    relative)."""
+    out = []
+    for c in cands:
+        v = np.array([c.values[k] for k in sorted(c.values)])
+        if all(
+            c.branch != o.branch
+            or np.max(np.abs(v - np.array([o.values[k] for k in sorted(o.values)])) / np.maximum(1, np.abs(v))) > 1e-6
+            for o in out
+        ):
+            out.append(c)
+    return out
+
+
+__all__ = ["MultiStart", "score", "distinct", "MIN_WAY", "MANY_STARTS"]
