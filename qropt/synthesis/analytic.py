@@ -61,6 +61,37 @@ class DragLinkR3(NamedTuple):
     theta2a: float
 
 
+def drag_link_tr_range(r1: float, r2: float, r4: float, r3_lo: float, r3_hi: float) -> tuple[float, float]:
+    """(low, high) of eq. (5)'s TR over the coupler lengths r3 in [r3_lo, r3_hi] that keep a Grashof drag-link
+    (r1 shortest, s + l <= p + q: r3 in [r1 + |r2 - r4|, r2 + r4 - r1]): a dense scan refined by bounded Brent
+    at the best samples; (nan, nan) where no r3 is a drag-link."""
+    from scipy.optimize import minimize_scalar
+
+    a, b = max(r3_lo, r1, r1 + abs(r2 - r4)), min(r3_hi, r2 + r4 - r1)
+    if not a <= b or r1 > min(r2, r4):
+        return math.nan, math.nan
+    r3 = np.linspace(a, b, 2001)
+    with np.errstate(invalid="ignore"):
+        t2a = np.arccos(np.clip((r2**2 + (r4 + r1) ** 2 - r3**2) / (2 * r2 * (r4 + r1)), -1, 1))
+        t2b = np.arccos(np.clip((r2**2 + (r4 - r1) ** 2 - r3**2) / (2 * r2 * (r4 - r1)), -1, 1))
+    tr = (math.pi - t2a + t2b) / (math.pi + t2a - t2b)
+    out = []
+    for sign in (1.0, -1.0):
+        i = int(np.argmin(sign * tr))
+        best = float(tr[i])
+        lo_, hi_ = r3[max(i - 1, 0)], r3[min(i + 1, r3.size - 1)]
+        if hi_ > lo_:
+            res = minimize_scalar(
+                lambda x: sign * paper_time_ratio(r1, r2, x, r4),
+                bounds=(lo_, hi_),
+                method="bounded",
+                options={"xatol": 1e-13},
+            )
+            best = min(best, sign * res.fun, key=lambda v: sign * v) if res.success else best
+        out.append(best)
+    return out[0], out[1]
+
+
 def drag_link_r3(time_ratio: float, r1: float, r2: float, r4: float) -> list[DragLinkR3]:
     """Eqs. (7)-(13): every positive r3 giving the time ratio (Grashof not checked).
 
@@ -300,6 +331,7 @@ class WarmStarts(NamedTuple):
     points: list
     kind: str
     how: str
+    ranges: dict = {}  # target -> (low, high) over the free bounds, where the closed form gives it
 
 
 FAMILY_POINTS = 17  # closed-form family points scanned when a family holds every solution
@@ -351,14 +383,21 @@ def warm_starts(problem) -> WarmStarts:
         for s in drag_link_r3(tr, val["r1"], val["r2"], val["r4"]):
             emit(r3=s.r3, **r5)
         exact = square and set(free) <= {"r3", "r5"} and ("r5" not in free or fixed.get("r6", 0.0) > stroke / 2)
-        return result("enumeration" if exact else "partial", "eqs. (7)-(13) give every r3 for the TR; r5 = stroke/2")
+        how = "eqs. (7)-(13) give every r3 for the TR; r5 = stroke/2"
+        if exact:
+            lo, hi = free.get("r3", (val["r3"], val["r3"]))
+            return WarmStarts(
+                out, "enumeration", how, {"time_ratio": drag_link_tr_range(val["r1"], val["r2"], val["r4"], lo, hi)}
+            )
+        return result("partial", how)
     if cls is CrankShaper and tr is not None:
         ratio = crank_shaper_ratio(tr)
         lever = {"r4": stroke / (2 * ratio)} if stroke is not None and "r4" in free else {}
         yoke = "r6" not in fixed and "r6" not in free
         if yoke and stroke is not None and set(free) == {"r1", "r2", "r4"}:  # r1 walks the family, r4 fixed
-            for r1 in np.geomspace(max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1],
-                                   free["r2"][1] / ratio), FAMILY_POINTS):  # fmt: skip
+            for r1 in np.geomspace(
+                max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1], free["r2"][1] / ratio), FAMILY_POINTS
+            ):
                 emit(r1=float(r1), r2=float(ratio * r1), **lever)
             return result("family", "sin(beta) = r2/r1 fixes the TR; stroke = 2 r4 r2/r1; r1 walks the family")
         rod = "r6" in free and "h" not in free and stroke is not None and len(free) == 3 and "r4" in free
@@ -366,8 +405,11 @@ def warm_starts(problem) -> WarmStarts:
             for r6 in np.geomspace(*free["r6"], FAMILY_POINTS):
                 crank = {"r2": ratio * val["r1"]} if "r2" in free else {"r1": val["r2"] / ratio}
                 emit(**crank, **lever, r6=float(r6))
-            return result("family", "sin(beta) = r2/r1 fixes the TR and stroke = 2 r4 r2/r1 for every rod (a slider "
-                          "reversing once does so with the lever); the rod r6 walks the family")  # fmt: skip
+            return result(
+                "family",
+                "sin(beta) = r2/r1 fixes the TR and stroke = 2 r4 r2/r1 for every rod (a slider "
+                "reversing once does so with the lever); the rod r6 walks the family",
+            )
         if "r2" in free:
             emit(r2=ratio * val["r1"], **lever)
         elif "r1" in free:

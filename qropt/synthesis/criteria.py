@@ -105,8 +105,12 @@ class Criterion:
         raise NotImplementedError
 
     def to_nlp(self, v: float, omega2: float) -> float:
-        """A value as the NLP states it (at omega2 = 1)."""
-        return v
+        """A value as the NLP states it (at omega2 = 1), a quantity it minimises: negated where maximised."""
+        return -v if self.maximise else v
+
+    def from_nlp(self, y: float, omega2: float) -> float:
+        """The inverse of ``to_nlp``."""
+        return -y if self.maximise else y
 
     def violation(self, problem, m, bound: float) -> float:
         """How far m is past the bound (>= 0)."""
@@ -119,9 +123,18 @@ class Criterion:
         named kinematic outputs. [] where the measure is an explicit expression."""
         return []
 
+    def expression(self, f):
+        """The value as an expression of the Formulation f's parameters (``f.params``), for a criterion of the
+        parameters alone (no epigraph)."""
+        raise NotImplementedError(f"criterion {self.name!r} needs an expression or an epigraph")
+
     def measure(self, f, z: list):
-        """The criterion in the NLP's terms from its epigraph variables z (or f's parameters)."""
-        return z[0]
+        """The criterion in the NLP's terms (what it minimises): its first epigraph variable, or ``to_nlp`` of its
+        expression."""
+        if z:
+            return z[0]
+        e = self.expression(f)
+        return -e if self.maximise else e
 
     def lifts(self, f, role: Role) -> int:
         """How many lifted crank angles (decision variables with a stationarity row) it takes in this role."""
@@ -140,7 +153,8 @@ class Criterion:
         """As objective: the NLP value from z (or the NLP objective value_nlp), the exact one, and where to add
         samples when the gap exceeds gap_tol."""
         exact = self.value(problem, m)
-        return Exchange(value_nlp, exact, abs(exact - value_nlp) if value_nlp is not None else 0.0, [], [])
+        nlp = None if value_nlp is None else self.from_nlp(value_nlp, problem.omega2)
+        return Exchange(nlp, exact, abs(exact - nlp) if nlp is not None else 0.0, [], [])
 
     def exceeded(self, problem, m) -> tuple[list, list]:
         """Where to add samples when m breaks its bound: (angles, working-arc fractions)."""
@@ -211,12 +225,8 @@ class SizeSum(Criterion):
     def value(self, problem, m):
         return m.size("sum")
 
-    def measure(self, f, z):
+    def expression(self, f):
         return sum(f.params[k] for k in f.lengths)
-
-    def exchange(self, f, problem, m, z, value_nlp, gap_tol):
-        exact = self.value(problem, m)
-        return Exchange(value_nlp, exact, abs(exact - value_nlp) if value_nlp is not None else 0.0, [], [])
 
 
 class SizeLongest(SizeSum):
@@ -229,9 +239,6 @@ class SizeLongest(SizeSum):
 
     def epigraph(self, f):
         return [("longest link", [f.params[k] for k in f.lengths])]
-
-    def measure(self, f, z):
-        return z[0]
 
 
 class Footprint(Criterion):

@@ -1,9 +1,17 @@
-"""The diagnosis of a solve without a certified design: why, within a budget.
+"""The diagnosis of a solve without a certified design: why, within a stated budget.
 
-A target beyond the range the type reaches within the bounds, a bound condition beyond the best value of its
-criterion among designs that meet the targets, or nothing that meets everything together; a design meeting
-every target and condition found on the way turns the answer into 'failed' (the optimum was not reached), never
-'infeasible'.
+In order, each step only where the ones before said nothing:
+1. each bound condition against the best value of its criterion among designs that meet the targets (one solve
+   of that criterion, without diagnosis): a bound beyond it is 'infeasible', and that solve's designs that meet
+   every bound start one refinement of the problem;
+2. each target against its reachable range (``Solver.target_range``: sampled designs and RANGE_SOLVES local
+   solves): a target outside it is 'infeasible';
+3. a feasibility solve (no objective): a design meeting every target and condition found there starts one
+   refinement of the objective, and otherwise makes the answer 'failed' (the optimum was not reached), never
+   'infeasible';
+4. where the closed forms gave the starts, one space-filling search (they may have missed).
+Every solve here runs without diagnosis and with at most ``starts_n`` space-filling starts, so a diagnosis
+costs at most (bounds + 3) solves and 2 * RANGE_SOLVES local solves per target.
 """
 
 from __future__ import annotations
@@ -15,52 +23,69 @@ from qropt.synthesis import criteria
 from qropt.synthesis.backends import PROVES
 from qropt.synthesis.result import Result
 
+DIAGNOSIS_STARTS = 4  # space-filling starts of each solve a diagnosis runs
+RANGE_SOLVES = 4  # local solves for a target outside its sampled range, that push both ends out (two an end)
+
 
 class Diagnosis:
-    """Says why a solve found no certified design, with the Solver's parts (its multi-start and target ranges)."""
+    """Says why a solve found no certified design, with the Solver's parts (its solves and target ranges)."""
 
     def __init__(self, solver):
         self.solver = solver
 
-    def run(self, problem, cands, targets, starts_n, seed, stats, t0) -> Result:
-        """No certified design: say why (a target out of its reachable range, or nothing meets all together)."""
-        reasons = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
-        beyond, found = self.bound_out_of_reach(problem, targets, starts_n, seed)
-        if beyond:
+    def run(self, problem, plan, cands, claim, retry, targets, starts_n, seed, t0) -> Result:
+        """No certified design among ``cands`` (from ``plan``; ``retry``: the multi-start's second pass, or None):
+        the Result that says why."""
+        solve, n = self.solver.solve, min(starts_n, DIAGNOSIS_STARTS)
+
+        def done(status, msg, **kw):
+            stats = self.solver._stats(problem, cands, plan)
             stats["t_total"] = time.perf_counter() - t0
-            return Result("infeasible", beyond[0], stats=stats, reachable=beyond[1])
+            return Result(status, msg, stats=stats, **kw)
+
+        beyond, found = self.bound_out_of_reach(problem, targets, n, seed)
+        if beyond:
+            return done("infeasible", beyond[0], reachable=beyond[1])
         if found:  # a design optimising a bounded criterion meets every bound: refine from it
-            r = self.solver.solve(problem, targets=targets, starts_n=0, seed=seed, extra_starts=found, diagnose=False)
+            r = solve(problem, targets=targets, starts_n=0, seed=seed, extra_starts=found, diagnose=False)
             if r.success:
                 return r
-        if problem.objective and not found:  # is there any design at all? (then the objective's solves failed)
-            r = self.solver.solve(
-                problem.replace(objective=None), targets=targets, starts_n=starts_n, seed=seed, diagnose=False
-            )
-            found = [{k: r.params[k] for k in problem.free}] if r.success else []
-        reach, msgs = {}, []
-        for k, v in targets.items():
-            lo, hi = self.solver.target_range(problem, k, targets, starts_n=starts_n, seed=seed)
-            reach[k] = (lo, hi)
-            msgs.append(_range_message(problem, k, v, lo, hi))
-        stats["t_total"] = time.perf_counter() - t0
-        outside = [m for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True) if not _inside(targets[k], lo, hi)]
+        # a complete enumeration that gives no design proves there is none: its ranges are sampled only
+        proved = plan.kind == "enumeration" and not plan.analytic and not plan.outside
+        reach = self.solver.target_ranges(
+            problem, targets, list(targets), starts_n=n, seed=seed, solves=RANGE_SOLVES, toward=True
+        )
+        msgs = [range_message(problem, k, targets[k], lo, hi) for k, (lo, hi) in reach.items()]
+        outside = [m for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True) if not inside(targets[k], lo, hi)]
+        if proved:
+            why = f"no design: the closed form that gives every design ({plan.how}) gives none for these targets"
+            return done("infeasible", "; ".join([why, *msgs]), reachable=reach)
         if outside:
-            return Result("infeasible", "; ".join(outside), stats=stats, reachable=reach)
-        if all(
-            max(c.residuals.values(), default=0.0) > self.solver.tolerances["feasibility"] or c.mechanism is None
-            for c in cands
-        ):
+            return done("infeasible", "; ".join(outside), reachable=reach)
+        if retry is not None:  # the multi-start's second pass: every space-filling start both ways
+            cands = cands + retry()
+            if any(c.ok for c in cands):
+                return self.solver.best(problem, cands, claim, plan, t0)
+        if problem.objective and not found:  # is there any design at all? (then the objective's solves failed)
+            r = solve(problem.replace(objective=None), targets=targets, starts_n=n, seed=seed, diagnose=False)
+            found = [{k: r.params[k] for k in problem.free}] if r.success else []
+            if found:
+                r = solve(problem, targets=targets, starts_n=0, seed=seed, extra_starts=found, diagnose=False)
+                if r.success:
+                    return r
+        if plan.kind in ("family", "enumeration", "partial") and plan.analytic and not found:  # closed forms missed?
+            r = solve(problem, targets=targets, starts_n=starts_n, seed=seed, use_analytic=False, diagnose=False)
+            if r.success:
+                return r
+        feas = self.solver.tolerances["feasibility"]
+        if all(max(c.residuals.values(), default=0.0) > feas or c.mechanism is None for c in cands):
             ends: dict = {}
             for c in cands:
                 k = c.statuses[-1] if c.statuses else "no run"
                 ends[k] = ends.get(k, 0) + 1
-            proved = any(c.ends and c.ends[-1] in PROVES for c in cands)
             how = ", ".join(f"{n} {k}" for k, n in sorted(ends.items(), key=lambda kv: -kv[1]))
             msg = f"none of {len(cands)} starts reaches a design meeting the targets and conditions together "
-            msg += f"(IPOPT: {how}), though each target alone can be met (" + "; ".join(msgs) + ")"
-            # IPOPT's own failures (invalid numbers, iteration limits) prove nothing: only converged or
-            # infeasible-detected runs make the problem infeasible
+            msg += f"({self.solver.backend.name}: {how}), though each target alone can be met (" + "; ".join(msgs) + ")"
             if found:  # a design meeting every target and condition exists: the objective's solves failed
                 shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
                 msg += (
@@ -68,15 +93,18 @@ class Diagnosis:
                     " optimum was not reached (it may lie at a singular limit: a dead point, a link of zero "
                     "length or a bound)"
                 )
-                return Result("failed", msg, stats=stats, reachable=reach)
-            return Result("infeasible" if proved else "failed", msg, stats=stats, reachable=reach)
+                return done("failed", msg, reachable=reach)
+            # the backend's own failures (invalid numbers, iteration limits) prove nothing: only converged or
+            # infeasible-detected runs make the problem infeasible
+            proved = any(c.ends and c.ends[-1] in PROVES for c in cands)
+            return done("infeasible" if proved else "failed", msg, reachable=reach)
+        reasons = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
         why = "; ".join(r for r in reasons[:3] if r)
-        return Result(
-            "failed",
-            f"no start converged to a certified design ({why}); " + "; ".join(msgs),
-            stats=stats,
-            reachable=reach,
-        )
+        msg = f"no start converged to a certified design ({why}); " + "; ".join(msgs)
+        if found:
+            shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
+            msg += f"; a design meeting every target and condition: {shown}"
+        return done("failed", msg, reachable=reach)
 
     def bound_out_of_reach(self, problem, targets, starts_n, seed):
         """((message, {quantity: (low, high)}) if a bound condition is beyond what any design meeting the targets
@@ -87,13 +115,12 @@ class Diagnosis:
             bound = problem.conditions.get(key)
             if bound is None:
                 continue
-            quantity = c.name
             sub = problem.replace(
                 objective=c.objective,
                 size=c.size or problem.size,
                 conditions={k: v for k, v in problem.conditions.items() if k != key},
             )
-            r = self.solver.solve(sub, targets=targets, starts_n=starts_n, seed=seed)
+            r = self.solver.solve(sub, targets=targets, starts_n=starts_n, seed=seed, diagnose=False)
             if r.status not in ("optimal", "acceptable"):
                 continue
             tol = self.solver.tolerances["feasibility"]
@@ -112,22 +139,25 @@ class Diagnosis:
                     return f"{v:.6g} {c.unit}{deg}"
 
                 msg = (
-                    f"{key} {show(bound)} is beyond reach: the {word} {quantity} of a design meeting the "
+                    f"{key} {show(bound)} is beyond reach: the {word} {c.name} of a design meeting the "
                     f"targets and the other conditions is {show(best)} ({r.certificate.global_claim})"
                 )
-                return (msg, {quantity: span}), []
+                return (msg, {c.name: span}), []
         return None, found
 
 
-def _inside(v, lo, hi) -> bool:
+def inside(v, lo, hi) -> bool:
     """v within a found range, to 1e-6 relative: the range's ends are designs found, not proofs of an end."""
     tol = 1e-6 * max(1.0, abs(v))
     return lo - tol <= v <= hi + tol
 
 
-def _range_message(problem, k, v, lo, hi):
+def range_message(problem, k, v, lo, hi):
     bounds = ", ".join(f"{n} in [{a:g}, {b:g}]" for n, (a, b) in problem.free.items())
     if not math.isfinite(lo):
         return f"no design turns fully and meets the conditions for {bounds}"
-    where = "inside" if _inside(v, lo, hi) else "below" if v < lo else "above"
+    where = "inside" if inside(v, lo, hi) else "below" if v < lo else "above"
     return f"{k} {v:g} is {where} the reachable {lo:.6g}..{hi:.6g} for {bounds}"
+
+
+__all__ = ["Diagnosis", "DIAGNOSIS_STARTS", "inside", "range_message"]

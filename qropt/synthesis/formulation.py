@@ -477,6 +477,10 @@ class Formulation:
         f = casadi.Function(name, [self.w_sym, self.p_sym], [expr])
         return Batched(casadi.Function(name + "z", [z], [f(z[: self.w_sym.numel()], z[self.w_sym.numel() :])]))
 
+    def row_kind(self, name: str) -> RowKind | None:
+        """The kind of the rows named ``name`` (None for a name that is no row of this NLP)."""
+        return next((r.kind for r in self.rows if r.name == name), None)
+
     def violations(self, g) -> dict:
         """Named constraint violations (>= 0) of constraint values g, the formulation's own rows left out."""
         v = np.maximum(np.maximum(self.lbg - g, g - self.ubg), 0.0)

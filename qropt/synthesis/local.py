@@ -17,7 +17,8 @@ from qropt.synthesis.backends import CONVERGED, Status
 from qropt.synthesis.certificate import Designs, certify, residuals
 from qropt.synthesis.formulation import TWO_PI, Formulation
 
-RESTARTS = 2  # runs continued from their last iterate when they hit the iteration limit
+RESTARTS = 2  # runs continued from their last iterate when they hit the iteration limit near a design
+RESTART_VIOLATION = 1e-6  # ... that is, with no constraint violated by more than this
 
 
 @dataclass
@@ -132,9 +133,10 @@ class LocalSolve:
             m, info, add, frac = certify(
                 problem, form, c.values, branch, pt.theta, pt.z, run.f, gap_tol, feas_tol, designs
             )
-            if run.status is Status.ITERATION_LIMIT and restarts < RESTARTS and not range_target:
-                restarts += 1  # the iteration budget ran out on the way: go on from where it stopped
-                continue
+            if run.status is Status.ITERATION_LIMIT and restarts < RESTARTS:
+                if range_target or max(form.violations(g).values(), default=0.0) <= RESTART_VIOLATION:
+                    restarts += 1  # the iteration budget ran out on the way to an optimum: go on from there
+                    continue
             if not run.converged and not range_target:
                 break
             if not add and not frac:

@@ -25,8 +25,10 @@ class MultiStart:
     def __init__(self, local: LocalSolve):
         self.local = local
 
-    def candidates(self, problem, plan, extra, targets, starts_n, seed, max_rounds, designs):
-        """(candidates, claim, whether space-filling starts were used)."""
+    def candidates(self, problem, plan, extra, targets, starts_n, seed, max_rounds, designs, retry=True):
+        """(candidates, claim, the retry): where no space-filling start gives a certified design, the retry runs
+        each of them in both TR orientations; with ``retry`` it is run here (and None is returned), otherwise it
+        is returned as a callable (None where there is nothing to retry)."""
         runs = [("given", v) for v in extra]
         cands: list[Candidate] = []
         claim = ""
@@ -47,10 +49,16 @@ class MultiStart:
                 runs += [("analytic", v) for v in plan.analytic]
             runs += [("multistart", v) for v in starts_.sobol(problem, starts_n, seed, designs)]
         cands += self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
-        spread = any(o == "multistart" for o, *_ in runs)
-        if spread and not any(c.ok for c in cands):  # the other way of meeting the TR equality
-            cands += self.run(problem, [r for r in runs if r[0] == "multistart"], targets, max_rounds, designs, True)
-        return cands, claim, spread
+        spread = [r for r in runs if r[0] == "multistart"]
+        if not spread or any(c.ok for c in cands):
+            return cands, claim, None
+
+        def again():  # the other way of meeting the TR equality
+            return self.run(problem, spread, targets, max_rounds, designs, both_ways=True)
+
+        if retry:
+            return cands + again(), claim, None
+        return cands, claim, again
 
     def run(self, problem, runs, targets, max_rounds, designs, both_ways):
         """A local solve from every start; the incumbent's NLP value prunes starts that cannot beat it."""

@@ -20,13 +20,16 @@ from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import Ipopt, Status
 from qropt.synthesis.certificate import Certificate, Designs, objective_value, quantities
 from qropt.synthesis.diagnosis import Diagnosis
-from qropt.synthesis.formulation import BASE_SAMPLES, EXTRA_SAMPLES, Formulation
+from qropt.synthesis.formulation import BASE_SAMPLES, EXTRA_SAMPLES, Formulation, RowKind
 from qropt.synthesis.local import Candidate, Formulations, LocalSolve
 from qropt.synthesis.multistart import MultiStart, distinct
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import Result
 
 TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
+RANGE_SAMPLES = 64  # designs spread over the bounds whose exact target values start a reachable range
+RANGE_SOLVES = 4  # local solves that push a reachable range's ends out from the samples
+RANGE_FREE = (RowKind.DEAD_CENTRE, RowKind.ORIENTATION, RowKind.TARGET)  # rows a range's designs need not meet
 
 
 class Solver:
@@ -134,7 +137,9 @@ class Solver:
         )
         plan = starts_.plan(problem, use_analytic)
         designs = Designs()  # every mechanism this solve builds, built once
-        cands, claim, _ = self.multistart.candidates(problem, plan, extra, targets, starts_n, seed, max_rounds, designs)
+        cands, claim, retry = self.multistart.candidates(
+            problem, plan, extra, targets, starts_n, seed, max_rounds, designs, retry=not diagnose
+        )
         good = [c for c in cands if c.ok]
         if plan.kind == "enumeration" and not extra and not good and not diagnose:  # every design, none valid
             why = sorted({c.info.get("reason", "") or "it breaks a condition" for c in cands})
@@ -145,11 +150,25 @@ class Solver:
             return Result(
                 "infeasible", msg, stats={"plan": plan.kind, "starts": len(cands), "t_total": time.perf_counter() - t0}
             )
-        if plan.kind in ("family", "enumeration") and not extra and not good:
-            # no closed-form point refines (or the closed form missed): search instead
+        if plan.kind in ("family", "enumeration") and not extra and not good and not diagnose:
+            # no closed-form point refines (or the closed form missed): search instead (the diagnosis does this last)
             kw = {"starts_n": starts_n, "seed": seed, "targets": targets, "max_rounds": max_rounds}
-            return self.solve(problem, use_analytic=False, diagnose=diagnose, **kw)
-        stats = {
+            return self.solve(problem, use_analytic=False, diagnose=False, **kw)
+        if good:
+            return self.best(problem, cands, claim, plan, t0)
+        if not diagnose:
+            stats = self._stats(problem, cands, plan)
+            stats["t_total"] = time.perf_counter() - t0
+            why = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
+            return Result(
+                "failed",
+                f"no start gave a certified design ({'; '.join(w for w in why[:3] if w)}); not diagnosed",
+                stats=stats,
+            )
+        return self.diagnosis.run(problem, plan, cands, claim, retry, targets, starts_n, seed, t0)
+
+    def _stats(self, problem, cands, plan) -> dict:
+        return {
             "starts": len(cands),
             "plan": plan.kind,
             "omega2": problem.omega2,
@@ -158,6 +177,11 @@ class Solver:
             "iterations_total": sum(c.iterations for c in cands),
             "t_ipopt": sum(c.t_ipopt for c in cands),
         }
+
+    def best(self, problem, cands, claim, plan, t0) -> Result:
+        """The Result of the certified candidates among ``cands``, best first (with every distinct local optimum)."""
+        stats = self._stats(problem, cands, plan)
+        good = [c for c in cands if c.ok]
         if good:
             for c in good:
                 c.q = quantities(problem, c.mechanism)
@@ -173,15 +197,7 @@ class Solver:
                 self._result(problem, c, "local_optimum" if i else None, claim, stats) for i, c in enumerate(best_first)
             ]
             return self._result(problem, best_first[0], None, claim, stats, local)
-        if not diagnose:
-            stats["t_total"] = time.perf_counter() - t0
-            why = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
-            return Result(
-                "failed",
-                f"no start gave a certified design ({'; '.join(w for w in why[:3] if w)}); not diagnosed",
-                stats=stats,
-            )
-        return self.diagnosis.run(problem, cands, targets, starts_n, seed, stats, t0)
+        raise AssertionError("best() of candidates without a certified one")
 
     def _check(self, problem, targets, extra_starts, starts_n, seed, max_rounds):
         if not isinstance(problem, Problem):
@@ -251,50 +267,63 @@ class Solver:
         )
 
     # ---- reachable range of one target ---------------------------------------------------------------
-    def target_range(self, problem, target, targets=None, *, starts_n=None, seed=None):
-        """(low, high) of one target over the free bounds and conditions (other targets dropped).
-
-        Every value is that of a certified design: the optimised extremes and the start designs themselves.
-        (nan, nan) if no design turns fully.
-        """
-        starts_n = self.starts_n if starts_n is None else starts_n
-        seed = self.seed if seed is None else seed
+    def target_range(self, problem, target, targets=None, *, starts_n=None, seed=None, solves: int = RANGE_SOLVES):
+        """(low, high) of one target over the free bounds and conditions (other targets dropped); see
+        ``target_ranges``. (nan, nan) if no design turns fully."""
         targets = dict(problem.targets if targets is None else targets)
         if target not in targets:
             raise ProblemError(f"{target!r} is not a target of this problem ({sorted(targets)})")
-        sub = problem.replace(targets={target: targets[target]})
-        seen = []
+        return self.target_ranges(problem, targets, [target], starts_n=starts_n, seed=seed, solves=solves)[target]
 
-        def value(m):
-            return m.time_ratio() if target == "time_ratio" else m.stroke()
-
-        pts = list(starts_.plan(problem).analytic) + starts_.sobol(problem, starts_n, seed)
+    def target_ranges(
+        self, problem, targets, names, *, starts_n=None, seed=None, solves: int = RANGE_SOLVES, toward: bool = False
+    ):
+        """{target: (low, high)} over the free bounds and conditions, each target alone: the exact values of
+        RANGE_SAMPLES designs spread over the bounds (and the closed forms' points), built once for every target
+        (or the closed form's range where the plan has one),
+        then at most ``solves`` local solves per target that push it down and up from the samples nearest each
+        end (``toward``: only for a target outside the samples' range). Every value is that
+        of a design found, not a proof of an end; (nan, nan) where no design turns."""
+        starts_n = self.starts_n if starts_n is None else starts_n
+        seed = self.seed if seed is None else seed
+        plan = starts_.plan(problem)
+        exact = {k: plan.ranges[k] for k in names if k in plan.ranges}  # the closed form's own, where it has one
+        names = [k for k in names if k not in exact]
+        pts = list(plan.analytic) + starts_.rule_points(problem, max(RANGE_SAMPLES, starts_n), seed) if names else []
+        seen = []  # (mechanism, start values, branch)
         for v in pts:
             for br in starts_.branches(problem):
                 with contextlib.suppress(QroptError):
-                    seen.append(value(problem.build(v, br)))
-        for sense in (1, -1):
-            for v in pts:
-                for br in starts_.branches(problem):
-                    for way in (1, -1):
-                        c = self.local(
-                            sub,
-                            v,
-                            br,
-                            {target: targets[target]},
-                            orientation=way,
-                            max_rounds=3,
-                            range_target=target,
-                            sense=sense,
-                        )
-                        m = c.mechanism
-                        internal = ("dead centre", "time_ratio orientation")
-                        conditions = [x for k, x in c.residuals.items() if not k.startswith(internal)]
-                        if m is not None and m.dead_centres().reversals == 1 and max(conditions, default=0.0) <= 1e-9:
-                            seen.append(value(m))  # the exact value of a design that meets every condition
-        if not seen:
-            return float("nan"), float("nan")
-        return float(min(seen)), float(max(seen))
+                    m = problem.build(v, br)
+                    if m.dead_centres().reversals == 1:
+                        seen.append((m, v, br))
+        out = dict(exact)
+        for target in names:
+            if not seen:
+                out[target] = (math.nan, math.nan)
+                continue
+
+            def value(m, target=target):
+                return m.time_ratio() if target == "time_ratio" else m.stroke()
+
+            values = [value(m) for m, _, _ in seen]
+            sub = problem.replace(targets={target: targets[target]})
+            per_end = solves // 2
+            if toward and min(values) <= targets[target] <= max(values):
+                out[target] = (float(min(values)), float(max(values)))  # inside the samples: nothing to push
+                continue
+            for sense in (1, -1):  # minimise, then maximise, from the samples nearest that end
+                for _, v, br in sorted(seen, key=lambda s, sense=sense: sense * value(s[0]))[:per_end]:
+                    c = self.local(
+                        sub, v, br, {target: targets[target]}, max_rounds=3, range_target=target, sense=sense
+                    )
+                    form = self.formulation(sub, br, c.orientation, target, sense)
+                    m = c.mechanism
+                    conditions = [x for k, x in c.residuals.items() if form.row_kind(k) not in RANGE_FREE]
+                    if m is not None and m.dead_centres().reversals == 1 and max(conditions, default=0.0) <= 1e-9:
+                        values.append(value(m))  # the exact value of a design that meets every condition
+            out[target] = (float(min(values)), float(max(values)))
+        return out
 
 
 def _positive(v) -> bool:

@@ -7,7 +7,7 @@ that walks a family holding every solution is scanned and only its best points a
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -25,6 +25,7 @@ class Plan:
     kind: str
     how: str
     outside: int = 0  # closed-form points of an enumeration left out as outside the bounds
+    ranges: dict = field(default_factory=dict)  # target -> (low, high) over the bounds, by the closed form
 
 
 def _build(problem, values, branch):
@@ -48,47 +49,50 @@ def plan(problem, use_analytic: bool = True) -> Plan:
 
     if w.kind == "enumeration":  # every design: one outside the bounds is no start, it is not a design here
         inside = [v for v in w.points if all(lo <= v[k] <= hi for k, (lo, hi) in problem.free.items())]
-        return Plan(tuple(inside), w.kind, w.how, len(w.points) - len(inside))
+        return Plan(tuple(inside), w.kind, w.how, len(w.points) - len(inside), dict(w.ranges))
     return Plan(tuple(clip(v) for v in w.points), w.kind, w.how)
 
 
 POOL = 64  # Sobol points drawn per start wanted: the type's rules (one vectorised check) thin them first
 
 
-def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
-    """Up to n scrambled-Sobol points over the free bounds (log-spaced for lengths) whose mechanism turns fully
-    on the first branch; if none does among POOL * n, the first n points as they are. The points that break
-    the type's rules (Grashof class, crank shorter than the centres and the like) are dropped before any is
-    built. Where every length and offset is free, each point is scaled to meet the stroke target (TR and angles
-    do not change with scale) when the scaled point stays inside the bounds."""
-    if n <= 0:
-        return []
+def rule_points(problem, n: int, seed: int) -> list[dict]:
+    """Scrambled-Sobol points over the free bounds (log-spaced for lengths), a power of two of them at least n,
+    with the points that break the type's rules (Grashof class, crank shorter than the centres and the like)
+    dropped in one vectorised check; none is built."""
     from scipy.stats import qmc  # imported here: scipy.stats takes a second to import
 
     names = list(problem.free)
-    kept = []
-    branch = branches(problem)[0]
-    build = build or _build
-    u = qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(max(0, POOL * n - 1).bit_length())
+    u = qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(max(0, n - 1).bit_length())
     cols = {}
     for j, k in enumerate(names):
         lo, hi = problem.free[k]
         cols[k] = lo * (hi / lo) ** u[:, j] if k in problem.mechanism.LENGTHS and lo > 0 else lo + (hi - lo) * u[:, j]
-    p = {**problem.fixed, **cols, **branch}
+    p = {**problem.fixed, **cols, **branches(problem)[0]}
     ok = np.ones(u.shape[0], bool)
     for rule in problem.mechanism.rules(NUMPY, p, problem.conditions.get("grashof")):
         ok &= np.broadcast_to(np.asarray(rule.value) >= 0, ok.shape)
+    return [{k: float(cols[k][i]) for k in names} for i in np.flatnonzero(ok).tolist()] or [
+        {k: float(cols[k][i]) for k in names} for i in range(min(n, u.shape[0]))
+    ]
 
-    def point(i):
-        return {k: float(cols[k][i]) for k in names}
 
-    for i in np.flatnonzero(ok).tolist():
-        v = point(i)
+def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
+    """Up to n of the ``rule_points`` (POOL * n drawn) whose mechanism turns fully on the first branch; if none
+    does, the first n points as they are. Where every length and offset is free, each point is scaled to meet
+    the stroke target (TR and angles do not change with scale) when the scaled point stays inside the bounds."""
+    if n <= 0:
+        return []
+    branch = branches(problem)[0]
+    build = build or _build
+    pts = rule_points(problem, POOL * n, seed)
+    kept = []
+    for v in pts:
         if orientation(problem, v, branch, build) is not None:
             kept.append(_to_stroke(problem, v, branch, build))
             if len(kept) == n:
                 break
-    return kept or [point(i) for i in range(n)]
+    return kept or pts[:n]
 
 
 def _to_stroke(problem, values, branch, build) -> dict:
