@@ -82,7 +82,7 @@ def drag_link_tr_range(r1: float, r2: float, r4: float, r3_lo: float, r3_hi: flo
         lo_, hi_ = r3[max(i - 1, 0)], r3[min(i + 1, r3.size - 1)]
         if hi_ > lo_:
             res = minimize_scalar(
-                lambda x: sign * paper_time_ratio(r1, r2, x, r4),
+                lambda x, sign=sign: sign * paper_time_ratio(r1, r2, x, r4),
                 bounds=(lo_, hi_),
                 method="bounded",
                 options={"xatol": 1e-13},

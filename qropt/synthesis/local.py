@@ -133,10 +133,10 @@ class LocalSolve:
             m, info, add, frac = certify(
                 problem, form, c.values, branch, pt.theta, pt.z, run.f, gap_tol, feas_tol, designs
             )
-            if run.status is Status.ITERATION_LIMIT and restarts < RESTARTS:
-                if range_target or max(form.violations(g).values(), default=0.0) <= RESTART_VIOLATION:
-                    restarts += 1  # the iteration budget ran out on the way to an optimum: go on from there
-                    continue
+            near = range_target or max(form.violations(g).values(), default=0.0) <= RESTART_VIOLATION
+            if run.status is Status.ITERATION_LIMIT and restarts < RESTARTS and near:
+                restarts += 1  # the iteration budget ran out on the way to an optimum: go on from there
+                continue
             if not run.converged and not range_target:
                 break
             if not add and not frac:

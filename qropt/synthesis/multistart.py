@@ -119,14 +119,14 @@ def score(problem, values, branch, build):
 
 
 def distinct(cands):
-    """Candidates that differ from every earlier one (another branch, or values apart by more than 1e-6
-    relative)."""
+    """Candidates that differ from every earlier one (another branch, or values apart by more than 1e-6 of the
+    largest value: the test is the same at every scale)."""
     out = []
     for c in cands:
         v = np.array([c.values[k] for k in sorted(c.values)])
+        scale = max(float(np.max(np.abs(v))), np.finfo(float).tiny)
         if all(
-            c.branch != o.branch
-            or np.max(np.abs(v - np.array([o.values[k] for k in sorted(o.values)])) / np.maximum(1, np.abs(v))) > 1e-6
+            c.branch != o.branch or np.max(np.abs(v - np.array([o.values[k] for k in sorted(o.values)]))) > 1e-6 * scale
             for o in out
         ):
             out.append(c)

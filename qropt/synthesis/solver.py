@@ -9,13 +9,14 @@ Where no start gives a certified design, the diagnosis (``diagnosis``) says why 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import time
 
 import numpy as np
 
 from qropt.errors import ProblemError, QroptError
-from qropt.synthesis import criteria
+from qropt.synthesis import criteria, scaling
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import Ipopt, Status
 from qropt.synthesis.certificate import Certificate, Designs, objective_value, quantities
@@ -135,6 +136,23 @@ class Solver:
         problem, targets, extra, starts_n, seed, max_rounds = self._check(
             problem, targets, extra_starts, starts_n, seed, max_rounds
         )
+        k = scaling.factor(problem)
+        if k != 1.0:  # far from unit scale: solved at unit scale (the tolerances are absolute), scaled back
+            r = self.solve(
+                scaling.scaled(problem, k),
+                starts_n=starts_n,
+                use_analytic=use_analytic,
+                seed=seed,
+                max_rounds=max_rounds,
+                extra_starts=[{n: v * k for n, v in e.items()} for e in extra],
+                diagnose=diagnose,
+            )
+            r = scaling.unscaled(r, problem, k)
+            if not r.success:
+                r = dataclasses.replace(
+                    r, message=f"{r.message} (lengths in this message are {k:g} times the problem's)"
+                )
+            return r
         plan = starts_.plan(problem, use_analytic)
         designs = Designs()  # every mechanism this solve builds, built once
         cands, claim, retry = self.multistart.candidates(
