@@ -335,7 +335,7 @@ def test_the_table_csv_json_and_picture(comparison, tmp_path):
         rows = list(csv.DictReader(fh))
     assert float(rows[0]["gamma_min"]) == pytest.approx(t[0]["gamma_min"], rel=1e-11)
     d = json.loads(comparison.to_json())
-    assert d["rows"][0]["type"] == t[0]["type"] and d["units"]["peak_velocity"] == "length/s"
+    assert d["rows"][0]["type"] == t[0]["type"] and d["units"]["peak_velocity"] == "m/s"
     comparison.plot(tmp_path / "c.png")
     assert (tmp_path / "c.png").stat().st_size > 10_000
     assert len(repr(comparison).splitlines()) == len(TYPES) + 1

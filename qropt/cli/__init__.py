@@ -14,6 +14,7 @@ import sys
 
 import numpy as np
 
+from qropt import units as units_
 from qropt.errors import QroptError
 from qropt.mechanisms import REGISTRY, Mechanism, mechanism_type
 from qropt.synthesis import criteria
@@ -68,21 +69,35 @@ def picture_path(path: str) -> str:
     return path
 
 
+def units_argument(parser, what: str = "the design's length unit") -> None:
+    """--units: one of qropt.units.LENGTH_UNITS."""
+    parser.add_argument("--units", choices=list(units_.LENGTH_UNITS), help=f"{what} (default: m)")
+
+
+def stated(m: Mechanism, units: str | None, where: str) -> Mechanism:
+    """m, whose unit is stated (a design file's, or the built-in design's metres): --units may repeat it, never
+    contradict it."""
+    if units is not None and units != m.units:
+        raise CliError(f"--units {units} contradicts {where}, which is in {m.units}")
+    return m
+
+
 def build_mechanism(args) -> Mechanism:
     given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
+    units = getattr(args, "units", None)
     if getattr(args, "design", None):
         if given or args.type is not None:
             raise CliError("--from reads the whole design: give no TYPE or parameters with it")
         from qropt.io.export import load_design
 
-        return load_design(args.design)
+        return stated(load_design(args.design), units, f"the design file {args.design}")
     if args.type is None:
         if given:
             raise CliError("give the mechanism TYPE before its parameters (types: " + ", ".join(sorted(REGISTRY)) + ")")
         from qropt.examples import paper_mechanism
 
-        return paper_mechanism()
-    return mechanism_type(args.type)(**given)
+        return stated(paper_mechanism(), units, "the built-in paper design")
+    return mechanism_type(args.type)(**given, units=units or units_.DEFAULT)
 
 
 def analysis_report(m: Mechanism, theta2: float, omega2: float, alpha2: float) -> dict:
@@ -93,6 +108,7 @@ def analysis_report(m: Mechanism, theta2: float, omega2: float, alpha2: float) -
     out = {
         "type": m.KIND,
         "params": dict(m.params),
+        "units": m.units,
         "time_ratio": m.time_ratio(),
         "stroke": m.stroke(),
         "dead_centres": {
@@ -129,8 +145,9 @@ def analysis_report(m: Mechanism, theta2: float, omega2: float, alpha2: float) -
 
 def print_report(r: dict, out=None):
     w = (out or sys.stdout).write
-    out_name = "follower theta4 [rad]" if r["type"] == "four-bar" else "slider x"
-    w(f"{r['type']}: " + ", ".join(f"{k}={v:g}" for k, v in r["params"].items()) + "\n")
+    u = r.get("units", units_.DEFAULT)
+    out_name = "follower theta4 [rad]" if r["type"] == "four-bar" else f"slider x [{u}]"
+    w(f"{r['type']} ({u}): " + ", ".join(f"{k}={v:g}" for k, v in r["params"].items()) + "\n")
     if "grashof" in r:
         g = r["grashof"]
         w(
@@ -142,7 +159,7 @@ def print_report(r: dict, out=None):
     if r["type"] == "four-bar":
         w(f"  swing             {math.degrees(r['stroke']):.6f} deg\n")
     else:
-        w(f"  stroke            {r['stroke']:.10g} (length units)\n")
+        w(f"  stroke            {r['stroke']:.10g} {u}\n")
     w(
         f"  dead centres      theta_max = {d['theta_max_deg']:.6f} deg ({out_name} = {d['x_max']:.10g}); "
         f"theta_min = {d['theta_min_deg']:.6f} deg ({d['x_min']:.10g})\n"
@@ -159,7 +176,7 @@ def print_report(r: dict, out=None):
     if r["type"] == "four-bar":
         w(f"    follower: theta4 = {s['x']:.6g} rad, omega4 = {s['v']:.6g} rad/s, alpha4 = {s['a']:.6g} rad/s^2\n")
     else:
-        w(f"    slider: x = {s['x']:.6g} length, v = {s['v']:.6g} length/s, a = {s['a']:.6g} length/s^2\n")
+        w(f"    slider: x = {s['x']:.6g} {u}, v = {s['v']:.6g} {u}/s, a = {s['a']:.6g} {u}/s^2\n")
     for k, v in s["links"].items():
         w(
             f"    {k:7s} = {v['angle_deg']:11.5f} deg   omega = {v['omega']:11.5g} rad/s   "
@@ -168,7 +185,8 @@ def print_report(r: dict, out=None):
 
 
 def write_table(m: Mechanism, step: float, omega2: float, alpha2: float, path: str):
-    """Full-cycle table at crank-angle steps (rad): every joint, link angle, x, v, a, transmission angle."""
+    """Full-cycle table at crank-angle steps (rad): every joint, link angle, x, v, a, transmission angle, and the
+    length unit of the joints and the slider (x, v, a: unit, unit/s, unit/s^2) in a last column "units"."""
     n = max(1, round(2 * math.pi / step))
     th = np.linspace(0.0, 2 * math.pi, n + 1)
     pos, mo, tr = m.positions(th), m.motion(th, omega2, alpha2), m.transmission_angles(th)
@@ -183,9 +201,9 @@ def write_table(m: Mechanism, step: float, omega2: float, alpha2: float, path: s
     f = sys.stdout if path == "-" else open(path, "w", newline="")  # noqa: SIM115
     try:
         wr = csv.writer(f)
-        wr.writerow(cols)
+        wr.writerow([*cols, "units"])
         for i in range(th.size):
-            wr.writerow([f"{cols[c][i]:.12g}" for c in cols])
+            wr.writerow([*(f"{cols[c][i]:.12g}" for c in cols), m.units])
     finally:
         if f is not sys.stdout:
             f.close()
@@ -263,6 +281,7 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("--csv", help="file for the full-cycle table ('-' for standard output)")
     a.add_argument("--plot", help="PNG file: mechanism at theta2 beside x, v, a over the cycle")
     a.add_argument("--from", dest="design", help="a design file (qropt synth --save, or --json output) to analyse")
+    units_argument(a, "the length unit of the parameters (a design file states its own; --units may repeat it)")
     _export_arguments(a)
     a.set_defaults(run=cmd_analyze)
     s = sub.add_parser("synth", help="solve a synthesis problem file (build() -> Problem)")
@@ -297,6 +316,7 @@ def parser() -> argparse.ArgumentParser:
     )
     r.add_argument("--json", action="store_true", help="print JSON")
     r.add_argument("--plot", help="PNG file: TR against the parameter (the paper's Fig. 5)")
+    units_argument(r, "the length unit of the parameters")
     r.set_defaults(run=cmd_reachable)
     sub.add_parser("bench", help="the benchmark suite, from the repository root (options: qropt bench --help)")
     for info in pkgutil.iter_modules(__path__):
@@ -340,12 +360,14 @@ def cmd_family(args):
             "ends": [{"branch": e.branch, "side": e.side, "reason": e.reason, "params": e.params} for e in fam.ends],
             "folds": fam.folds,
             "best": best.to_dict(),
+            "units": problem.units,
         }
         json.dump(out, sys.stdout, indent=2, default=str)
         sys.stdout.write("\n")
     else:
         free = list(problem.free)
-        print(f"{problem.name or args.problem}: {len(fam.branches)} branch(es), {sum(map(len, fam.branches))} points")
+        print(f"{problem.name or args.problem}: {len(fam.branches)} branch(es), {sum(map(len, fam.branches))} points "
+              f"(lengths in {problem.units})")  # fmt: skip
         for e in fam.ends:
             at = ", ".join(f"{k}={e.params[k]:.10g}" for k in free)
             print(f"  branch {e.branch + 1} {'start' if e.side == 0 else 'end'}: {at}  ({e.reason})")
@@ -357,7 +379,7 @@ def cmd_family(args):
         with open(args.csv, "w", newline="") as fh:
             w = csv.writer(fh)
             head = ["branch", "arclength", *problem.free, "theta_max_deg", "theta_min_deg", "time_ratio", "stroke",
-                    "gamma_min_deg", "peak_accel", "grashof"]  # fmt: skip
+                    "gamma_min_deg", "peak_accel", "grashof", "units"]  # fmt: skip
             w.writerow(head)
             bar = progress_bar("exact quantities", total=sum(map(len, fam.branches)))
             for b, pts in enumerate(fam.branches):
@@ -367,7 +389,7 @@ def cmd_family(args):
                     w.writerow([b + 1, f"{p.arclength:.12g}", *(f"{p.params[k]:.15g}" for k in problem.free),
                                 *(f"{math.degrees(t):.12g}" for t in p.theta), q.get("time_ratio"),
                                 q.get("stroke", q.get("swing")), math.degrees(q["gamma_min"]) if q else None,
-                                q.get("peak_accel"), q.get("grashof")])  # fmt: skip
+                                q.get("peak_accel"), q.get("grashof"), problem.units])  # fmt: skip
             bar.close()
     if args.plot:
         from qropt.io import plots
@@ -382,11 +404,11 @@ def cmd_reachable(args):
     if args.type is None and not given:
         from qropt.examples import paper_mechanism
 
-        m = paper_mechanism()
+        m = stated(paper_mechanism(), args.units, "the built-in paper design")
     elif args.type is None:
         raise CliError("give the mechanism TYPE before its parameters")
     else:
-        m = mechanism_type(args.type)(**given)
+        m = mechanism_type(args.type)(**given, units=args.units or units_.DEFAULT)
     with progress_bar(f"scanning {args.free}", total=301) as bar:
         r = reachable(m, args.free, tuple(args.bounds) if args.bounds else None, progress=bar.update)
     tmin, xmin, tmax, xmax = r.time_ratio_range
@@ -398,7 +420,7 @@ def cmd_reachable(args):
     adj = r.adjustable(low, high)
     counts = {t: r.solutions(t) for t in args.tr}
     if args.json:
-        out = {"free": args.free, "intervals": r.intervals, "time_ratio_range": r.time_ratio_range,
+        out = {"free": args.free, "units": m.units, "intervals": r.intervals, "time_ratio_range": r.time_ratio_range,
                "stroke_range": r.stroke_range, "solutions": {str(k): v for k, v in counts.items()},
                "adjustable": {"time_ratios": [low, high], "interval": adj.interval,
                               "worst_gamma_min_deg": math.degrees(adj.gamma_min),
@@ -406,10 +428,12 @@ def cmd_reachable(args):
         json.dump(out, sys.stdout, indent=2, default=float, allow_nan=False)
         sys.stdout.write("\n")
     else:
-        print(f"{type(m).__name__}: {args.free} varies, the rest as given")
-        print("  feasible " + " and ".join(f"{args.free} in [{a:.10g}, {b:.10g}]" for a, b in r.intervals))
-        print(f"  time ratio {tmin:.10g} (at {args.free} = {xmin:.10g}) .. {tmax:.10g} (at {args.free} = {xmax:.10g})")
-        print(f"  stroke {r.stroke_range.low:.10g} .. {r.stroke_range.high:.10g}")
+        u = m.units
+        print(f"{type(m).__name__}: {args.free} varies, the rest as given (lengths in {u})")
+        print("  feasible " + " and ".join(f"{args.free} in [{a:.10g}, {b:.10g}] {u}" for a, b in r.intervals))
+        print(f"  time ratio {tmin:.10g} (at {args.free} = {xmin:.10g} {u}) .. {tmax:.10g} "
+              f"(at {args.free} = {xmax:.10g} {u})")  # fmt: skip
+        print(f"  stroke {r.stroke_range.low:.10g} .. {r.stroke_range.high:.10g} {u}")
         for t, xs in counts.items():
             print(f"  TR {t:g}: {len(xs)} design(s)" + (": " + ", ".join(f"{x:.10g}" for x in xs) if xs else ""))
         print(f"  adjustable {args.free}: {adj.explanation}")
@@ -495,7 +519,8 @@ def cmd_synth(args):
         print(f"{problem.name or args.problem}: {problem.mechanism.KIND}, objective {problem.objective}")
         print(r.summary())
         for k, (lo, hi) in r.reachable.items():
-            print(f"reachable {k}: {lo:.10g} .. {hi:.10g}")
+            unit = {"stroke": f" {problem.units}", "swing": " rad"}.get(k, "")
+            print(f"reachable {k}: {lo:.10g} .. {hi:.10g}{unit}")
         if r.local_optima:
             print(f"local optima ({len(r.local_optima)}):")
             for o in r.local_optima:
@@ -530,6 +555,9 @@ def main(argv=None) -> int:
         return 2
     except QroptError as e:
         print(f"qropt: {type(e).__name__}: {e}", file=sys.stderr)
+        return 1
+    except RecursionError:  # a file nested too deeply for Python's parsers, wherever it was read
+        print("qropt: error: an input is nested too deeply to read", file=sys.stderr)
         return 1
     except BrokenPipeError:
         sys.stderr.close()

@@ -9,7 +9,8 @@ import math
 import numpy as np
 
 import qropt.cli as cli
-from qropt.synthesis.criteria import maximises
+from qropt.synthesis.criteria import maximises, of_problem
+from qropt.units import named
 
 COMMAND = "chart"
 HELP = "solve a problem file over a grid of time ratios, strokes, swings or fixed parameters (a design chart)"
@@ -117,7 +118,7 @@ def summary(ch) -> list[str]:
         at = ", ".join(f"{a.name} {math.degrees(a.values[k]) if a.name == 'swing' else a.values[k]:.6g}"
                        for a, k in ((ch.x, c.i), (ch.y, c.j)) if a)  # fmt: skip
         design = ", ".join(f"{k}={c.params[k]:.6g}" for k in p.free)
-        unit = " deg" if deg else ""
+        unit = " deg" if deg else f" {named(of_problem(p).unit, p.units)}" if p.objective else ""
         lines.append(f"objective {lo:.6g}..{hi:.6g}{unit}; best at {at}: {design}")
     bad = [c for c in ch.cells if not c.success]
     lines += [f"  no design at cell ({c.i}, {c.j}): {c.message}" for c in bad[:5]]

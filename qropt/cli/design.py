@@ -13,9 +13,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from qropt.cli import real
     from qropt.studies._design import TYPES
     from qropt.synthesis import criteria
+    from qropt.units import LENGTH_UNITS
 
     parser.add_argument("--tr", type=real, required=True, help="time ratio (slow/fast, >= 1)")
-    parser.add_argument("--stroke", type=real, required=True, help="slider stroke [length]")
+    parser.add_argument("--stroke", type=real, required=True, help="slider stroke [in --units]")
+    parser.add_argument("--units", default="m", choices=list(LENGTH_UNITS),
+                        help="the length unit of the stroke, the bounds and the answer (default m)")  # fmt: skip
     parser.add_argument("--objective", default="max_gamma_min", choices=[o for o in criteria.objectives() if o])
     parser.add_argument("--size", default="footprint", choices=["sum", "longest", "footprint"],
                         help="size measure of min_size (default footprint)")  # fmt: skip
@@ -36,7 +39,7 @@ def bound_flags(parser) -> None:
 
     for key, c in criteria.bounds().items():
         side = "lower" if c.maximise else "upper"
-        unit = "e.g. 40deg" if c.unit == "rad" else c.unit
+        unit = "e.g. 40deg" if c.unit == "rad" else c.unit.replace("length", "the length unit")
         parser.add_argument(
             c.flag, dest=key, type=angle if c.unit == "rad" else real, help=f"{side} bound on {c.name} [{unit}]"
         )
@@ -58,7 +61,8 @@ def run(args) -> int:
     with progress_bar("types", total=n_types, unit="type") as bar:
         cmp = design(args.tr, args.stroke, objective=args.objective, types=args.types, size=args.size,
                      conditions=conditions_of(args), omega2=args.omega2,
-                     pareto=tuple(args.pareto) if args.pareto else None, n=args.n, progress=bar.update)  # fmt: skip
+                     pareto=tuple(args.pareto) if args.pareto else None, n=args.n, progress=bar.update,
+                     units=args.units)  # fmt: skip
     if args.csv:
         cmp.to_csv(args.csv)
     if plot:
@@ -67,11 +71,12 @@ def run(args) -> int:
     if args.json:
         print(cmp.to_json())
         return code
-    print(f"TR {args.tr:g}, stroke {args.stroke:g}, omega2 {args.omega2:g} rad/s: best by {args.objective} first")
+    u = cmp.units
+    print(f"TR {args.tr:g}, stroke {args.stroke:g} {u}, omega2 {args.omega2:g} rad/s: best by {args.objective} first")
     print(f"  {'type':20s} {'gamma_min':>10s} {'footprint':>11s} {'sum':>8s} {'peak accel':>11s} "
           f"{'peak v':>9s} {'T/F':>8s}")  # fmt: skip
-    print(f"  {'':20s} {'[deg]':>10s} {'[length^2]':>11s} {'[length]':>8s} {'[l/s^2]':>11s} {'[l/s]':>9s} "
-          f"{'[l]':>8s}")  # fmt: skip
+    print(f"  {'':20s} {'[deg]':>10s} {f'[{u}^2]':>11s} {f'[{u}]':>8s} {f'[{u}/s^2]':>11s} {f'[{u}/s]':>9s} "
+          f"{f'[{u}]':>8s}")  # fmt: skip
     for r in cmp.rows:
         if not r.success:
             print(f"  {r.type:20s} no design: {r.reason}")
@@ -79,7 +84,7 @@ def run(args) -> int:
         c = r.criteria
         print(f"  {r.type:20s} {math.degrees(c['gamma_min']):10.3f} {c['footprint']:11.4g} {c['sum']:8.4g} "
               f"{c['peak_accel']:11.4g} {c['peak_velocity']:9.4g} {c['torque_per_newton']:8.4g}")  # fmt: skip
-    print("  (T/F: peak crank torque per newton of cutting force; l: the stroke's length unit)")
+    print(f"  (T/F: peak crank torque per newton of cutting force, N {u} per N)")
     if args.csv:
         print(f"table written to {args.csv}")
     if plot:

@@ -37,7 +37,7 @@ def run(args) -> int:
     print(f"{problem.name or args.problem}: {front.objectives[0]} vs {front.objectives[1]}, "
           f"{len(front.points)} non-dominated points")  # fmt: skip
     for va, vb in front.values:
-        print(f"  {_show(a, va)}   {_show(b, vb)}")
+        print(f"  {_show(a, va, problem.units)}   {_show(b, vb, problem.units)}")
     for eps, why in front.removed:
         print(f"  removed (bound {eps if eps is None else format(eps, '.6g')}): {why}")
     if args.csv:
@@ -49,8 +49,9 @@ def run(args) -> int:
     return 0
 
 
-def _show(q, v):
+def _show(q, v, length: str):
     from qropt.synthesis.criteria import CRITERIA
+    from qropt.units import named
 
-    unit = CRITERIA[q].unit
+    unit = named(CRITERIA[q].unit, length)
     return f"{q} {math.degrees(v):.4f} deg" if unit == "rad" else f"{q} {v:.6g} {unit}"

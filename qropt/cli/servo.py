@@ -18,8 +18,9 @@ COMMAND = "servo"
 HELP = "fastest crank-speed profile of a servo-driven crank within speed, acceleration and torque limits"
 PARAM_NAMES = ("r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider")
 LIMITS = ("omega_max", "alpha_max", "v_max", "a_max", "v_cut", "force", "inertia", "torque_max")
-UNITS = {"omega_max": "rad/s", "alpha_max": "rad/s^2", "v_max": "length/s", "a_max": "length/s^2",
-         "v_cut": "length/s", "force": "N", "inertia": "kg m^2", "torque_max": "N*length"}  # fmt: skip
+UNITS = {"omega_max": "rad/s", "alpha_max": "rad/s^2", "v_max": "m/s", "a_max": "m/s^2",
+         "v_cut": "m/s", "force": "N", "inertia": "kg m^2", "torque_max": "N m"}  # fmt: skip
+# the servo's dynamics add force x length to inertia x alpha: its designs are given in metres (SI) only
 
 
 def add_mechanism_arguments(parser: argparse.ArgumentParser) -> None:
@@ -107,7 +108,7 @@ def run(args) -> int:
             print(f"  time ratio        {p.time_ratio:.6f}; {c.time_ratio:.6f} at constant speed")
             if p.peak_torque is not None:
                 ref = "" if c.peak_torque is None else f"; {c.peak_torque:.6g} at constant speed"
-                print(f"  peak torque       {p.peak_torque:.6g} N*length{ref}")
+                print(f"  peak torque       {p.peak_torque:.6g} N m{ref}")
             print("  largest excess    " + ", ".join(f"{k} {v:+.2e}" for k, v in r["excess"].items())
                   + " (relative, exact simulation 10x finer)")  # fmt: skip
     if p.time is not None and args.csv:

@@ -9,14 +9,15 @@ import math
 import sys
 from pathlib import Path
 
+from qropt import units as units_
 from qropt.convex.tolerance import QUANTITIES, allocate
-from qropt.errors import InvalidParameter
+from qropt.errors import InvalidParameter, QroptError
 from qropt.mechanisms import REGISTRY, mechanism_type
 
 COMMAND = "tolerance"
 HELP = "exact sensitivities and the largest tolerances keeping TR, stroke, gamma_min within limits"
 PARAM_NAMES = ("r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider")
-LENGTH_UNITS = {"um": 1e-6, "mm": 1e-3, "cm": 1e-2, "m": 1.0}  # in metres
+LENGTH_UNITS = {u: units_.LENGTH_UNITS[u] for u in ("um", "mm", "cm", "m")}  # a limit's suffixes, in metres
 ANGLE_UNITS = {"deg": math.pi / 180, "rad": 1.0}
 PAPER_UNIT = "m"  # the paper's mechanism (the default design) is given in metres
 
@@ -24,7 +25,8 @@ PAPER_UNIT = "m"  # the paper's mechanism (the default design) is given in metre
 def limit(text: str) -> tuple[str, float, str | None]:
     """'QUANTITY=VALUE[unit]' -> (quantity, value, unit or None). time_ratio is dimensionless (no unit); gamma_min
     takes deg or rad (a plain number is rad); stroke takes um, mm, cm or m, converted in ``run`` to the design's
-    length unit (a plain number is in the design's unit); peak_acceleration is a plain number (length/s^2)."""
+    length unit (a plain number is in the design's unit); peak_acceleration is a plain number (the design's
+    length unit/s^2)."""
     name, sep, value = text.partition("=")
     name = name.strip()
     if not sep or name not in QUANTITIES:
@@ -68,13 +70,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         required=True,
         metavar="QUANTITY=VALUE",
         help="allowed deviation, once per quantity: time_ratio=0.01, stroke=0.001 (the design's "
-        "length unit) or stroke=1mm (with --unit, or the default design in m), gamma_min=1deg",
+        "length unit) or stroke=1mm (a design whose unit is stated), gamma_min=1deg",
     )
     parser.add_argument(
+        "--units",
         "--unit",
-        choices=sorted(LENGTH_UNITS),
-        help="the design's length unit, so that a stroke limit may carry a unit suffix (default: "
-        "m for the paper's mechanism, undeclared for any other design)",
+        dest="units",
+        choices=list(units_.LENGTH_UNITS),
+        help="the design's length unit: states it for TYPE and parameters (so that a stroke limit may carry a "
+        "unit suffix); a design file or the paper's mechanism (m) states its own, which --units may only repeat",
     )
     parser.add_argument("--params", help="toleranced parameters, comma-separated (default: lengths and offsets)")
     parser.add_argument("--rss", action="store_true", help="statistical stack-up ||S t|| <= E / k")
@@ -85,24 +89,39 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print JSON instead of text")
 
 
-def mechanism_from(args):
-    """The mechanism from TYPE and --r1 ..., or from a JSON file; the paper's mechanism by default."""
+def design_from(args):
+    """(the mechanism, its stated length unit or None): from TYPE and --r1 ... (stated by --units), from a JSON
+    file (its "units", which --units may repeat but not contradict), or the paper's mechanism (in m)."""
+    from qropt.cli import CliError
+
     given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
+    override = getattr(args, "units", None)
     if args.target is None:
         if given:
             raise InvalidParameter("give the mechanism TYPE before its parameters: " + ", ".join(sorted(REGISTRY)))
         from qropt.examples import paper_mechanism
 
-        return paper_mechanism()
-    path = Path(args.target)
-    if args.target.endswith(".json") or path.is_file():
+        declared, m, where = PAPER_UNIT, paper_mechanism(), "the paper's mechanism"
+    elif args.target.endswith(".json") or Path(args.target).is_file():
+        from qropt.io.export import declared_unit
+
         try:
-            d = json.loads(path.read_text())
+            d = json.loads(Path(args.target).read_text())
             kind, params = d["type"], {**d["params"], **given}
-        except (OSError, ValueError, KeyError, TypeError) as e:
-            raise InvalidParameter(f"{args.target}: not a JSON design with 'type' and 'params' ({e})") from None
-        return mechanism_type(kind)(**params)
-    return mechanism_type(args.target)(**given)
+            declared = declared_unit(d)
+        except (OSError, ValueError, KeyError, TypeError, AttributeError, RecursionError) as e:
+            why = "nested too deeply" if isinstance(e, RecursionError) else e
+            raise InvalidParameter(f"{args.target}: not a JSON design with 'type' and 'params' ({why})") from None
+        except QroptError as e:
+            raise InvalidParameter(f"{args.target}: {e}") from None
+        if not isinstance(kind, str) or not isinstance(params, dict):
+            raise InvalidParameter(f"{args.target}: not a JSON design with 'type' and 'params'")
+        m, where = mechanism_type(kind)(**params, units=declared or override or units_.DEFAULT), args.target
+    else:
+        return mechanism_type(args.target)(**given, units=override or units_.DEFAULT), override
+    if declared is not None and override is not None and override != declared:
+        raise CliError(f"--units {override} contradicts {where}, which is in {declared}")
+    return m, declared or override
 
 
 def _finite(v):
@@ -112,13 +131,12 @@ def _finite(v):
     return None if isinstance(v, float) and not math.isfinite(v) else v
 
 
-def limits_from(args) -> dict:
+def limits_from(args, design_unit: str | None = None) -> dict:
     """{quantity: limit} in the design's units: each quantity once, a suffixed length converted to the design's
-    length unit (--unit, or metres for the default design) or refused where that unit is not declared."""
+    length unit (``design_unit``: the one its file or --units states, metres for the default design) or refused
+    where that unit is not stated."""
     from qropt.cli import CliError
 
-    default = args.target is None and not any(getattr(args, k) is not None for k in PARAM_NAMES)
-    design_unit = args.unit or (PAPER_UNIT if default else None)
     out = {}
     for name, value, unit in args.limit:
         if name in out:
@@ -127,24 +145,24 @@ def limits_from(args) -> dict:
             if design_unit is None:
                 raise CliError(
                     f"--limit {name}={value:g}{unit}: this design's length unit is not declared (qropt "
-                    "lengths are in the design's own unit); give --unit, or the limit as a plain number "
+                    "lengths are in the design's own unit); give --units, or the limit as a plain number "
                     "in the design's unit"
                 )
-            value *= LENGTH_UNITS[unit] / LENGTH_UNITS[design_unit]
+            value *= units_.to_metres(unit) / units_.to_metres(design_unit)
         out[name] = value
     return out
 
 
 def run(args) -> int:
-    m = mechanism_from(args)
-    limits = limits_from(args)
+    m, design_unit = design_from(args)
+    limits = limits_from(args, design_unit)
     params = None if args.params is None else [p.strip() for p in args.params.split(",") if p.strip()]
     al = allocate(m, limits, params=params, method="rss" if args.rss else "worst-case", k=args.k, omega2=args.omega2)
     mc = None
     if al.status == "optimal" and args.monte_carlo is not None:
         mc = al.monte_carlo(args.monte_carlo, seed=args.seed)
     if args.json:
-        out = {"type": m.KIND, "params": dict(m.params), "status": al.status, "message": al.message,
+        out = {"type": m.KIND, "params": dict(m.params), "units": m.units, "status": al.status, "message": al.message,
                "method": al.method, "k": al.k, "limits": al.limits, "tolerances": al.tolerances,
                "sensitivities": al.sensitivities, "usage": al.usage}  # fmt: skip
         if mc is not None:
@@ -153,7 +171,8 @@ def run(args) -> int:
         json.dump(_finite(out), sys.stdout, indent=2)
         sys.stdout.write("\n")
         return 0 if al.status == "optimal" else 1
-    print(f"{m.KIND}: " + ", ".join(f"{k}={v:g}" for k, v in m.params.items()))
+    stated = m.units if design_unit else "not stated"
+    print(f"{m.KIND} (lengths: {stated}): " + ", ".join(f"{k}={v:g}" for k, v in m.params.items()))
     rule = "sum |S| t <= E" if al.method == "worst-case" else f"||S t|| <= E / {al.k:g}"
     print(f"  {al.method} ({rule}); status {al.status}: {al.message}")
     if al.status != "optimal":

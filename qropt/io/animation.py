@@ -57,8 +57,8 @@ def _render(m, sc, path, omega2, frames, fps, progress, arc):
     ax.set_xlim(x0 - pad, x1 + pad)
     ax.set_ylim(y0 - pad, y1 + pad)
     ax.set_aspect("equal")
-    ax.set_xlabel("x [length]")
-    ax.set_ylabel("y [length]")
+    ax.set_xlabel(f"x [{m.units}]")
+    ax.set_ylabel(f"y [{m.units}]")
     ax.grid(alpha=0.3)
     working = None
     if arc is not None:

@@ -1,10 +1,11 @@
 """What leaves qropt for CAD and other tools: the mechanism at one crank angle as DXF (ezdxf) or SVG, and a
 design file (JSON) that ``load_design`` and ``qropt analyze --from`` read back.
 
-Drawings are in the mechanism's own length unit, x right and y up (the SVG flips y for the screen), and draw the
-bodies the type declares (``qropt.io.drawing``). Layers: LINKS (bar and lever centre lines at their true lengths;
-a plate as a closed polygon, hatched in DXF), PIVOTS (ground pivots), JOINTS (moving joints), SLIDE_LINE,
-SLIDER_PATH (the output joint's path over a turn) and BLOCKS (sliding blocks, rams and slots, as outlines).
+Drawings are in the mechanism's own length unit (the DXF header's $INSUNITS and the SVG's title name it), x right
+and y up (the SVG flips y for the screen), and draw the bodies the type declares (``qropt.io.drawing``). Layers:
+LINKS (bar and lever centre lines at their true lengths; a plate as a closed polygon, hatched in DXF), PIVOTS
+(ground pivots), JOINTS (moving joints), SLIDE_LINE, SLIDER_PATH (the output joint's path over a turn) and BLOCKS
+(sliding blocks, rams and slots, as outlines).
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import os
 from pathlib import Path
 from xml.sax.saxutils import escape
 
+from qropt import units as units_
 from qropt.errors import InvalidParameter, QroptError
 from qropt.io import drawing
 from qropt.io.paths import output_path
@@ -22,6 +24,20 @@ from qropt.mechanisms import Mechanism, mechanism_type
 
 LAYERS = drawing.LAYERS  # name -> DXF colour
 RESERVED = ("type", "params", "units")  # the design file's own fields
+LEGACY_UNITS = "lengths in one consistent unit, angles in rad"  # what design files said before units were stated
+DXF_UNITS = {"m": 6, "cm": 5, "mm": 4, "um": 13, "in": 1, "ft": 2}  # $INSUNITS codes (ezdxf.units)
+
+
+def declared_unit(d: dict) -> str | None:
+    """The length unit a design dictionary states (a design file's "units": "mm", or a Result's "units" table
+    with its "length"), None where it states none (a file from before units were stated); InvalidParameter for
+    a unit that is not one of qropt.units.LENGTH_UNITS."""
+    u = d.get("units")
+    if isinstance(u, dict):
+        u = u.get("length")
+    if u is None or u == LEGACY_UNITS:
+        return None
+    return units_.length_unit(u)
 
 
 def geometry(m: Mechanism, theta2: float = 0.0, n: int = drawing.TURN) -> dict:
@@ -62,6 +78,8 @@ def to_dxf(m: Mechanism, path, theta2: float = 0.0) -> None:
     p = output_path(path, (".dxf",), "DXF drawing")
     geo = geometry(m, theta2)
     doc = ezdxf.new("R2010")
+    doc.units = DXF_UNITS[m.units]  # $INSUNITS: CAD reads the drawing in the mechanism's unit
+    doc.header["$MEASUREMENT"] = 0 if m.units in ("in", "ft") else 1  # imperial or metric
     for name, colour in LAYERS.items():
         doc.layers.add(name, color=colour)
     msp = doc.modelspace()
@@ -112,10 +130,11 @@ def to_svg(m: Mechanism, path, theta2: float = 0.0) -> None:
                     fill = f'fill="{colours[layer]}" fill-opacity="0.25"' if a[1] else 'fill="none"'
                     parts.append(f'<polygon points="{d}" {fill}/>')
         body.append(f'<g id="{layer}" stroke="{colours[layer]}" stroke-width="{width:.6g}">' + "".join(parts) + "</g>")
-    title = escape(f"{m!r} at theta2 = {math.degrees(theta2):.6g} deg")
+    title = escape(f"{m!r} at theta2 = {math.degrees(theta2):.6g} deg, lengths in {m.units}")
     svg = (
-        f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="{x0:.12g} {-y1:.12g} {x1 - x0:.12g} {y1 - y0:.12g}">'
-        f'<title>{title}</title><g transform="scale(1,-1)">{"".join(body)}</g></svg>\n'
+        f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="{x0:.12g} {-y1:.12g} {x1 - x0:.12g} {y1 - y0:.12g}" '
+        f'data-units="{m.units}"><title>{title}</title><desc>user units are {m.units} (x right, y up)</desc>'
+        f'<g transform="scale(1,-1)">{"".join(body)}</g></svg>\n'
     )
     _write(p, lambda q: q.write_text(svg))
 
@@ -130,8 +149,8 @@ def _coords(args):
 
 
 def save_design(m: Mechanism, path, **extra) -> None:
-    """A design file: the type (kind), every parameter, the units, and any extra JSON-ready fields (strict JSON:
-    finite numbers, strings, lists, dictionaries, booleans and null)."""
+    """A design file: the type (kind), every parameter, its length unit ("units": "mm"; angles in rad), and any
+    extra JSON-ready fields (strict JSON: finite numbers, strings, lists, dictionaries, booleans and null)."""
     _mechanism(m)
     p = output_path(path, (".json",), "design file")
     clash = [k for k in extra if k in RESERVED]
@@ -143,13 +162,14 @@ def save_design(m: Mechanism, path, **extra) -> None:
         except (ValueError, TypeError, RecursionError) as e:
             why = "nan or infinite numbers" if isinstance(e, ValueError) else type(e).__name__
             raise InvalidParameter(f"save_design: extra field {k!r} is not strict JSON ({why}): {v!r:.80}") from None
-    d = {"type": m.KIND, "params": dict(m.params), "units": "lengths in one consistent unit, angles in rad", **extra}
+    d = {"type": m.KIND, "params": dict(m.params), "units": m.units, **extra}
     text = json.dumps(d, indent=2, allow_nan=False) + "\n"
     _write(p, lambda q: q.write_text(text))
 
 
 def load_design(path) -> Mechanism:
-    """The mechanism of a design file (``save_design``, or the JSON of ``qropt synth/analyze --json``)."""
+    """The mechanism of a design file (``save_design``, or the JSON of ``qropt synth/analyze --json``) in the unit
+    the file states (the default unit, ``qropt.units.DEFAULT``, for a file that states none)."""
     if isinstance(path, bytes) or not isinstance(path, (str, os.PathLike)):
         raise InvalidParameter(f"a design file path is a str or path-like, got {path!r}")
     p = Path(path)
@@ -166,11 +186,12 @@ def load_design(path) -> Mechanism:
     if not isinstance(d["type"], str):
         raise InvalidParameter(f"{path}: the design's 'type' is a type name, got {d['type']!r:.80}")
     try:
-        return mechanism_type(d["type"])(**d["params"])
+        unit = declared_unit(d) or units_.DEFAULT
+        return mechanism_type(d["type"])(**d["params"], units=unit)
     except QroptError as e:
         raise InvalidParameter(f"{path}: {e}") from None
     except (TypeError, RecursionError) as e:
         raise InvalidParameter(f"{path}: {type(e).__name__}: {e}") from None
 
 
-__all__ = ["LAYERS", "geometry", "to_dxf", "to_svg", "save_design", "load_design"]
+__all__ = ["LAYERS", "geometry", "to_dxf", "to_svg", "save_design", "load_design", "declared_unit"]

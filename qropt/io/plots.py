@@ -74,14 +74,14 @@ def cycle_figure(m: Mechanism, theta2: float = math.radians(60), omega2: float =
     ax0 = fig.add_subplot(1, 2, 1)
     draw_mechanism(ax0, m, theta2)
     ax0.set_title(f"{type(m).__name__} at theta2 = {math.degrees(theta2):.1f} deg")
-    ax0.set_xlabel("x [length]")
-    ax0.set_ylabel("y [length]")
+    ax0.set_xlabel(f"x [{m.units}]")
+    ax0.set_ylabel(f"y [{m.units}]")
     th = np.linspace(0, 2 * math.pi, n)
     mo = m.motion(th, omega2, alpha2)
     d = m.dead_centres()
     a, b = m.stroke_angles()
     follower = m.OUTPUT == "follower"
-    unit = "rad" if follower else "length"
+    unit = "rad" if follower else m.units
     names = ("theta4", "omega4", "alpha4") if follower else ("slider x", "slider v", "slider a")
     rows = [(names[0], mo.x, unit), (names[1], mo.v, f"{unit}/s"), (names[2], mo.a, f"{unit}/s^2")]
     deg = np.degrees(th)
@@ -149,7 +149,7 @@ def reachable_figure(r, time_ratios=()):
         ax.plot(xs, [t] * len(xs), "o", color="tab:red")
         at, ha = (r.grid[0], "left") if k % 2 == 0 else (r.grid[-1], "right")
         ax.annotate(f"TR {t:g}: {len(xs)} solution(s)", (at, t), textcoords="offset points", xytext=(4, 4), ha=ha)
-    ax.set_xlabel(f"{r.free} [length]")
+    ax.set_xlabel(f"{r.free} [{r.base.units}]")
     ax.set_ylabel("time ratio [-] (slow / fast)")
     ax.set_title(f"TR over the feasible {r.free} of {type(r.base).__name__} (shaded)")
     ax.grid(alpha=0.3)
@@ -184,8 +184,8 @@ def family_figure(f, x=None, y=None, best=None, max_points=400):
         g = math.degrees(best.objective) if best.objective is not None else float("nan")
         ax.plot(best.params[x], best.params[y], "*", color="tab:red", ms=16, label=f"best gamma_min {g:.2f} deg")
     ax.legend(loc="best", fontsize=8)  # matplotlib's least-overlap place
-    ax.set_xlabel(f"{x} [length]")
-    ax.set_ylabel(f"{y} [length]")
+    ax.set_xlabel(f"{x} [{f.problem.units}]")  # free parameters are lengths and offsets
+    ax.set_ylabel(f"{y} [{f.problem.units}]")
     n = sum(len(b) for b in f.branches)
     ax.set_title(f"{f.problem.mechanism.__name__} family ({n} points, {len(f.folds)} fold(s))")
     ax.grid(alpha=0.3)
@@ -209,10 +209,10 @@ def family_mechanisms(f, count=4):
     return fig
 
 
-def _criteria_text(c: dict) -> str:
-    return "\n".join([f"gamma_min {math.degrees(c['gamma_min']):.1f} deg", f"footprint {c['footprint']:.3g} length^2",
-                      f"peak accel {c['peak_accel']:.3g} length/s^2",
-                      f"peak working v {c['peak_velocity']:.3g} length/s"])  # fmt: skip
+def _criteria_text(c: dict, unit: str) -> str:
+    return "\n".join([f"gamma_min {math.degrees(c['gamma_min']):.1f} deg", f"footprint {c['footprint']:.3g} {unit}^2",
+                      f"peak accel {c['peak_accel']:.3g} {unit}/s^2",
+                      f"peak working v {c['peak_velocity']:.3g} {unit}/s"])  # fmt: skip
 
 
 def comparison_figure(cmp):
@@ -241,7 +241,7 @@ def comparison_figure(cmp):
         ax.set_xlim(cx - span / 2, cx + span / 2)
         ax.set_ylim(cy - span / 2, cy + span / 2)
         ax.set_title(r.type, fontsize=10)
-        ax.text(0.02, 0.02, _criteria_text(r.criteria), transform=ax.transAxes, fontsize=7.5, va="bottom",
+        ax.text(0.02, 0.02, _criteria_text(r.criteria, cmp.units), transform=ax.transAxes, fontsize=7.5, va="bottom",
                 bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "0.8"})  # fmt: skip
         ax.tick_params(labelsize=7)
     if cmp.fronts:
@@ -254,14 +254,14 @@ def comparison_figure(cmp):
             if k not in drawn:
                 ax.plot([], [], " ", label=f"{k}: no front")
         a, b = next(iter(drawn.values())).criteria if drawn else ("gamma_min", "peak_accel")
-        ax.set_xlabel(_label(a))
-        ax.set_ylabel(_label(b))
+        ax.set_xlabel(_label(a, cmp.units))
+        ax.set_ylabel(_label(b, cmp.units))
         ax.set_title("trade-off fronts")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
     for ax in axes[n:]:
         ax.set_axis_off()
-    fig.suptitle(f"TR {cmp.time_ratio:g}, stroke {cmp.stroke:g}: best by {cmp.objective} first (one scale; "
+    fig.suptitle(f"TR {cmp.time_ratio:g}, stroke {cmp.stroke:g} {cmp.units}: best by {cmp.objective} first (one scale; "
                  f"omega2 = {cmp.omega2:g} rad/s)")  # fmt: skip
     fig.tight_layout()
     return fig
@@ -273,10 +273,10 @@ def _wrap(text, width):
     return "\n".join(textwrap.wrap(text, width)[:8])
 
 
-def _label(q):
+def _label(q, unit: str):
     from qropt.synthesis.criteria import units
 
-    return f"{q} [{'deg' if q == 'gamma_min' else units()[q]}]"
+    return f"{q} [{'deg' if q == 'gamma_min' else units(unit)[q]}]"
 
 
 def _front_xy(front, va, vb):
@@ -301,8 +301,8 @@ def front_figure(front, designs: int = 3):
         ax.annotate(f"{k + 1}", (x[i], y[i]), textcoords="offset points", xytext=(6, 6))
     ax.plot([], [], "x", color="tab:red", label=f"removed: {len(front.removed)} (dominated or none)")
     a, b = front.criteria
-    ax.set_xlabel(_label(a))
-    ax.set_ylabel(_label(b))
+    ax.set_xlabel(_label(a, front.problem.units))
+    ax.set_ylabel(_label(b, front.problem.units))
     ax.set_title(f"{front.problem.mechanism.__name__}: {front.objectives[0]} vs {front.objectives[1]}")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="best")
@@ -316,14 +316,17 @@ def front_figure(front, designs: int = 3):
         cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
         axm.set_xlim(cx - span / 2, cx + span / 2)
         axm.set_ylim(cy - span / 2, cy + span / 2)
-        axm.set_title(f"{k + 1}: {_short(a, va[i])}, {_short(b, vb[i])}", fontsize=9)
+        axm.set_title(f"{k + 1}: {_short(a, va[i], front.problem.units)}, {_short(b, vb[i], front.problem.units)}",
+                      fontsize=9)  # fmt: skip
         axm.tick_params(labelsize=7)
     fig.tight_layout()
     return fig
 
 
-def _short(q, v):
-    return f"{q} {math.degrees(v):.1f} deg" if q == "gamma_min" else f"{q} {v:.3g}"
+def _short(q, v, unit: str):
+    from qropt.synthesis.criteria import units
+
+    return f"{q} {math.degrees(v):.1f} deg" if q == "gamma_min" else f"{q} {v:.3g} {units(unit).get(q, '')}".rstrip()
 
 
 def _extent(m) -> tuple[float, float, float, float]:

@@ -62,13 +62,16 @@ def _design_section(title, r, free) -> str:
     if not r.success:
         return f"<h2>{title}</h2><p class=bad>{html.escape(r.status)}: {html.escape(r.message)}</p>"
     m, q = r.mechanism, r.quantities
-    rows = [*m.params.items(), ("time ratio", q["time_ratio"]), ("gamma_min [deg]", math.degrees(q["gamma_min"]))]
-    rows += [("stroke", q["stroke"])] if "stroke" in q else [("swing [deg]", math.degrees(q["swing"]))]
+    u = m.units
+    rows = [(f"{k} [{u}]" if not k.startswith("sigma") else k, v) for k, v in m.params.items()]
+    rows += [("time ratio", q["time_ratio"]), ("gamma_min [deg]", math.degrees(q["gamma_min"]))]
+    rows += [(f"stroke [{u}]", q["stroke"])] if "stroke" in q else [("swing [deg]", math.degrees(q["swing"]))]
+    head = ["status", *(f"{k} [{u}]" for k in free), "gamma_min [deg]", "objective"]
     optima = [(o.status, *(o.params[k] for k in free), math.degrees(o.quantities["gamma_min"]), o.objective)
               for o in r.local_optima]  # fmt: skip
     return (
         f"<h2>{title}</h2><p>{html.escape(r.message)}</p>{_table(['quantity', 'value'], rows)}"
-        f"<h3>Every certified local optimum</h3>{_table(['status', *free, 'gamma_min [deg]', 'objective'], optima)}"
+        f"<h3>Every certified local optimum</h3>{_table(head, optima)}"
         f"{_png(plots.cycle_figure(m, omega2=r.stats.get('omega2', 1.0)))}"
     )
 
@@ -172,7 +175,7 @@ def _problem(problem) -> str:
     from qropt import solve
 
     r = solve(problem)
-    title = f"{problem.mechanism.__name__}: objective {problem.objective}"
+    title = f"{problem.mechanism.__name__}: objective {problem.objective}, lengths in {problem.units}"
     return f"<h1>{html.escape(problem.name or problem.mechanism.__name__)}</h1>" + _design_section(
         title, r, list(problem.free)
     )

@@ -4,7 +4,8 @@ A type defines ``PARAMS`` (name -> default, ``REQUIRED`` for none), the names of
 its ``LENGTHS`` (positive) and ``loop(xp, theta2, p) -> Loop`` written once over a
 math namespace. Everything else (positions, rates, dead centres, time ratio,
 stroke, transmission angles, gamma_min, the assembly check) is derived here.
-Angles are radians; lengths in any consistent unit; theta2 counter-clockwise from +x.
+Angles are radians; lengths are numbers in the mechanism's stated unit (``units="mm"``, a keyword that is not a
+parameter; metres by default, see ``qropt.units``); theta2 counter-clockwise from +x.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
+from qropt import units as units_
 from qropt.errors import AssemblyError, DegenerateMechanism, InvalidParameter, NoDeadCentres
 from qropt.kinematics import cycle
 from qropt.kinematics.closures import transmission_angle
@@ -226,8 +228,11 @@ class Mechanism:
         """Defaults that depend on which parameters are given (override; e.g. a rod's slide line at h = 0)."""
         return {}
 
+    units: str = units_.DEFAULT  # the length unit (qropt.units): it names lengths, it is not a parameter
+
     def __init__(self, **params):
         name = type(self).__name__
+        object.__setattr__(self, "units", units_.length_unit(params.pop("units", units_.DEFAULT)))
         unknown = sorted(set(params) - set(self.PARAMS))
         if unknown:
             raise InvalidParameter(f"{name}: unknown parameter(s) {unknown}; it takes {list(self.PARAMS)}")
@@ -258,13 +263,15 @@ class Mechanism:
         raise AttributeError(f"{type(self).__name__} is immutable")
 
     def __repr__(self):
-        return f"{type(self).__name__}(" + ", ".join(f"{k}={v:g}" for k, v in self.params.items()) + ")"
+        given = [f"{k}={v:g}" for k, v in self.params.items()]
+        given += [f"units={self.units!r}"] if self.units != units_.DEFAULT else []
+        return f"{type(self).__name__}(" + ", ".join(given) + ")"
 
     def __eq__(self, other):
-        return type(self) is type(other) and self.params == other.params
+        return type(self) is type(other) and self.params == other.params and self.units == other.units
 
     def __hash__(self):
-        return hash((type(self).__name__, tuple(sorted(self.params.items()))))
+        return hash((type(self).__name__, tuple(sorted(self.params.items())), self.units))
 
     @classmethod
     def required(cls) -> list[str]:
@@ -772,7 +779,7 @@ class Mechanism:
         from qropt.errors import QroptError
 
         try:
-            m = type(self)(**dict(zip(self.params, row.tolist(), strict=True)))
+            m = type(self)(**dict(zip(self.params, row.tolist(), strict=True)), units=self.units)
             vals = {
                 "time_ratio": m.time_ratio,
                 "stroke": m.stroke,

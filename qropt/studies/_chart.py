@@ -20,9 +20,11 @@ import numpy as np
 
 from qropt.errors import ChartError, QroptError
 from qropt.io.paths import picture_path
+from qropt.synthesis import criteria
 from qropt.synthesis.criteria import maximises
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import STATUSES, Result
+from qropt.units import named
 
 METHODS = ("continued", "full")
 STATS = ("cells", "certified", "no_design", "continued", "full", "needed", "jumps", "switched", "seconds",
@@ -252,8 +254,8 @@ class Chart:
         return out
 
     def to_csv(self, path) -> None:
-        """Every cell as a CSV row (angles in rad, lengths in the problem's units)."""
-        rows = self.rows()
+        """Every cell as a CSV row (angles in rad, lengths in the problem's unit, named in the column "units")."""
+        rows = [r | {"units": self.problem.units} for r in self.rows()]
         keys = list(dict.fromkeys(k for r in rows for k in r))
         with _writing(path, "CSV") as fh:
             w = csv.DictWriter(fh, fieldnames=keys)
@@ -447,20 +449,27 @@ def _index(axis: Axis, v) -> int:
 
 
 # ---- the picture ---------------------------------------------------------------------------------------------
-def _shown(axis: Axis) -> tuple:
-    """Display values and label of an axis: swing in degrees."""
+def _shown(axis: Axis, problem=None) -> tuple:
+    """Display values and label of an axis: swing in degrees, a length (the stroke, a parameter) in the problem's
+    unit."""
     if axis.name == "swing":
         return np.degrees(axis.values), "swing [deg]"
-    return np.asarray(axis.values), axis.name.replace("_", " ")
+    label = axis.name.replace("_", " ")
+    if problem is not None and (axis.name == "stroke" or axis.name in problem.mechanism.PARAMS):
+        label += f" [{problem.units}]"
+    return np.asarray(axis.values), label
 
 
 def _panel(ch: Chart, name: str) -> tuple:
     """Values and title of one panel: the objective (gamma_min in degrees) or a parameter."""
     if name != "objective":
-        return ch.grid(name), f"optimal {name}"
+        return ch.grid(name), f"optimal {name} [{ch.problem.units}]"
     if maximises(ch.problem.objective):  # gamma_min, the one maximised criterion
         return np.degrees(ch.grid()), "best gamma_min [deg]"
-    return ch.grid(), f"{ch.problem.objective or 'feasible'}: objective"
+    if not ch.problem.objective:
+        return ch.grid(), "feasible: objective"
+    unit = named(criteria.of_problem(ch.problem).unit, ch.problem.units)
+    return ch.grid(), f"{ch.problem.objective}: objective [{unit}]"
 
 
 def chart_figure(ch: Chart):
@@ -472,7 +481,7 @@ def chart_figure(ch: Chart):
     import matplotlib.pyplot as plt
 
     names = ["objective", *ch.problem.free]
-    xs, xlabel = _shown(ch.x)
+    xs, xlabel = _shown(ch.x, ch.problem)
     note = ", ".join([f"{k} = {v:g}" for k, v in ch.problem.fixed.items() if k != getattr(ch.y, "name", "")
                       and k in ch.problem.mechanism.LENGTHS and k != ch.x.name]
                      + [f"{k} = {v:g}" for k, v in ch.problem.targets.items() if k not in (ch.x.name,
@@ -495,7 +504,7 @@ def chart_figure(ch: Chart):
         fig.suptitle(f"{title}\n{how}", fontsize=9)
         fig.tight_layout()
         return fig
-    ys, ylabel = _shown(ch.y)
+    ys, ylabel = _shown(ch.y, ch.problem)
     n = len(names) + 1
     cols = 3 if n > 4 else 2
     rows = -(-n // cols)

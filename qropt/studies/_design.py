@@ -2,17 +2,22 @@
 
 Each type's problem has bounds that scale with the stroke s (every length in [s/20, 5 s], offsets in
 [-5 s, 5 s]) and its own conditions (the Grashof class of the four-bar types). Every row is a certified solve;
-every criterion of a row is evaluated exactly on its design. Lengths in the stroke's unit, angles in radians.
+every criterion of a row is evaluated exactly on its design. Lengths in the stated unit (``units``, that of the
+stroke and the bounds; metres by default), angles in radians.
 """
 
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+from qropt import units as units_
 from qropt.errors import ProblemError, QroptError
+from qropt.mechanisms.base import MAGNITUDE
 from qropt.synthesis import criteria
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import SOLUTION_PRESENT, Result, json_safe
@@ -29,10 +34,11 @@ TYPES = {
 
 
 def type_problem(kind: str, time_ratio: float, stroke: float, *, objective="max_gamma_min", bounds=None,
-                 conditions=None, omega2: float = 1.0, size: str = "footprint") -> Problem:  # fmt: skip
+                 conditions=None, omega2: float = 1.0, size: str = "footprint",
+                 units: str = units_.DEFAULT) -> Problem:  # fmt: skip
     """The task as a Problem of one type: default bounds scaled by the stroke, ``bounds`` (name -> (lo, hi))
-    overriding those the type has, ``conditions`` added to the type's own."""
-    if kind not in TYPES:
+    overriding those the type has, ``conditions`` added to the type's own; lengths in ``units``."""
+    if not isinstance(kind, str) or kind not in TYPES:
         raise ProblemError(f"unknown type {kind!r}; types are {list(TYPES)}")
     mech, lengths, offsets, fixed = TYPES[kind]
     s = stroke
@@ -42,7 +48,7 @@ def type_problem(kind: str, time_ratio: float, stroke: float, *, objective="max_
             free[k] = b
     return Problem(mechanism=mech, fixed=fixed, free=free, targets={"time_ratio": time_ratio, "stroke": stroke},
                    conditions=dict(conditions or {}), objective=objective, omega2=omega2, size=size,
-                   name=f"{kind} TR {time_ratio:g} stroke {stroke:g}")  # fmt: skip
+                   name=f"{kind} TR {time_ratio:g} stroke {stroke:g} {units}", units=units)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -79,37 +85,43 @@ class Comparison:
     omega2: float
     rows: tuple
     fronts: dict = field(default_factory=dict)
+    units: str = units_.DEFAULT
 
     def __repr__(self):
-        lines = [f"Comparison(TR {self.time_ratio:g}, stroke {self.stroke:g}, {self.objective}):"]
+        u = criteria.units(self.units)
+        lines = [f"Comparison(TR {self.time_ratio:g}, stroke {self.stroke:g} {self.units}, {self.objective}):"]
         for r in self.rows:
             if r.success:
                 c = r.criteria
                 lines.append(f"  {r.type:20s} gamma_min {math.degrees(c['gamma_min']):6.2f} deg  footprint "
-                             f"{c['footprint']:.4g}  peak accel {c['peak_accel']:.4g}  peak velocity "
-                             f"{c['peak_velocity']:.4g}")  # fmt: skip
+                             f"{c['footprint']:.4g} {u['footprint']}  peak accel {c['peak_accel']:.4g} "
+                             f"{u['peak_accel']}  peak velocity {c['peak_velocity']:.4g} "
+                             f"{u['peak_velocity']}")  # fmt: skip
             else:
                 lines.append(f"  {r.type:20s} no design: {r.reason}")
         return "\n".join(lines)
 
     def table(self) -> list[dict]:
-        """One dict per row (Row.record), best first."""
-        return [r.record() for r in self.rows]
+        """One dict per row (Row.record, with the length unit under "units"), best first."""
+        return [r.record() | {"units": self.units} for r in self.rows]
 
     def to_json(self) -> str:
+        """The comparison as JSON; "units" names each criterion's unit, "length" the length unit."""
         d = {"time_ratio": self.time_ratio, "stroke": self.stroke, "objective": self.objective,
-             "omega2": self.omega2, "units": criteria.units(), "rows": self.table()}  # fmt: skip
+             "omega2": self.omega2, "units": {"length": self.units, **criteria.units(self.units)},
+             "rows": self.table()}  # fmt: skip
         return json.dumps(json_safe(d), indent=2, allow_nan=False)
 
     def to_csv(self, path) -> None:
+        """The table as CSV: a row per type, its criteria (lengths in the column "units"; angles in rad)."""
         rows = self.table()
         names = sorted({k for r in rows for k in r["params"]})
         with open(path, "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["type", "status", "objective", *columns(), *names, "reason"])
+            w.writerow(["type", "status", "objective", *columns(), *names, "reason", "units"])
             for r in rows:
                 w.writerow([r["type"], r["status"], _cell(r["objective"]), *(_cell(r[k]) for k in columns()),
-                            *(_cell(r["params"].get(k)) for k in names), r["reason"]])  # fmt: skip
+                            *(_cell(r["params"].get(k)) for k in names), r["reason"], self.units])  # fmt: skip
 
     def plot(self, path) -> None:
         """The designs side by side at one scale, each with its numbers (and the fronts, if computed)."""
@@ -120,33 +132,54 @@ class Comparison:
 
 def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min", types=None, bounds=None,
            conditions=None, omega2: float = 1.0, size: str = "footprint", pareto=None, n: int = 12,
-           solver=None, progress=None) -> Comparison:  # fmt: skip
+           solver=None, progress=None, units: str = units_.DEFAULT) -> Comparison:  # fmt: skip
     """Solve the task (TR, stroke) for every type (or ``types``) and compare; see the module docstring.
 
     objective: as Problem.objective; conditions: bound conditions for every type (e.g. {'gamma_min': 0.7});
     pareto: two objectives whose front is computed for every type (``n`` points each; a type without one gets
-    the reason in ``Comparison.fronts``); progress: a callable
-    called once per finished type.
+    the reason in ``Comparison.fronts``); progress: a callable called once per finished type; units: the length
+    unit of the stroke, the bounds and every length of the answer (one of ``qropt.units.LENGTH_UNITS``).
+    Every argument is checked (every type's problem built, the front's objectives and ``n``) before any solve.
     """
-    from qropt.synthesis.solver import DEFAULT
+    from qropt.synthesis.solver import DEFAULT, Solver
 
+    if solver is not None and not isinstance(solver, Solver):
+        raise ProblemError(f"solver is a qropt.Solver or None, got {type(solver).__name__}")
+    if progress is not None and not callable(progress):
+        raise ProblemError(f"progress is a callable (called once per finished type) or None, got {progress!r}")
     solver = solver or DEFAULT
+    try:
+        units = units_.length_unit(units)
+    except QroptError as e:
+        raise ProblemError(f"design: {e}") from None
     types = list(TYPES) if types is None else _types(types)
     if not (criteria.finite(time_ratio) and time_ratio >= 1):
         raise ProblemError(f"time_ratio is slow/fast >= 1, got {time_ratio!r}")
     if not (criteria.finite(stroke) and stroke > 0):
         raise ProblemError(f"stroke must be a positive number, got {stroke!r}")
-    if bounds is not None and not isinstance(bounds, dict):
+    if not 20 / MAGNITUDE <= stroke <= MAGNITUDE / 5:  # the default bounds [s/20, 5 s] within the magnitude range
+        raise ProblemError(f"stroke {stroke:g} {units} is out of range [2e-99, 2e99] (its bounds reach s/20 and 5 s)")
+    if bounds is not None and not isinstance(bounds, Mapping):
         raise ProblemError(f"bounds is a dict name -> (lower, upper), got {bounds!r}")
+    if conditions is not None and not isinstance(conditions, Mapping):
+        raise ProblemError(f"conditions is a dict name -> bound (e.g. {{'gamma_min': 0.7}}), got {conditions!r}")
     known = {k for t in types for k in TYPES[t][1] + TYPES[t][2]}
-    unknown = sorted(set(bounds or {}) - known)
+    unknown = sorted(set(bounds or {}) - known, key=str)
     if unknown:
         raise ProblemError(f"bounds name {unknown}, which no type of {types} has (they have {sorted(known)})")
+    problems = {kind: type_problem(kind, time_ratio, stroke, objective=objective, bounds=bounds,
+                                   conditions=conditions, omega2=omega2, size=size, units=units)
+                for kind in types}  # fmt: skip
+    if pareto is not None:
+        from qropt.studies._pareto import _check
+
+        for p in problems.values():
+            _check(p, pareto, n)
     rows, fronts = [], {}
-    for kind in types:
-        p = type_problem(kind, time_ratio, stroke, objective=objective, bounds=bounds, conditions=conditions,
-                         omega2=omega2, size=size)  # fmt: skip
+    for kind, p in problems.items():
         r = solver.solve(p)
+        if r.mechanism is None and r.units != units:  # a Result without a design names the problem's unit too
+            r = dataclasses.replace(r, units=units)
         rows.append(_row(kind, p, r))
         if pareto is not None:
             from qropt.studies._pareto import pareto as front
@@ -161,7 +194,8 @@ def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min"
     ok = [r for r in rows if r.success]
     if objective:
         ok.sort(key=lambda r: r.result.objective, reverse=maximise)
-    return Comparison(time_ratio, stroke, objective, omega2, tuple(ok + [r for r in rows if not r.success]), fronts)
+    rows = tuple(ok + [r for r in rows if not r.success])
+    return Comparison(time_ratio, stroke, objective, omega2, rows, fronts, units)
 
 
 def _row(kind, problem, r: Result) -> Row:
@@ -183,7 +217,7 @@ def _types(types) -> list[str]:
         raise ProblemError(f"types is a list of type names from {list(TYPES)}, got {types!r}")
     out = list(types)
     for t in out:
-        if t not in TYPES:
+        if not isinstance(t, str) or t not in TYPES:
             raise ProblemError(f"unknown type {t!r}; types are {list(TYPES)}")
     if not out or len(set(out)) != len(out):
         raise ProblemError(f"types must name at least one type, each once; got {out}")

@@ -26,6 +26,8 @@ from qropt.synthesis.problem import Problem
 from qropt.synthesis.solver import DEFAULT, Solver
 
 NEWTON_TOL = 1e-12
+MAX_POINTS = 100_000  # points one trace may take (each half of a branch): a cap, not a target
+MIN_DS = 1e-6  # the smallest ds, relative to the free box's diagonal (and at least 1e-12 of the largest bound)
 
 
 @dataclass(frozen=True)
@@ -41,7 +43,7 @@ class FamilyPoint:
 
     @cached_property
     def mechanism(self):
-        return self.problem.mechanism(**self.params)
+        return self.problem.mechanism(**self.params, units=self.problem.units)
 
     @cached_property
     def quantities(self) -> dict:
@@ -78,13 +80,13 @@ class Family:
 
     def best(self, objective: str = "max_gamma_min", size: str | None = None, sample: int = 200):
         """The best family point for an objective, refined by ``solve()`` into a Result."""
-        pts = self.points()
-        step = max(1, len(pts) // sample)
-        chosen = pts[::step] + [b[-1] for b in self.branches]
         if not isinstance(objective, str) or objective not in criteria.objectives():
             raise ProblemError(f"best takes an objective from {criteria.objectives()[1:]}, got {objective!r}")
         if isinstance(sample, bool) or not isinstance(sample, (int, np.integer)) or sample < 1:
             raise ProblemError(f"sample is how many family points to score, an integer >= 1; got {sample!r}")
+        pts = self.points()
+        step = max(1, len(pts) // int(sample))
+        chosen = pts[::step] + [b[-1] for b in self.branches]
         changes = {"objective": objective, **({"size": size} if size else {})}
         problem = self.problem.replace(**changes)
         c = criteria.of_problem(problem)
@@ -195,26 +197,40 @@ def family(problem: Problem, along: str | None = None, *, ds: float | None = Non
     """Trace every branch of a one-parameter family of designs.
 
     along: the parameter in which folds are counted (default: the first free one); ds: the largest
-    arclength step (default 1/200 of the free box's diagonal); progress: callable(points traced);
+    arclength step (default 1/200 of the free box's diagonal; at least MIN_DS of it, and 1e-12 of the largest
+    bound, so that points differ); max_points: the most points one trace takes (at most MAX_POINTS);
+    starts_n, seed: the Sobol seeds of the branches; progress: callable(points traced);
     solver: whose formulations to use (default ``qropt.solve.DEFAULT``).
     """
     if not isinstance(problem, Problem):
         raise ProblemError(f"family takes a qropt.Problem, got {type(problem).__name__}")
     if ds is not None and not (isinstance(ds, (int, float)) and not isinstance(ds, bool) and 0 < ds < math.inf):
         raise ProblemError(f"ds is the largest arclength step, a positive number; got {ds!r}")
-    if isinstance(max_points, bool) or not isinstance(max_points, int) or max_points < 2:
-        raise ProblemError(f"max_points must be an integer >= 2, got {max_points!r}")
+    if isinstance(max_points, bool) or not isinstance(max_points, int) or not 2 <= max_points <= MAX_POINTS:
+        raise ProblemError(f"max_points must be an integer from 2 to {MAX_POINTS:,}, got {max_points!r}")
+    for name, v in (("starts_n", starts_n), ("seed", seed)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+            raise ProblemError(f"{name} must be an integer >= 0, got {v!r}")
     if progress is not None and not callable(progress):
         raise ProblemError("progress must be a callable(points traced) or None")
+    if solver is not None and not isinstance(solver, Solver):
+        raise ProblemError(f"solver is a qropt.Solver or None, got {type(solver).__name__}")
     solver = solver or DEFAULT
     n_free, n_targets = len(problem.free), len(problem.targets)
     if n_free != n_targets + 1:
         raise ProblemError(f"a family needs one more free parameter than targets: {n_free} free, {n_targets} targets")
+    if along is not None and not isinstance(along, str):
+        raise ProblemError(f"along is the name of a free parameter ({list(problem.free)}), got {along!r}")
     along = along or next(iter(problem.free))
     if along not in problem.free:
         raise ProblemError(f"along={along!r} is not a free parameter ({list(problem.free)})")
     box = np.array([hi - lo for lo, hi in problem.free.values()])
-    ds_max = ds or float(np.linalg.norm(box)) / 200
+    diagonal = float(np.linalg.norm(box))
+    least = max(MIN_DS * diagonal, 1e-12 * max(abs(b) for bounds in problem.free.values() for b in bounds))
+    if ds is not None and ds < least:
+        raise ProblemError(f"ds = {ds:g} is below {least:.3g} {problem.units} (MIN_DS = {MIN_DS:g} of the free "
+                           "box's diagonal, and 1e-12 of its largest bound): its points would not differ")  # fmt: skip
+    ds_max = ds or diagonal / 200
     traced, ends, folds, n_points = [], [], [], 0
     seeds = list(starts_.plan(problem).analytic) + starts_.sobol(problem, starts_n, seed)
     for br, way in itertools.product(starts_.branches(problem), (1, -1)):

@@ -17,6 +17,7 @@ from qropt.errors import ProblemError
 from qropt.synthesis import criteria
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import SOLUTION_PRESENT, Result
+from qropt.units import named
 
 MAX_POINTS = 1000
 
@@ -35,10 +36,11 @@ class Front:
 
     def __repr__(self):
         a, b = self.criteria
+        ua, ub = (named(criteria.CRITERIA[q].unit, self.problem.units) for q in (a, b))
         lines = [f"Front({self.objectives[0]} vs {self.objectives[1]}: {len(self.points)} points, "
                  f"{len(self.removed)} removed)"]  # fmt: skip
         for va, vb in self.values[:6]:
-            lines.append(f"  {a} {va:.6g}  {b} {vb:.6g}")
+            lines.append(f"  {a} {va:.6g} {ua}  {b} {vb:.6g} {ub}")
         if len(self.values) > 6:
             lines.append("  ...")
         return "\n".join(lines)

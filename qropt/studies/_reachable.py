@@ -13,7 +13,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from qropt.errors import InvalidParameter, QroptError
 from qropt.kinematics.ops import NUMPY
-from qropt.mechanisms import FourBar, Mechanism
+from qropt.mechanisms import Mechanism
 from qropt.mechanisms.base import MAGNITUDE
 
 SPAN = 1000.0  # given bounds may span at most this many times the mechanism's largest other parameter
@@ -156,7 +156,7 @@ def _bounds(mechanism, free, bounds) -> tuple[float, float]:
     """The scanned interval: the given bounds (within the type's own rules: outside them no value works), or the
     rules' interval; InvalidParameter when it is empty, unbounded, beyond MAGNITUDE or too wide to scan."""
     if bounds is None:
-        lo, hi = _rule_interval(mechanism, free, "crank-rocker" if isinstance(mechanism, FourBar) else None)
+        lo, hi = _rule_interval(mechanism, free, "crank-rocker" if mechanism.FOUR_BAR and not mechanism.CLASS else None)
         if not (math.isfinite(lo) and math.isfinite(hi)):
             side = " and ".join(w for w, v in (("below", lo), ("above", hi)) if not math.isfinite(v))
             raise InvalidParameter(f"give bounds for {free}: the type's rules do not bound it {side}")
@@ -190,7 +190,7 @@ def _bounds(mechanism, free, bounds) -> tuple[float, float]:
 def _evaluate(base, free, x):
     """(TR, stroke, gamma_min) of the base mechanism with free = x; nan where it does not work."""
     try:
-        m = type(base)(**{**base.params, free: float(x)})
+        m = type(base)(**{**base.params, free: float(x)}, units=base.units)
         d = m.dead_centres()
         if d.reversals != 1:
             return math.nan, math.nan, math.nan

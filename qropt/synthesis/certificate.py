@@ -38,6 +38,28 @@ class Certificate:
     def to_dict(self) -> dict:
         return asdict(self)
 
+    @classmethod
+    def from_dict(cls, d) -> Certificate:
+        """The Certificate of ``to_dict``; ProblemError naming the first field of the wrong type."""
+        from qropt.errors import ProblemError
+
+        def num(v):
+            return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+        checks = {"exact": (lambda v: isinstance(v, bool), "true or false"),
+                  "nlp": (lambda v: v is None or num(v), "null or a number"),
+                  "certified": (lambda v: v is None or num(v), "null or a number"),
+                  "gap": (num, "a number"),
+                  "rounds": (lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0, "a count"),
+                  "local": (lambda v: isinstance(v, str), "a string"),
+                  "global_claim": (lambda v: isinstance(v, str), "a string")}  # fmt: skip
+        if not isinstance(d, dict) or set(d) - set(checks) or set(checks) - {"global_claim"} - set(d):
+            raise ProblemError(f"a certificate is a table of {list(checks)}, got {d!r:.80}")
+        for k, v in d.items():
+            if not checks[k][0](v):
+                raise ProblemError(f"certificate {k} must be {checks[k][1]}, got {v!r:.80}")
+        return cls(**d)
+
 
 class Designs:
     """Mechanisms built from a problem's free values, each built once (they are immutable); one per Solver.

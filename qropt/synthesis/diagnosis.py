@@ -41,7 +41,7 @@ class Diagnosis:
         def done(status, msg, **kw):
             stats = self.solver._stats(problem, cands, plan)
             stats["t_total"] = time.perf_counter() - t0
-            return Result(status, msg, stats=stats, **kw)
+            return Result(status, msg, stats=stats, units=problem.units, **kw)
 
         beyond, found = self.bound_out_of_reach(problem, targets, n, seed)
         if beyond:

@@ -1,7 +1,12 @@
 """A synthesis problem: what the designer wants, validated and frozen.
 
-Lengths in any consistent unit, angles in radians. Targets are equality
-constraints, conditions inequalities, the objective one of ``criteria.objectives()``.
+Lengths are numbers in the problem's stated unit (``units``, one of ``qropt.units.LENGTH_UNITS``; default metres),
+angles in radians. Targets are equality constraints, conditions inequalities, the objective one of
+``criteria.objectives()``.
+
+Magnitudes are bounded where the analysis would overflow: lengths and offsets (fixed values, bounds, the stroke,
+length conditions) within MAGNITUDE (lengths at least 1 / MAGNITUDE), the crank speed |omega2| <= MAX_OMEGA2 rad/s
+and the time ratio <= MAX_TIME_RATIO.
 """
 
 from __future__ import annotations
@@ -13,11 +18,16 @@ from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Any
 
-from qropt.errors import ProblemError
+from qropt import units as units_
+from qropt.errors import ProblemError, QroptError
 from qropt.mechanisms import Mechanism, mechanism_type
-from qropt.mechanisms.base import REQUIRED
+from qropt.mechanisms.base import MAGNITUDE, REQUIRED
 from qropt.synthesis import criteria
 from qropt.synthesis.criteria import SIZES, finite
+
+MAX_OMEGA2 = 1e6  # rad/s: omega2^2 times a length up to MAGNITUDE stays finite (1e112); no machine turns faster
+MAX_TIME_RATIO = 1e6  # slow/fast: beyond it the fast stroke takes under 2 pi / 1e6 rad and TR has no meaning
+MAX_NESTING = 200  # levels of nested tables and lists in a problem file (a problem needs about 4)
 
 
 def _frozen(d):
@@ -35,7 +45,8 @@ class Problem:
     'max_peak_velocity' (length/s), 'linear' [(coefficients, lower, upper)], 'ratio' [(numerator,
     denominator, lower, upper)]; objective: 'max_gamma_min', 'min_size' (with ``size``), 'min_peak_accel'
     (at ``omega2``, over the 'cycle' or the 'working' stroke), 'min_peak_velocity' (at ``omega2``, over the
-    working stroke) or None (see ``qropt.criteria``); branches: name -> allowed signs.
+    working stroke) or None (see ``qropt.criteria``); branches: name -> allowed signs; units: the length unit
+    of every length above and of the answer (one of ``qropt.units.LENGTH_UNITS``; default metres).
     """
 
     mechanism: Any
@@ -49,6 +60,7 @@ class Problem:
     accel_over: str = "cycle"
     branches: Any = field(default_factory=dict)
     name: str = ""
+    units: str = units_.DEFAULT
 
     def __post_init__(self):
         try:
@@ -59,6 +71,10 @@ class Problem:
         set_(self, "mechanism", cls)
         if not isinstance(self.name, str):
             raise ProblemError(f"{cls.__name__}: name must be a string, got {self.name!r}")
+        try:
+            units_.length_unit(self.units)
+        except QroptError as e:
+            raise self._err(str(e)) from None
         for k in ("fixed", "free", "targets", "conditions", "branches"):
             v = getattr(self, k)
             if v is not None and not isinstance(v, Mapping):
@@ -66,7 +82,7 @@ class Problem:
             set_(self, k, _frozen(v))
         try:
             self._validate()
-        except (TypeError, ValueError, KeyError, IndexError, AttributeError) as e:  # malformed nested values
+        except (TypeError, ValueError, KeyError, IndexError, AttributeError, RecursionError) as e:  # malformed values
             if isinstance(e, ProblemError):
                 raise
             raise self._err(f"malformed problem ({type(e).__name__}: {e})") from None
@@ -105,15 +121,25 @@ class Problem:
                 raise self._err(f"bounds of {k} are empty or contradictory: ({lo:g}, {hi:g}); fix it instead")
             if k in cls.LENGTHS and lo <= 0:
                 raise self._err(f"length {k} needs a positive lower bound, got {lo:g}")
+            self._check_magnitude(f"bounds of {k}", k in cls.LENGTHS, lo, hi)
         for k, v in self.fixed.items():
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
                 raise self._err(f"fixed {k} must be a finite number, got {v!r}")
             if k in cls.LENGTHS and v <= 0:
                 raise self._err(f"fixed length {k} must be positive, got {v:g}")
+            if k not in cls.BRANCHES:
+                self._check_magnitude(f"fixed {k}", k in cls.LENGTHS, v)
         missing = [k for k, v in params.items() if v is REQUIRED and k not in self.fixed and k not in self.free]
         if missing:
             raise self._err(f"parameters {missing} are neither fixed nor free")
         return self.free
+
+    def _check_magnitude(self, what, length: bool, *values):
+        """Lengths in [1/MAGNITUDE, MAGNITUDE] and other values (offsets) within MAGNITUDE, as mechanisms take."""
+        for v in values:
+            if abs(v) > MAGNITUDE or (length and v < 1 / MAGNITUDE):
+                span = "[1e-100, 1e100]" if length else "[-1e100, 1e100]"
+                raise self._err(f"{what} = {v:g} is out of range ({span} {self.units})")
 
     def _branches(self):
         out = {}
@@ -151,8 +177,12 @@ class Problem:
         tr = self.targets.get("time_ratio")
         if tr is not None and tr < 1.0:
             raise self._err(f"time_ratio is slow/fast >= 1 by definition, got {tr:g}")
+        if tr is not None and tr > MAX_TIME_RATIO:
+            raise self._err(f"time_ratio {tr:g} is beyond {MAX_TIME_RATIO:g} (a fast stroke under 2 pi / 1e6 rad)")
         if self.targets.get("stroke", 1.0) <= 0:
             raise self._err(f"stroke must be positive, got {self.targets['stroke']:g}")
+        if "stroke" in self.targets:
+            self._check_magnitude("stroke", True, self.targets["stroke"])
         if not 0 < self.targets.get("swing", 1.0) < math.pi:
             raise self._err(f"swing must be in (0, pi) rad, got {self.targets['swing']:g}")
 
@@ -180,6 +210,8 @@ class Problem:
                 if not (finite(c[k]) and c[k] > 0):
                     raise self._err(f"{k} is an upper bound, a positive number; got {c[k]!r}")
                 c[k] = float(c[k])
+                if c[k] > MAGNITUDE**2 or c[k] < MAGNITUDE**-2:  # footprints are length^2; MAGNITUDE^2 is finite
+                    raise self._err(f"{k} = {c[k]:g} is out of range")
             if k in c and not crit.applies(self.mechanism):
                 raise self._err(f"{self.mechanism.__name__} has no slider: {k} does not apply")
         linear = []
@@ -223,10 +255,12 @@ class Problem:
             raise self._err(f"accel_over is 'cycle' or 'working', got {self.accel_over!r}")
         if not (finite(self.omega2) and self.omega2 != 0):
             raise self._err(f"omega2 is the crank speed in rad/s, a nonzero finite number; got {self.omega2!r}")
+        if abs(self.omega2) > MAX_OMEGA2:
+            raise self._err(f"omega2 = {self.omega2:g} rad/s is out of range (|omega2| <= {MAX_OMEGA2:g} rad/s)")
         if self.objective and not criteria.of(self.objective, self.size).applies(self.mechanism):
             raise self._err(f"{self.mechanism.__name__} has no slider: {self.objective} does not apply")
 
-    # ---- equality and serialisation (angles in radians, lengths in the problem's units) -------------
+    # ---- equality and serialisation (angles in radians, lengths in the problem's unit) -------------
     def to_dict(self) -> dict:
         """Plain JSON-ready values: the mechanism by its kind, bounds as [lower, upper], objective None or a name."""
         c = dict(self.conditions)
@@ -246,6 +280,7 @@ class Problem:
             "accel_over": self.accel_over,
             "branches": {k: list(v) for k, v in self.branches.items()},
             "name": self.name,
+            "units": self.units,
         }
 
     @classmethod
@@ -271,10 +306,16 @@ class Problem:
 
     @classmethod
     def _from_text(cls, text, loads, error, kind) -> Problem:
+        if not isinstance(text, str):
+            raise ProblemError(f"a {kind} problem is text (str), got {type(text).__name__}")
+        if _nesting(text) > MAX_NESTING:
+            raise ProblemError(f"not a {kind} problem: nested deeper than {MAX_NESTING} levels")
         try:
             d = loads(text)
         except error as e:
             raise ProblemError(f"not a {kind} problem: {e}") from None
+        except RecursionError:
+            raise ProblemError(f"not a {kind} problem: nested too deeply") from None
         return cls.from_dict(d)
 
     def to_toml(self) -> str:
@@ -306,5 +347,19 @@ class Problem:
         return Problem(**{k: (dict(v) if isinstance(v, MappingProxyType) else v) for k, v in d.items()})
 
     def build(self, values: dict, branch: dict) -> Mechanism:
-        """The mechanism with the free parameters at ``values`` on ``branch`` (may raise QroptError)."""
-        return self.mechanism(**self.fixed, **values, **branch)
+        """The mechanism (in the problem's unit) with the free parameters at ``values`` on ``branch`` (may raise
+        QroptError)."""
+        return self.mechanism(**self.fixed, **values, **branch, units=self.units)
+
+
+def _nesting(text: str) -> int:
+    """An upper bound on the nesting depth of JSON or TOML text: brackets and braces open at once (counting those
+    inside strings too, which only overestimates)."""
+    depth = most = 0
+    for ch in text:
+        if ch in "[{":
+            depth += 1
+            most = max(most, depth)
+        elif ch in "]}":
+            depth = max(depth - 1, 0)
+    return most

@@ -13,17 +13,37 @@ Statuses (grouped as cvxpy groups its own):
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from qropt import units as units_
+from qropt.errors import ProblemError, QroptError
 from qropt.synthesis.certificate import Certificate
 
 STATUSES = ("optimal", "local_optimum", "acceptable", "feasible", "infeasible", "failed")
 SOLUTION_PRESENT = ("optimal", "local_optimum", "acceptable", "feasible")
 NO_SOLUTION = ("infeasible", "failed")
-UNITS = {"angles": "rad (gamma_min, swing, theta)", "lengths": "the problem's length unit (stroke, size, params)",
-         "footprint": "length^2", "peak_accel": "length/s^2 at the problem's omega2", "time_ratio": "1 (slow/fast)",
-         "times": "s"}  # fmt: skip
+MAX_DEPTH = 8  # levels of local_optima within local_optima a Result dictionary may hold (a solve writes 1)
+
+
+def unit_names(unit: str = units_.DEFAULT) -> dict:
+    """What the numbers of a Result in length unit ``unit`` are in (its ``to_dict()['units']``)."""
+    from qropt.synthesis import criteria
+
+    u = units_.length_unit(unit)
+    c = criteria.CRITERIA
+    return {
+        "length": u,
+        "angles": "rad (gamma_min, swing, theta)",
+        "lengths": f"{u} (stroke, size, params)",
+        "footprint": units_.named(c["footprint"].unit, u),
+        "peak_accel": units_.named(c["peak_accel"].unit, u) + " at the problem's omega2",
+        "peak_velocity": units_.named(c["peak_velocity"].unit, u) + " at the problem's omega2",
+        "torque_per_newton": f"{u} (N m per N)",
+        "time_ratio": "1 (slow/fast)",
+        "times": "s",
+    }
 
 
 def json_safe(v):
@@ -49,7 +69,8 @@ class Result:
     stroke or swing, gamma_min (rad), peak_accel, grashof, size, working_direction; residuals: constraint
     name -> violation (>= 0); certificate: a Certificate; stats: solver statistics and timings (s);
     local_optima: every distinct local optimum found (best first); reachable: target -> (low, high)
-    when no design was found.
+    when no design was found; units: the length unit of every length in it (None: its mechanism's, else
+    ``qropt.units.DEFAULT``; always a unit name once built).
     """
 
     status: str
@@ -63,6 +84,22 @@ class Result:
     stats: dict = field(default_factory=dict)
     local_optima: tuple = ()
     reachable: dict = field(default_factory=dict)
+    units: str | None = None
+
+    def __post_init__(self):
+        if self.status not in STATUSES:
+            raise ProblemError(f"a Result's status is one of {list(STATUSES)}, got {self.status!r:.80}")
+        if not isinstance(self.message, str):
+            raise ProblemError(f"a Result's message is a string, got {type(self.message).__name__}")
+        own = getattr(self.mechanism, "units", None)
+        unit = self.units if self.units is not None else own or units_.DEFAULT
+        try:
+            units_.length_unit(unit)
+        except QroptError as e:
+            raise ProblemError(f"a Result's units: {e}") from None
+        if own is not None and own != unit:
+            raise ProblemError(f"a Result in {unit} has a mechanism in {own}")
+        object.__setattr__(self, "units", unit)
 
     @property
     def success(self) -> bool:
@@ -74,22 +111,30 @@ class Result:
         return max(self.residuals.values(), default=0.0)
 
     def _quantity_parts(self, sep: str) -> list[str]:
+        from qropt.synthesis import criteria
+
         q = self.quantities
         parts = [f"time_ratio{sep}{q['time_ratio']:.10g}"]
         if "stroke" in q:
-            parts.append(f"stroke{sep}{q['stroke']:.10g}")
+            parts.append(f"stroke{sep}{q['stroke']:.10g} {self.units}")
         if "swing" in q:
             parts.append(f"swing{sep}{math.degrees(q['swing']):.6f} deg")
         parts.append(f"gamma_min{sep}{math.degrees(q['gamma_min']):.6f} deg")
         if q.get("peak_accel") is not None:
             w = self.stats.get("omega2", 1.0)
-            parts.append(f"peak_accel{sep}{q['peak_accel']:.6g} length/s^2 at omega2 = {w:g} rad/s")
+            unit = units_.named(criteria.CRITERIA["peak_accel"].unit, self.units)
+            parts.append(f"peak_accel{sep}{q['peak_accel']:.6g} {unit} at omega2 = {w:g} rad/s")
+        for name, c in criteria.CRITERIA.items():  # registered criteria beyond the built-in ones
+            if name not in criteria.BUILT_IN and isinstance(q.get(name), (int, float)):
+                shown = math.degrees(q[name]) if c.unit == "rad" else q[name]
+                unit = "deg" if c.unit == "rad" else units_.named(c.unit, self.units)
+                parts.append(f"{name}{sep}{shown:.10g} {unit}")
         return parts
 
     def __repr__(self):
         lines = [f"Result(status={self.status!r}, objective={self.objective!r})", f"  message: {self.message}"]
         if self.params:
-            lines.append("  params: " + ", ".join(f"{k}={v:.10g}" for k, v in self.params.items()))
+            lines.append(f"  params ({self.units}, rad): " + ", ".join(f"{k}={v:.10g}" for k, v in self.params.items()))
         if self.quantities:
             lines.append("  quantities: " + ", ".join(self._quantity_parts("=")))
         if self.certificate is not None:
@@ -107,7 +152,7 @@ class Result:
         """A few readable lines: status, design, quantities (gamma_min in degrees), certificate."""
         lines = [f"status: {self.status} - {self.message}"]
         if self.params:
-            lines.append("design: " + ", ".join(f"{k}={v:.10g}" for k, v in self.params.items()))
+            lines.append(f"design ({self.units}): " + ", ".join(f"{k}={v:.10g}" for k, v in self.params.items()))
         if self.quantities:
             extra = [self.quantities["grashof"]] if self.quantities.get("grashof") else []
             lines.append("quantities: " + ", ".join(self._quantity_parts(" ") + extra))
@@ -123,7 +168,7 @@ class Result:
     def to_dict(self) -> dict:
         """Strict-JSON dictionary (no NaN: None); the mechanism as its type kind and parameters."""
         return json_safe({
-            "units": UNITS,
+            "units": unit_names(self.units),
             "status": self.status,
             "success": self.success,
             "message": self.message,
@@ -140,30 +185,77 @@ class Result:
         })  # fmt: skip
 
     @classmethod
-    def from_dict(cls, d: dict) -> Result:
-        """The Result of ``to_dict`` (the mechanism rebuilt from its type and parameters)."""
-        from qropt.errors import ProblemError
+    def from_dict(cls, d, _depth: int = 0) -> Result:
+        """The Result of ``to_dict`` (the mechanism rebuilt from its type, parameters and unit); ProblemError naming
+        the first field that is missing or of the wrong type. A dictionary without units is in the default unit."""
+        if not isinstance(d, Mapping):
+            raise ProblemError(f"not a qropt Result dictionary: a table of fields, got {type(d).__name__}")
+        if _depth > MAX_DEPTH:
+            raise ProblemError(f"not a qropt Result dictionary: local_optima nested deeper than {MAX_DEPTH} levels")
+        try:
+            return cls._from_dict(d, _depth)
+        except QroptError as e:
+            why = str(e)
+        except (KeyError, TypeError, ValueError, RecursionError) as e:
+            why = f"{type(e).__name__}: {e}"
+        prefix = "not a qropt Result dictionary: "
+        raise ProblemError(why if why.startswith(prefix) else prefix + why)
+
+    @classmethod
+    def _from_dict(cls, d, depth) -> Result:
+        def need(key, ok, what, default=None):
+            v = d.get(key, default)
+            if not ok(v):
+                raise ProblemError(f"{key} must be {what}, got {v!r:.80}")
+            return v
+
+        def numbers(v, none=False):
+            return isinstance(v, Mapping) and all(
+                isinstance(k, str) and (_number(x) or (none and x is None)) for k, x in v.items()
+            )
+
+        def pair(v):
+            return isinstance(v, (list, tuple)) and len(v) == 2 and all(x is None or _number(x) for x in v)
+
+        if "status" not in d or "message" not in d:
+            raise ProblemError("it needs 'status' and 'message'")
+        need("status", lambda v: v in STATUSES, f"one of {list(STATUSES)}")
+        need("message", lambda v: isinstance(v, str), "a string")
+        kind = need("type", lambda v: v is None or isinstance(v, str), "null or a type name")
+        params = need("params", lambda v: numbers(v), "a table of numbers", {})
+        objective = need("objective", lambda v: v is None or _number(v), "null or a number")
+        quantities = need("quantities", lambda v: isinstance(v, Mapping), "a table", {})
+        residuals = need("residuals", lambda v: numbers(v, none=True), "a table of numbers", {})
+        cert = need("certificate", lambda v: v is None or isinstance(v, Mapping), "null or a table")
+        stats = need("stats", lambda v: isinstance(v, Mapping), "a table", {})
+        reach = need("reachable", lambda v: isinstance(v, Mapping) and all(map(pair, v.values())),
+                     "a table of [low, high] pairs", {})  # fmt: skip
+        local = need("local_optima", lambda v: isinstance(v, (list, tuple)), "a list of Result tables", [])
+        unit = d.get("units")
+        if isinstance(unit, Mapping):  # to_dict's table names its length unit; older files: the default
+            unit = unit.get("length", units_.DEFAULT)
+        unit = units_.DEFAULT if unit is None else units_.length_unit(unit)
         from qropt.mechanisms import mechanism_type
 
-        try:
-            d = {k: v for k, v in d.items() if k != "units"}
-            mech = mechanism_type(d["type"])(**d["params"]) if d.get("type") else None
-            cert = Certificate(**d["certificate"]) if d.get("certificate") else None
-            return cls(
-                status=d["status"],
-                message=d["message"],
-                params=dict(d.get("params") or {}),
-                mechanism=mech,
-                objective=d.get("objective"),
-                quantities=dict(d.get("quantities") or {}),
-                residuals={k: (v if v is not None else math.inf) for k, v in (d.get("residuals") or {}).items()},
-                certificate=cert,
-                stats=dict(d.get("stats") or {}),
-                local_optima=tuple(cls.from_dict(x) for x in d.get("local_optima") or ()),
-                reachable={
-                    k: (math.nan if v[0] is None else v[0], math.nan if v[1] is None else v[1])
-                    for k, v in (d.get("reachable") or {}).items()
-                },  # fmt: skip
-            )
-        except (KeyError, TypeError, ValueError) as e:
-            raise ProblemError(f"not a qropt Result dictionary: {e}") from None
+        mech = mechanism_type(kind)(**params, units=unit) if kind else None
+        return cls(
+            status=d["status"],
+            message=d["message"],
+            params=dict(params),
+            mechanism=mech,
+            objective=None if objective is None else float(objective),
+            quantities=dict(quantities),
+            residuals={k: (v if v is not None else math.inf) for k, v in residuals.items()},
+            certificate=None if cert is None else Certificate.from_dict(cert),
+            stats=dict(stats),
+            local_optima=tuple(cls.from_dict(x, depth + 1) for x in local),
+            reachable={
+                k: (math.nan if lo is None else lo, math.nan if hi is None else hi) for k, (lo, hi) in reach.items()
+            },
+            units=unit,
+        )
+
+
+def _number(v) -> bool:
+    """A real number (int or float, not a bool); nan and inf allowed (a Result holds them)."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool)

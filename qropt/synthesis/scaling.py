@@ -70,7 +70,7 @@ def unscaled(result, problem, k: float):
     if k == 1.0:
         return result
     back = 1.0 / k
-    params = {n: v * back if _scales(problem, n) else v for n, v in result.params.items()}
+    params = {n: problem.fixed.get(n, v * back) if _scales(problem, n) else v for n, v in result.params.items()}
     mechanism = None
     if result.mechanism is not None:
         branch = {n: v for n, v in params.items() if n in problem.mechanism.BRANCHES}

@@ -165,9 +165,8 @@ class Solver:
             msg += f"{plan.outside + len(cands)}" if plan.outside or cands else "none for these targets"
             msg += f", {plan.outside} outside the bounds" if plan.outside else ""
             msg += f"; {len(cands)} fail ({'; '.join(why[:3])})" if cands else ""
-            return Result(
-                "infeasible", msg, stats={"plan": plan.kind, "starts": len(cands), "t_total": time.perf_counter() - t0}
-            )
+            stats = {"plan": plan.kind, "starts": len(cands), "t_total": time.perf_counter() - t0}
+            return Result("infeasible", msg, stats=stats, units=problem.units)
         if plan.kind in ("family", "enumeration") and not extra and not good and not diagnose:
             # no closed-form point refines (or the closed form missed): search instead (the diagnosis does this last)
             kw = {"starts_n": starts_n, "seed": seed, "targets": targets, "max_rounds": max_rounds}
@@ -182,6 +181,7 @@ class Solver:
                 "failed",
                 f"no start gave a certified design ({'; '.join(w for w in why[:3] if w)}); not diagnosed",
                 stats=stats,
+                units=problem.units,
             )
         return self.diagnosis.run(problem, plan, cands, claim, retry, targets, starts_n, seed, t0)
 
