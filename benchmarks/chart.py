@@ -71,9 +71,17 @@ def main() -> None:
     t_local = time.perf_counter() - t
     print(f"scheduler='local', 2 workers (cluster start and the workers' NLP builds included): {t_local:.2f} s")
     heres, warms, ones, plains = [], [], [], []
-    specs = [{"problem": p.to_dict(), "x": [x[0], list(x[1])], "y": [y[0], list(y[1])],
-              "block": [i0, min(i0 + TILE[0], len(x[1])), j0, min(j0 + TILE[1], len(y[1]))], "check": 10}
-             for j0 in range(0, len(y[1]), TILE[1]) for i0 in range(0, len(x[1]), TILE[0])]  # fmt: skip
+    specs = [
+        {
+            "problem": p.to_dict(),
+            "x": [x[0], list(x[1])],
+            "y": [y[0], list(y[1])],
+            "block": [i0, min(i0 + TILE[0], len(x[1])), j0, min(j0 + TILE[1], len(y[1]))],
+            "check": 10,
+        }
+        for j0 in range(0, len(y[1]), TILE[1])
+        for i0 in range(0, len(x[1]), TILE[0])
+    ]
     quiet = {"threads_per_worker": 1, "dashboard_address": ":0", "silence_logs": logging.ERROR}
     with dask.config.set(LOCAL_CONFIG):
         lc2, lc1 = LocalCluster(n_workers=2, **quiet), LocalCluster(n_workers=1, **quiet)
@@ -95,11 +103,16 @@ def main() -> None:
             plains.append(max(sum(half) for half in pool.map(_tiles, [(specs, 0, 2), (specs, 1, 2)])))
     t_here, t_warm, t_one, t_plain = (statistics.median(v) for v in (heres, warms, ones, plains))
     print(f"in-process: {cells} cells in {t_here:.2f} s ({cells / t_here:.1f} cells/s); {here!r}")
-    same = all([getattr(a, k) for k in SAME] == [getattr(b, k) for k in SAME]
-               for ch in (local, cold, warm) for a, b in zip(here.cells, ch.cells, strict=True))  # fmt: skip
-    print(f"2-worker cluster: {t_cold:.2f} s (workers building their NLPs), {t_warm:.2f} s warm "
-          f"({t_here / t_warm:.2f}x); 1-worker cluster {t_one:.2f} s; two plain processes with half the tiles "
-          f"each {t_plain:.2f} s ({t_here / t_plain:.2f}x, the ceiling); every cell as in-process: {same}")  # fmt: skip
+    same = all(
+        [getattr(a, k) for k in SAME] == [getattr(b, k) for k in SAME]
+        for ch in (local, cold, warm)
+        for a, b in zip(here.cells, ch.cells, strict=True)
+    )
+    print(
+        f"2-worker cluster: {t_cold:.2f} s (workers building their NLPs), {t_warm:.2f} s warm "
+        f"({t_here / t_warm:.2f}x); 1-worker cluster {t_one:.2f} s; two plain processes with half the tiles "
+        f"each {t_plain:.2f} s ({t_here / t_plain:.2f}x, the ceiling); every cell as in-process: {same}"
+    )
 
     t = time.perf_counter()
     worse, better, diff = 0, 0, 0.0
@@ -110,9 +123,11 @@ def main() -> None:
         better += r.objective < c.objective - 1e-7
     t_base = time.perf_counter() - t
     load1 = os.getloadavg()
-    print(f"independent default solves: {t_base:.2f} s; the chart is {t_base / t_here:.2f}x faster; "
-          f"largest objective difference {diff:.1e} rad ({worse} cells better by an independent solve, "
-          f"{better} better in the chart)")  # fmt: skip
+    print(
+        f"independent default solves: {t_base:.2f} s; the chart is {t_base / t_here:.2f}x faster; "
+        f"largest objective difference {diff:.1e} rad ({worse} cells better by an independent solve, "
+        f"{better} better in the chart)"
+    )
 
     per_tile = max(0.0, t_warm - makespan(tiles, 2, 0.0)) / (
         len(tiles) / 2
@@ -128,18 +143,39 @@ def main() -> None:
     for w, s in scale.items():
         print(f"  estimated 200 x 100 chart on {w} workers: {s:.1f} s ({big / s:.0f} cells/s)")
     data = {
-        "problem": "problems/chart_crank_rocker.py", "cells": cells, "tile": list(TILE),
-        "tiles": here.stats["tiles"], "cpu_count": os.cpu_count(), "load_before": load0, "load_after": load1,
-        "in_process_s": t_here, "local_with_start_s": t_local, "cluster_cold_s": t_cold, "cluster_warm_s": t_warm,
-        "cluster_one_worker_s": t_one, "independent_s": t_base, "equal_results": same,
-        "two_plain_processes_s": t_plain, "runs_in_process_s": heres, "runs_two_workers_s": warms,
-        "speedup_two_workers": t_here / t_warm, "speedup_two_over_one_worker": t_one / t_warm,
-        "continuation_gain": t_base / t_here, "full_solves": n_full, "needed": here.stats["needed"],
-        "jumps": here.stats["jumps"], "switched": here.stats["switched"], "max_objective_difference": diff,
-        "independent_better": int(worse), "chart_better": int(better), "mean_full_s": t_full,
-        "mean_continued_s": t_cont, "dask_per_tile_s": per_tile,
-        "estimate_this_chart_s": here_scale, "estimate_200x100_s": scale,
-    }  # fmt: skip
+        "problem": "problems/chart_crank_rocker.py",
+        "cells": cells,
+        "tile": list(TILE),
+        "tiles": here.stats["tiles"],
+        "cpu_count": os.cpu_count(),
+        "load_before": load0,
+        "load_after": load1,
+        "in_process_s": t_here,
+        "local_with_start_s": t_local,
+        "cluster_cold_s": t_cold,
+        "cluster_warm_s": t_warm,
+        "cluster_one_worker_s": t_one,
+        "independent_s": t_base,
+        "equal_results": same,
+        "two_plain_processes_s": t_plain,
+        "runs_in_process_s": heres,
+        "runs_two_workers_s": warms,
+        "speedup_two_workers": t_here / t_warm,
+        "speedup_two_over_one_worker": t_one / t_warm,
+        "continuation_gain": t_base / t_here,
+        "full_solves": n_full,
+        "needed": here.stats["needed"],
+        "jumps": here.stats["jumps"],
+        "switched": here.stats["switched"],
+        "max_objective_difference": diff,
+        "independent_better": int(worse),
+        "chart_better": int(better),
+        "mean_full_s": t_full,
+        "mean_continued_s": t_cont,
+        "dask_per_tile_s": per_tile,
+        "estimate_this_chart_s": here_scale,
+        "estimate_200x100_s": scale,
+    }
     save("chart.json", data)
     (RESULTS / "chart.md").write_text(markdown(data, environment()))
     print(f"wrote {RESULTS / 'chart.md'} and chart.json")
@@ -181,12 +217,13 @@ def markdown(d: dict, env: dict) -> str:
         "transfer, and two processes sharing the machine's two cores)",
         "",
         "Estimated (a schedule of measured tile times, each worker taking the next tile when free, plus the "
-        "per-tile cost): this chart on " + ", ".join(f"{w} workers {s:.2f} s" for w, s in
-                                                       d["estimate_this_chart_s"].items()) +
-        " (8 tiles: more than 8 workers need smaller tiles); a 200 x 100 chart (200 tiles) on "
-        + ", ".join(f"{w} workers {s:.1f} s" for w, s in d["estimate_200x100_s"].items()) + ".",
+        "per-tile cost): this chart on "
+        + ", ".join(f"{w} workers {s:.2f} s" for w, s in d["estimate_this_chart_s"].items())
+        + " (8 tiles: more than 8 workers need smaller tiles); a 200 x 100 chart (200 tiles) on "
+        + ", ".join(f"{w} workers {s:.1f} s" for w, s in d["estimate_200x100_s"].items())
+        + ".",
         "",
-    ]  # fmt: skip
+    ]
     return "\n".join(lines)
 
 

@@ -50,8 +50,15 @@ def run() -> list[tuple]:
     t360 = median_s(lambda: speed_profile(dl, **TORQUE, n=360))
     rows.append(("speed_profile, drag-link torque limit, n = 720", t720, "n = 360", t360, 0.5))
     tcut = median_s(lambda: speed_profile(sc, **CUT, n=720))
-    rows.append(("speed_profile, in-line slider-crank v_cut, n = 720", tcut, "n = 360",
-                 median_s(lambda: speed_profile(sc, **CUT, n=360)), 0.5))  # fmt: skip
+    rows.append(
+        (
+            "speed_profile, in-line slider-crank v_cut, n = 720",
+            tcut,
+            "n = 360",
+            median_s(lambda: speed_profile(sc, **CUT, n=360)),
+            0.5,
+        )
+    )
     tsp = median_s(lambda: speed_profile(dl, omega_max=12.0, v_max=1.5, n=720))
     tnp = median_s(lambda: speed_only_numpy(dl, 12.0, 1.5, 720), repeat=21)
     rows.append(("speed_profile, speed limits only, n = 720", tsp, "numpy closed form", tnp, 0.5))
@@ -64,8 +71,13 @@ def run() -> list[tuple]:
     al = allocate(dl, LIMITS)
     tmc = median_s(lambda: al.monte_carlo(10_000, progress=False), repeat=3)
     rng = np.random.default_rng(0)
-    samples = [{k: v + (rng.uniform(-1, 1) * al.tolerances.get(k, 0.0) if math.isfinite(al.tolerances.get(k, 0.0))
-                        else 0.0) for k, v in dl.params.items()} for _ in range(200)]  # fmt: skip
+    samples = [
+        {
+            k: v + (rng.uniform(-1, 1) * al.tolerances.get(k, 0.0) if math.isfinite(al.tolerances.get(k, 0.0)) else 0.0)
+            for k, v in dl.params.items()
+        }
+        for _ in range(200)
+    ]
     tloop = median_s(lambda: [(lambda m: (m.time_ratio(), m.stroke()))(type(dl)(**p)) for p in samples], repeat=3)
     per = tloop / 200
     rows.append(("monte_carlo, 10,000 mechanisms, vectorised", tmc, "per-mechanism API x 10,000", per * 10_000, 2.0))
@@ -99,13 +111,22 @@ def main():
     env = environment()
     print("the convex layer (median of repeats)")
     for name, t, base, tb, target in rows:
-        print(f"  {name:52s} {1e3 * t:9.1f} ms   {base}: {1e3 * tb:9.2f} ms   ratio {t / tb:7.2f}x   "
-              f"target <= {1e3 * target:g} ms {'met' if t <= target else 'MISSED'}")  # fmt: skip
+        print(
+            f"  {name:52s} {1e3 * t:9.1f} ms   {base}: {1e3 * tb:9.2f} ms   ratio {t / tb:7.2f}x   "
+            f"target <= {1e3 * target:g} ms {'met' if t <= target else 'MISSED'}"
+        )
     RESULTS.mkdir(parents=True, exist_ok=True)
     (RESULTS / "convex.md").write_text(markdown(rows, env))
-    save("convex.json", {"cvxpy": cvxpy.__version__,
-                         "rows": [{"task": n, "median_s": t, "baseline": b, "baseline_s": tb, "ratio": t / tb,
-                                   "target_s": g} for n, t, b, tb, g in rows]})  # fmt: skip
+    save(
+        "convex.json",
+        {
+            "cvxpy": cvxpy.__version__,
+            "rows": [
+                {"task": n, "median_s": t, "baseline": b, "baseline_s": tb, "ratio": t / tb, "target_s": g}
+                for n, t, b, tb, g in rows
+            ],
+        },
+    )
 
 
 if __name__ == "__main__":

@@ -24,13 +24,19 @@ from qropt.studies._pareto import pareto
 from qropt.synthesis import criteria
 
 FRONTS = {
-    "slider_crank: max_gamma_min vs min_peak_accel": (problem_bases.slider_crank(omega2=2.0),
-                                                       ("max_gamma_min", "min_peak_accel")),
-    "slider_crank: max_gamma_min vs min_peak_velocity": (problem_bases.slider_crank(omega2=2.0),
-                                                          ("max_gamma_min", "min_peak_velocity")),
-    "crank_rocker_slider: max_gamma_min vs min_size (sum)": (problem_bases.crank_rocker_slider(omega2=2.0),
-                                                              ("max_gamma_min", "min_size")),
-}  # fmt: skip
+    "slider_crank: max_gamma_min vs min_peak_accel": (
+        problem_bases.slider_crank(omega2=2.0),
+        ("max_gamma_min", "min_peak_accel"),
+    ),
+    "slider_crank: max_gamma_min vs min_peak_velocity": (
+        problem_bases.slider_crank(omega2=2.0),
+        ("max_gamma_min", "min_peak_velocity"),
+    ),
+    "crank_rocker_slider: max_gamma_min vs min_size (sum)": (
+        problem_bases.crank_rocker_slider(omega2=2.0),
+        ("max_gamma_min", "min_size"),
+    ),
+}
 
 
 def timed(f, repeat):
@@ -48,8 +54,10 @@ def front_by_full_solves(problem, objectives, n, solver):
     cb = criteria.of(b, problem.size)
     ends = [solver.solve(problem.replace(objective=o)) for o in (a, b)]
     lo, hi = (cb.value(problem, r.mechanism) for r in ends)
-    return [solver.solve(problem.replace(objective=a, conditions={**problem.conditions, cb.bound: float(e)}))
-            for e in np.linspace(lo, hi, n)[1:-1]]  # fmt: skip
+    return [
+        solver.solve(problem.replace(objective=a, conditions={**problem.conditions, cb.bound: float(e)}))
+        for e in np.linspace(lo, hi, n)[1:-1]
+    ]
 
 
 def main(argv=None) -> int:
@@ -66,21 +74,38 @@ def main(argv=None) -> int:
     cold = Solver()
     for k in TYPES:
         cold.solve(type_problem(k, 1.5, 0.3), use_analytic=False)
-    _, t_cold, _ = timed(lambda: [cold.solve(type_problem(k, 1.5, 0.3), use_analytic=False) for k in TYPES],
-                         args.repeat)  # fmt: skip
+    _, t_cold, _ = timed(
+        lambda: [cold.solve(type_problem(k, 1.5, 0.3), use_analytic=False) for k in TYPES], args.repeat
+    )
     print(f"  the same types solved cold (no closed-form starts): median {t_cold:.2f} s ({t_cold / t_design:.1f}x)")
     fronts = {}
     for name, (p, objectives) in FRONTS.items():
         pareto(p, objectives, n=20, solver=solver)  # warm-up
-        f, t_front, _ = timed(lambda p=p, objectives=objectives: pareto(p, objectives, n=20, solver=solver),
-                              args.repeat)  # fmt: skip
+        f, t_front, _ = timed(
+            lambda p=p, objectives=objectives: pareto(p, objectives, n=20, solver=solver), args.repeat
+        )
         _, t_full, _ = timed(lambda p=p, objectives=objectives: front_by_full_solves(p, objectives, 20, solver), 1)
-        fronts[name] = {"points": len(f.points), "removed": len(f.removed), "median_s": t_front,
-                        "full_solves_s": t_full, "gain": t_full / t_front}  # fmt: skip
-        print(f"20-point front, {name}: median {t_front:.2f} s, {len(f.points)} points ({len(f.removed)} "
-              f"removed); every point a full solve: {t_full:.2f} s ({t_full / t_front:.1f}x)")  # fmt: skip
-    save("design.json", {"design_median_s": t_design, "design_runs_s": runs, "per_type_s": per_type,
-                         "cold_types_s": t_cold, "fronts": fronts})  # fmt: skip
+        fronts[name] = {
+            "points": len(f.points),
+            "removed": len(f.removed),
+            "median_s": t_front,
+            "full_solves_s": t_full,
+            "gain": t_full / t_front,
+        }
+        print(
+            f"20-point front, {name}: median {t_front:.2f} s, {len(f.points)} points ({len(f.removed)} "
+            f"removed); every point a full solve: {t_full:.2f} s ({t_full / t_front:.1f}x)"
+        )
+    save(
+        "design.json",
+        {
+            "design_median_s": t_design,
+            "design_runs_s": runs,
+            "per_type_s": per_type,
+            "cold_types_s": t_cold,
+            "fronts": fronts,
+        },
+    )
     return 0
 
 

@@ -25,26 +25,42 @@ def cases():
     from qropt import Problem
 
     def paper(**kw):
-        base = dict(mechanism="DragLinkSlider", fixed={"r1": 0.1, "r2": 0.225, "r4": 0.275, "r6": 0.3},
-                    free={"r3": (0.05, 1.0), "r5": (0.01, 0.5)}, targets={"time_ratio": 1.5, "stroke": 0.3},
-                    conditions={"grashof": "drag-link"}, objective="max_gamma_min")  # fmt: skip
+        base = dict(
+            mechanism="DragLinkSlider",
+            fixed={"r1": 0.1, "r2": 0.225, "r4": 0.275, "r6": 0.3},
+            free={"r3": (0.05, 1.0), "r5": (0.01, 0.5)},
+            targets={"time_ratio": 1.5, "stroke": 0.3},
+            conditions={"grashof": "drag-link"},
+            objective="max_gamma_min",
+        )
         return Problem(**{**base, **kw})
 
     def rocker_slider(**kw):
-        base = dict(mechanism="CrankRockerSlider", fixed={"r1": 0.3, "r2": 0.1, "r6": 0.5},
-                    free={"r3": (0.15, 0.6), "r4": (0.15, 0.45), "r5": (0.02, 0.45)},
-                    targets={"time_ratio": 1.2, "stroke": 0.15}, objective="max_gamma_min")  # fmt: skip
+        base = dict(
+            mechanism="CrankRockerSlider",
+            fixed={"r1": 0.3, "r2": 0.1, "r6": 0.5},
+            free={"r3": (0.15, 0.6), "r4": (0.15, 0.45), "r5": (0.02, 0.45)},
+            targets={"time_ratio": 1.2, "stroke": 0.15},
+            objective="max_gamma_min",
+        )
         return Problem(**{**base, **kw})
 
     def slider_crank(**kw):
-        base = dict(mechanism="SliderCrank", free={"r2": (0.05, 0.3), "r3": (0.1, 1.5), "e": (0.0, 0.6)},
-                    targets={"time_ratio": 1.3, "stroke": 0.3})  # fmt: skip
+        base = dict(
+            mechanism="SliderCrank",
+            free={"r2": (0.05, 0.3), "r3": (0.1, 1.5), "e": (0.0, 0.6)},
+            targets={"time_ratio": 1.3, "stroke": 0.3},
+        )
         return Problem(**{**base, **kw})
 
     def four_bar(**kw):
-        base = dict(mechanism="FourBar", fixed={"r1": 1.0}, free={"r2": (0.1, 0.5), "r3": (0.3, 2.0),
-                    "r4": (0.3, 2.0)}, targets={"time_ratio": 1.3, "swing": math.radians(60)},
-                    conditions={"grashof": "crank-rocker"})  # fmt: skip
+        base = dict(
+            mechanism="FourBar",
+            fixed={"r1": 1.0},
+            free={"r2": (0.1, 0.5), "r3": (0.3, 2.0), "r4": (0.3, 2.0)},
+            targets={"time_ratio": 1.3, "swing": math.radians(60)},
+            conditions={"grashof": "crank-rocker"},
+        )
         return Problem(**{**base, **kw})
 
     drag = {"grashof": "drag-link"}
@@ -55,14 +71,14 @@ def cases():
             "crank-rocker slider, gamma_min >= 80 deg",
             rocker_slider(),
             rocker_slider(conditions={"gamma_min": math.radians(80)}),
-        ),  # fmt: skip
+        ),
         ("slider-crank at TR 4", slider_crank(), slider_crank(targets={"time_ratio": 4.0, "stroke": 0.3})),
         ("slider-crank, stroke 5", slider_crank(), slider_crank(targets={"time_ratio": 1.3, "stroke": 5.0})),
         (
             "four-bar min_size (no attained optimum)",
             four_bar(objective="max_gamma_min"),
             four_bar(objective="min_size"),
-        ),  # fmt: skip
+        ),
     ]
 
 
@@ -91,8 +107,9 @@ def elsewhere(rev: str, repeat: int) -> list[dict]:
     """``measure`` on commit ``rev``: a detached worktree (kept under /tmp), this file run there in a subprocess."""
     tree = Path(f"/tmp/qropt-bench-{rev}")
     if not tree.exists():
-        subprocess.run(["git", "worktree", "add", "--detach", str(tree), rev], cwd=ROOT, check=True,
-                       capture_output=True)  # fmt: skip
+        subprocess.run(
+            ["git", "worktree", "add", "--detach", str(tree), rev], cwd=ROOT, check=True, capture_output=True
+        )
     here = Path(__file__).resolve()
     code = f"import sys; sys.path.insert(0, {str(tree)!r}); sys.argv = ['x', '--json', '--repeat', '{repeat}']; "
     code += f"exec(open({str(here)!r}).read())"

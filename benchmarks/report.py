@@ -19,8 +19,12 @@ def environment() -> dict:
             versions[name] = importlib.import_module(name).__version__
         except ImportError:
             versions[name] = "not installed"
-    return {"date": date.today().isoformat(), "machine": f"{platform.platform()} ({platform.machine()})",
-            "python": platform.python_version(), "versions": versions}  # fmt: skip
+    return {
+        "date": date.today().isoformat(),
+        "machine": f"{platform.platform()} ({platform.machine()})",
+        "python": platform.python_version(),
+        "versions": versions,
+    }
 
 
 def save(name: str, data: dict, directory: Path = RESULTS) -> Path:

@@ -106,11 +106,18 @@ def main(repeat: int = 21):
     save(
         "synthesis.json",
         {
-            "median_ms": {"closed_form": t_floor, "solve_default": t_default, "solve_closed_form_starts": t_analytic,
-                          "slsqp": t_slsqp, "analysis": t_ana, "peak_acceleration": t_peak, "motion_3600": t_motion},
+            "median_ms": {
+                "closed_form": t_floor,
+                "solve_default": t_default,
+                "solve_closed_form_starts": t_analytic,
+                "slsqp": t_slsqp,
+                "analysis": t_ana,
+                "peak_acceleration": t_peak,
+                "motion_3600": t_motion,
+            },
             "r3": {"closed_form": m_floor.params["r3"], "solve": res.params["r3"], "slsqp": r3_slsqp},
         },
-    )  # fmt: skip
+    )
 
 
 if __name__ == "__main__":

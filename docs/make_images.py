@@ -25,9 +25,13 @@ def types(path):
 
 
 def front(path):
-    p = qropt.Problem("CrankRockerSlider", fixed={"r1": 0.3, "r2": 0.1, "r6": 0.5},
-                      free={"r3": (0.15, 0.6), "r4": (0.15, 0.45), "r5": (0.02, 0.45)},
-                      targets={"time_ratio": 1.2, "stroke": 0.15}, omega2=2.0)  # fmt: skip
+    p = qropt.Problem(
+        "CrankRockerSlider",
+        fixed={"r1": 0.3, "r2": 0.1, "r6": 0.5},
+        free={"r3": (0.15, 0.6), "r4": (0.15, 0.45), "r5": (0.02, 0.45)},
+        targets={"time_ratio": 1.2, "stroke": 0.15},
+        omega2=2.0,
+    )
     qropt.pareto(p, ("max_gamma_min", "min_size"), n=20).plot(path)
 
 
@@ -48,8 +52,12 @@ def paper_mechanism_cycle(path):
 
 
 def family(path):
-    p = qropt.Problem("DragLinkSlider", fixed={"r2": 0.225, "r4": 0.275, "r5": 0.15, "r6": 0.3},
-                      free={"r1": (0.02, 0.2), "r3": (0.05, 0.6)}, targets={"time_ratio": 1.5})  # fmt: skip
+    p = qropt.Problem(
+        "DragLinkSlider",
+        fixed={"r2": 0.225, "r4": 0.275, "r5": 0.15, "r6": 0.3},
+        free={"r1": (0.02, 0.2), "r3": (0.05, 0.6)},
+        targets={"time_ratio": 1.5},
+    )
     f = qropt.family(p)
     plots.save(plots.family_figure(f, best=f.best("max_gamma_min")), path)
 

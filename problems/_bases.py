@@ -70,8 +70,10 @@ def crank_rocker_slider(**changes) -> Problem:
 
 def crank_rocker_slider_oracle(problem):
     """Grid along r4 for each root of the rocker's TR (r3), r5 from the stroke; the better of the two."""
-    runs = [oracles.along(problem, oracles.crank_rocker_slider_family(1.2, 0.15, 0.3, 0.1, 0.5, k), 0.15, 0.45, n=150)
-            for k in (0, 1)]  # fmt: skip
+    runs = [
+        oracles.along(problem, oracles.crank_rocker_slider_family(1.2, 0.15, 0.3, 0.1, 0.5, k), 0.15, 0.45, n=150)
+        for k in (0, 1)
+    ]
     runs = [r for r in runs if r["objective"] is not None]
     pick = max if problem.objective == "max_gamma_min" else min
     return pick(runs, key=lambda r: r["objective"])

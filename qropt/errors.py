@@ -36,8 +36,10 @@ class AssemblyError(QroptError):
                 continue
             span = f"[{math.degrees(lo) % 360:.4f}, {math.degrees(hi) % 360:.4f}]"
             by_closure.setdefault(what, []).append(span)
-        parts = [f"{what} fails for theta2 in {' and '.join(s)}" + (" deg" if s[-1][0] == "[" else "")
-                 for what, s in by_closure.items()]  # fmt: skip
+        parts = [
+            f"{what} fails for theta2 in {' and '.join(s)}" + (" deg" if s[-1][0] == "[" else "")
+            for what, s in by_closure.items()
+        ]
         given = ", ".join(f"{k}={v:g}" for k, v in self.params.items())
         super().__init__(f"{mechanism}({given}) cannot turn through a full revolution: " + "; ".join(parts))
 

@@ -33,8 +33,9 @@ def crank_shaper(rng):
     s = rng.uniform(0.2, 2.0) * r1
     k = analytic.crank_shaper_ratio(tr)
     bounds = {"r2": (0.01 * r1, 0.99 * r1), "r4": (0.05 * r1, max(10 * r1, s / k))}
-    prob = Problem("CrankShaper", fixed={"r1": r1}, free=bounds,
-                   targets={"time_ratio": tr, "stroke": s}, objective=None)  # fmt: skip
+    prob = Problem(
+        "CrankShaper", fixed={"r1": r1}, free=bounds, targets={"time_ratio": tr, "stroke": s}, objective=None
+    )
     ans = {"r2": k * r1, "r4": s / (2 * k)}
     assert np.allclose(_tr("crank-shaper", {"r1": r1, **ans}), (tr, s), rtol=1e-10)
     return prob, ans
@@ -42,8 +43,13 @@ def crank_shaper(rng):
 
 def whitworth(rng):
     r1, tr, s = rng.uniform(0.05, 0.3), rng.uniform(1.2, 3.0), rng.uniform(0.1, 1.0)
-    prob = Problem("Whitworth", fixed={"r1": r1, "r6": 1.5 * s}, free={"r2": (1.01 * r1, 20 * r1), "r5": (0.01, s)},
-                   targets={"time_ratio": tr, "stroke": s}, objective=None)  # fmt: skip
+    prob = Problem(
+        "Whitworth",
+        fixed={"r1": r1, "r6": 1.5 * s},
+        free={"r2": (1.01 * r1, 20 * r1), "r5": (0.01, s)},
+        targets={"time_ratio": tr, "stroke": s},
+        objective=None,
+    )
     ans = {"r2": r1 / analytic.whitworth_ratio(tr), "r5": s / 2}
     p = {"r1": r1, "r6": 1.5 * s, "h": 0.0, "sigma_slider": 1.0, **ans}
     assert np.allclose(_tr("whitworth", p), (tr, s), rtol=1e-10)
@@ -55,8 +61,9 @@ def slider_crank(rng):
     s = r2 * rng.uniform(2.05, 3.5)
     d = analytic.slider_crank_design(tr, s, r2)[0]
     bounds = {"r3": (1.001 * r2, max(20 * r2, 2 * d.r3)), "e": (0.0, max(10 * r2, 2 * d.e))}
-    prob = Problem("SliderCrank", fixed={"r2": r2}, free=bounds,
-                   targets={"time_ratio": tr, "stroke": s}, objective=None)  # fmt: skip
+    prob = Problem(
+        "SliderCrank", fixed={"r2": r2}, free=bounds, targets={"time_ratio": tr, "stroke": s}, objective=None
+    )
     assert np.allclose(_tr("slider-crank", {"r2": r2, "r3": d.r3, "e": d.e, "sigma_slider": 1.0}), (tr, s), rtol=1e-10)
     return prob, {"r3": d.r3, "e": d.e}
 
@@ -73,8 +80,12 @@ def drag_link(rng):
                 cands.append(p)
         if cands:
             break
-    prob = Problem("DragLinkSlider", fixed={"r1": r1, "r2": r2, "r4": r4, "r6": r6},
-                   free={"r3": (0.05, 1.0), "r5": (0.01, 0.3)}, targets={"time_ratio": tr, "stroke": s})  # fmt: skip
+    prob = Problem(
+        "DragLinkSlider",
+        fixed={"r1": r1, "r2": r2, "r4": r4, "r6": r6},
+        free={"r3": (0.05, 1.0), "r5": (0.01, 0.3)},
+        targets={"time_ratio": tr, "stroke": s},
+    )
     best = _best("drag-link-slider", cands)
     return prob, {"r3": best["r3"], "r5": best["r5"]}
 
@@ -103,8 +114,13 @@ def four_bar(rng):
         cands = [p for p in cands if abs(_tr("four-bar", p)[0] - tr) < 1e-9]
         if cands:
             break
-    prob = Problem("FourBar", fixed={"r1": r1, "r2": r2, "r4": r4}, free={"r3": (0.02, 2.5)},
-                   targets={"time_ratio": tr}, objective="max_gamma_min")  # fmt: skip
+    prob = Problem(
+        "FourBar",
+        fixed={"r1": r1, "r2": r2, "r4": r4},
+        free={"r3": (0.02, 2.5)},
+        targets={"time_ratio": tr},
+        objective="max_gamma_min",
+    )
     return prob, {"r3": _best("four-bar", cands)["r3"]}
 
 
@@ -137,8 +153,12 @@ def crank_rocker_slider(rng):
                     cands.append(p)
         if cands:
             break
-    prob = Problem("CrankRockerSlider", fixed={"r1": r1, "r2": r2, "r4": r4, "r6": r6},
-                   free={"r3": (0.05, 0.8), "r5": (0.01, 0.45)}, targets={"time_ratio": tr, "stroke": s})  # fmt: skip
+    prob = Problem(
+        "CrankRockerSlider",
+        fixed={"r1": r1, "r2": r2, "r4": r4, "r6": r6},
+        free={"r3": (0.05, 0.8), "r5": (0.01, 0.45)},
+        targets={"time_ratio": tr, "stroke": s},
+    )
     best = _best("crank-rocker-slider", cands)
     return prob, {"r3": best["r3"], "r5": best["r5"]}
 

@@ -112,8 +112,12 @@ def test_mechanisms_are_immutable():
 
 
 def test_family_and_reachable_reject_bad_arguments():
-    p = qropt.Problem("DragLinkSlider", fixed={"r2": 0.225, "r4": 0.275, "r5": 0.15, "r6": 0.3},
-                      free={"r1": (0.02, 0.2), "r3": (0.05, 0.6)}, targets={"time_ratio": 1.5})  # fmt: skip
+    p = qropt.Problem(
+        "DragLinkSlider",
+        fixed={"r2": 0.225, "r4": 0.275, "r5": 0.15, "r6": 0.3},
+        free={"r1": (0.02, 0.2), "r3": (0.05, 0.6)},
+        targets={"time_ratio": 1.5},
+    )
     with pytest.raises(ProblemError, match="ds"):
         family(p, ds=-0.01)
     with pytest.raises(ProblemError, match="Problem"):
@@ -145,8 +149,14 @@ KINDS = [t.KIND for t in qropt.mechanisms.TYPES]
 
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(kind=st.sampled_from(KINDS), params=st.dictionaries(st.sampled_from(
-    ["r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider", "bogus"]), VALUES, max_size=8))  # fmt: skip
+@given(
+    kind=st.sampled_from(KINDS),
+    params=st.dictionaries(
+        st.sampled_from(["r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider", "bogus"]),
+        VALUES,
+        max_size=8,
+    ),
+)
 def test_constructors_raise_only_qropt_errors(kind, params):
     try:
         m = qropt.mechanism_type(kind)(**params)
@@ -170,8 +180,11 @@ def test_methods_raise_only_qropt_errors(theta, omega, over):
 
 
 @settings(max_examples=40, deadline=None)
-@given(opts=st.dictionaries(st.sampled_from(["starts_n", "seed", "max_rounds", "targets", "extra_starts"]),
-                            VALUES, max_size=2))  # fmt: skip
+@given(
+    opts=st.dictionaries(
+        st.sampled_from(["starts_n", "seed", "max_rounds", "targets", "extra_starts"]), VALUES, max_size=2
+    )
+)
 def test_solve_options_raise_only_qropt_errors(opts):
     try:
         r = solve(paper_problem(), **opts)

@@ -11,8 +11,9 @@ from benchmarks.methods import METHODS
 
 
 def test_suite_subset(tmp_path, capsys):
-    rc = suite.main(["--problems", "[sf]*_[rn]*", "--methods", "qropt", "scipy-slsqp", "pylinkage",
-                     "--out", str(tmp_path)])  # fmt: skip
+    rc = suite.main(
+        ["--problems", "[sf]*_[rn]*", "--methods", "qropt", "scipy-slsqp", "pylinkage", "--out", str(tmp_path)]
+    )
     assert rc == 0
     data = json.loads((tmp_path / "results.json").read_text())
     assert {"meta", "summary", "oracles", "rows"} <= set(data)
@@ -27,8 +28,17 @@ def test_suite_subset(tmp_path, capsys):
     assert shaper["status"] in ("not applicable", "not installed") and shaper["success"] is None
     with open(tmp_path / "results.csv") as fh:
         table = list(csv.DictReader(fh))
-    assert len(table) == 6 and {"problem", "method", "status", "objective", "oracle", "error", "violation",
-                                "seconds", "nfev"} <= set(table[0])  # fmt: skip
+    assert len(table) == 6 and {
+        "problem",
+        "method",
+        "status",
+        "objective",
+        "oracle",
+        "error",
+        "violation",
+        "seconds",
+        "nfev",
+    } <= set(table[0])
     md = (tmp_path / "results.md").read_text()
     assert "| method | problems | meets oracle | median time [s] | median time / qropt |" in md
     assert "| qropt | 2 | 100% |" in md

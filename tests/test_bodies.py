@@ -45,8 +45,13 @@ class PlateSlider(Mechanism):
         s, margin = rod_to_line(xp, q, p["r3"], p["e"], p["sigma_slider"])
         t3 = xp.atan2(s[1] - q[1], s[0] - q[0])
         t = ((q[0] + s[0]) / 2 - p["k"] * xp.sin(t3), (q[1] + s[1]) / 2 + p["k"] * xp.cos(t3))
-        return Loop({"P": (0.0, 0.0), "Q": q, "S": s, "T": t}, {"theta2": theta2, "theta3": t3}, s[0],
-                    {"S": rod_lines(q, s)}, [("rod QS reaching the slide line", margin)])  # fmt: skip
+        return Loop(
+            {"P": (0.0, 0.0), "Q": q, "S": s, "T": t},
+            {"theta2": theta2, "theta3": t3},
+            s[0],
+            {"S": rod_lines(q, s)},
+            [("rod QS reaching the slide line", margin)],
+        )
 
 
 class MissingJoint(PlateSlider):
@@ -94,11 +99,15 @@ def test_a_user_type_draws_every_declared_body(tmp_path):
 
 @pytest.mark.parametrize(
     "draw",
-    [lambda m, d: export.to_dxf(m, d / "x.dxf"), lambda m, d: export.to_svg(m, d / "x.svg"),
-     lambda m, d: plots.cycle_figure(m), lambda m, d: animate(m, d / "x.gif"),
-     lambda m, d: plots.draw_mechanism(plots.plt.figure().add_subplot(), m, 0.0)],
+    [
+        lambda m, d: export.to_dxf(m, d / "x.dxf"),
+        lambda m, d: export.to_svg(m, d / "x.svg"),
+        lambda m, d: plots.cycle_figure(m),
+        lambda m, d: animate(m, d / "x.gif"),
+        lambda m, d: plots.draw_mechanism(plots.plt.figure().add_subplot(), m, 0.0),
+    ],
     ids=["dxf", "svg", "plot", "gif", "draw"],
-)  # fmt: skip
+)
 def test_a_body_naming_a_missing_joint_is_a_typed_error(draw, tmp_path):
     with pytest.raises(BodyError, match=r"body 'rod' names joint 'C'"):
         draw(MissingJoint(r2=0.1, r3=0.35), tmp_path)
@@ -107,11 +116,15 @@ def test_a_body_naming_a_missing_joint_is_a_typed_error(draw, tmp_path):
 
 @pytest.mark.parametrize(
     ("attrs", "words"),
-    [({"BODIES": ()}, "declares no bodies"), ({"GROUND": ("O2",)}, "ground pivot 'O2'"),
-     ({"OUTPUT_JOINT": "D"}, "output joint 'D'"), ({"OUTPUT_JOINT": None}, "needs its output joint"),
-     ({"BODIES": (Body("crank", ("P", "Q"), "spring"),)}, "kind 'spring'"),
-     ({"BODIES": (Body("ram", ("S", "Q"), "ram"),)}, "carries 1 joint")],
-)  # fmt: skip
+    [
+        ({"BODIES": ()}, "declares no bodies"),
+        ({"GROUND": ("O2",)}, "ground pivot 'O2'"),
+        ({"OUTPUT_JOINT": "D"}, "output joint 'D'"),
+        ({"OUTPUT_JOINT": None}, "needs its output joint"),
+        ({"BODIES": (Body("crank", ("P", "Q"), "spring"),)}, "kind 'spring'"),
+        ({"BODIES": (Body("ram", ("S", "Q"), "ram"),)}, "carries 1 joint"),
+    ],
+)
 def test_bad_declarations_are_typed_errors(attrs, words):
     bad = type("Bad", (PlateSlider,), attrs)
     with pytest.raises(BodyError, match=words):
@@ -119,10 +132,15 @@ def test_bad_declarations_are_typed_errors(attrs, words):
 
 
 def _every_type():
-    return [paper_mechanism(), qropt.SliderCrank(r2=0.1, r3=0.35, e=0.06), qropt.CrankShaper(r1=160, r2=40, r4=240),
-            qropt.CrankShaper(r1=160, r2=40, r4=240, r6=150, h=220), qropt.Whitworth(r1=0.1, r2=0.2, r5=0.12, r6=0.3),
-            qropt.CrankRockerSlider(r1=0.4, r2=0.1, r3=0.35, r4=0.3, r5=0.4, r6=0.5, h=0.1),
-            qropt.FourBar(r1=0.4, r2=0.1, r3=0.35, r4=0.3)]  # fmt: skip
+    return [
+        paper_mechanism(),
+        qropt.SliderCrank(r2=0.1, r3=0.35, e=0.06),
+        qropt.CrankShaper(r1=160, r2=40, r4=240),
+        qropt.CrankShaper(r1=160, r2=40, r4=240, r6=150, h=220),
+        qropt.Whitworth(r1=0.1, r2=0.2, r5=0.12, r6=0.3),
+        qropt.CrankRockerSlider(r1=0.4, r2=0.1, r3=0.35, r4=0.3, r5=0.4, r6=0.5, h=0.1),
+        qropt.FourBar(r1=0.4, r2=0.1, r3=0.35, r4=0.3),
+    ]
 
 
 def test_every_shipped_type_declares_bodies_that_fit_its_joints():
@@ -137,9 +155,14 @@ def test_every_shipped_type_declares_bodies_that_fit_its_joints():
     assert [b.name for b in rod.bodies()] == ["crank", "block", "lever", "rod", "ram"] and rod.output_joint() == "D"
 
 
-@pytest.mark.parametrize(("m", "length"), [(qropt.CrankShaper(r1=160, r2=40, r4=240), 240.0),
-                                           (qropt.CrankShaper(r1=160, r2=40, r4=150, r6=150, h=150), 200.0),
-                                           (qropt.Whitworth(r1=0.1, r2=0.2, r5=0.12, r6=0.3), 0.3)])  # fmt: skip
+@pytest.mark.parametrize(
+    ("m", "length"),
+    [
+        (qropt.CrankShaper(r1=160, r2=40, r4=240), 240.0),
+        (qropt.CrankShaper(r1=160, r2=40, r4=150, r6=150, h=150), 200.0),
+        (qropt.Whitworth(r1=0.1, r2=0.2, r5=0.12, r6=0.3), 0.3),
+    ],
+)
 def test_a_slotted_lever_is_drawn_at_its_true_length(m, length):
     """CONVENTIONS, Dynamics: the lever runs from O4 along O4->A for max(r4 or r5, r1 + r2), at every angle."""
     sc = drawing.scene(m)

@@ -36,8 +36,9 @@ def problem(name):
 @pytest.fixture(scope="module")
 def rocker():
     """A 4 x 3 crank-rocker chart in tiles of 2 x 2 with a check at every other cell: continuation and checks."""
-    return chart(problem("chart_crank_rocker"), ("time_ratio", TR), ("swing", SWING), tile=(2, 2), check=2,
-                 progress=False)  # fmt: skip
+    return chart(
+        problem("chart_crank_rocker"), ("time_ratio", TR), ("swing", SWING), tile=(2, 2), check=2, progress=False
+    )
 
 
 @pytest.fixture(scope="module")
@@ -82,17 +83,20 @@ def test_grid_result_and_mask(rocker):
     r = rocker.result(1.5, math.radians(60))
     assert r.objective == g[1, 1] and r.params == rocker.cell(1, 1).params and r.mechanism is not None
     assert rocker.mask("continued").sum() + rocker.mask("full").sum() == 12
-    for bad, words in ((lambda: rocker.grid("bogus"), "unknown chart quantity"),
-                       (lambda: rocker.result(1.55, SWING[0]), "not a chart value"),
-                       (lambda: rocker.result(1.5), "give the swing value"),
-                       (lambda: rocker.mask("odd"), "unknown chart flag")):  # fmt: skip
+    for bad, words in (
+        (lambda: rocker.grid("bogus"), "unknown chart quantity"),
+        (lambda: rocker.result(1.55, SWING[0]), "not a chart value"),
+        (lambda: rocker.result(1.5), "give the swing value"),
+        (lambda: rocker.mask("odd"), "unknown chart flag"),
+    ):
         with pytest.raises(ChartError, match=words):
             bad()
 
 
 def test_local_cluster_gives_the_in_process_answers(rocker, cluster):
-    far = chart(rocker.problem, ("time_ratio", TR), ("swing", SWING), tile=(2, 2), check=2, progress=False,
-                scheduler=cluster)  # fmt: skip
+    far = chart(
+        rocker.problem, ("time_ratio", TR), ("swing", SWING), tile=(2, 2), check=2, progress=False, scheduler=cluster
+    )
     assert "Dask cluster" in far.stats["scheduler"] and far.stats["tiles"] == 4
     for a, b in zip(rocker.cells, far.cells, strict=True):
         assert [getattr(a, k) for k in SAME] == [getattr(b, k) for k in SAME]
@@ -182,16 +186,20 @@ def test_a_better_branch_taking_over_is_flagged():
     p = problem("crank_rocker_slider_gamma")
     worse = solve(p, targets={"stroke": 0.1093}).local_optima[1]
     assert worse.status == "local_optimum"
-    tile = _Tile({"problem": p.to_dict(), "x": ["stroke", [0.1093, 0.1]], "y": None, "block": [0, 2, 0, 1],
-                  "check": 1}, DEFAULT, None)  # fmt: skip
+    tile = _Tile(
+        {"problem": p.to_dict(), "x": ["stroke", [0.1093, 0.1]], "y": None, "block": [0, 2, 0, 1], "check": 1},
+        DEFAULT,
+        None,
+    )
     tile.cells[(0, 0)] = Cell.of(0, 0, worse, "full")
     tile.solve_cell((1, 0))
     c = tile.cells[(1, 0)]
     assert c.switched and c.method == "full" and c.why == "check" and not c.jump
     best = solve(p, targets={"stroke": 0.1})
     assert c.objective == pytest.approx(best.objective, abs=1e-9)
-    cont = solve(p, targets={"stroke": 0.1}, starts_n=0, use_analytic=False,
-                 extra_starts=[{k: worse.params[k] for k in p.free}])  # fmt: skip
+    cont = solve(
+        p, targets={"stroke": 0.1}, starts_n=0, use_analytic=False, extra_starts=[{k: worse.params[k] for k in p.free}]
+    )
     assert cont.success and c.objective > cont.objective + 1e-5  # what continuing alone would have reported
 
 
@@ -207,17 +215,31 @@ def test_continuation_across_a_branch_takeover_ends_on_the_better_branch():
 
 def test_cli_writes_the_chart(tmp_path, capsys):
     files = [tmp_path / n for n in ("c.png", "c.csv", "c.json")]
-    args = ["chart", str(ROOT / "problems" / "chart_crank_rocker.py"), "--x", "time_ratio", "1.2:1.5:3",
-            "--y", "swing", "50deg,60deg", "--plot", str(files[0]), "--csv", str(files[1]),
-            "--json", str(files[2])]  # fmt: skip
+    args = [
+        "chart",
+        str(ROOT / "problems" / "chart_crank_rocker.py"),
+        "--x",
+        "time_ratio",
+        "1.2:1.5:3",
+        "--y",
+        "swing",
+        "50deg,60deg",
+        "--plot",
+        str(files[0]),
+        "--csv",
+        str(files[1]),
+        "--json",
+        str(files[2]),
+    ]
     assert main(args) == 0
     out = capsys.readouterr().out
     assert "6 cells in" in out and "6 certified" in out and "best at time_ratio 1.2, swing 50" in out
     assert files[0].read_bytes()[:4] == b"\x89PNG"
     back = Chart.from_json(files[2])
     assert back.shape == (2, 3) and back.cell(1, 1).result.params == back.cell(1, 1).params
-    assert back.grid()[0, 0] == pytest.approx(math.radians(float(out.split("objective ")[1].split("..")[1][:7])),
-                                              abs=1e-5)  # fmt: skip
+    assert back.grid()[0, 0] == pytest.approx(
+        math.radians(float(out.split("objective ")[1].split("..")[1][:7])), abs=1e-5
+    )
 
 
 @pytest.mark.parametrize(
@@ -248,8 +270,12 @@ def test_bad_input_is_one_line_on_the_command_line(capsys):
         main(["chart", file, "--x", "time_ratio", "1.2:1.5:3", "--y", "none", "--scheduler", "tcp://127.0.0.1:9"]) == 1
     )
     assert time.perf_counter() - t < 60  # it gives up (CONNECT_TIMEOUT 5 s) rather than hang
-    for args, code in ((["--x", "stroke", "1:2:3"], 1), (["--x", "time_ratio", "1:2"], 2),
-                       (["--x", "time_ratio", "1.2:1.5:3", "--workers", "0"], 1), (["--y", "swing"], 2)):  # fmt: skip
+    for args, code in (
+        (["--x", "stroke", "1:2:3"], 1),
+        (["--x", "time_ratio", "1:2"], 2),
+        (["--x", "time_ratio", "1.2:1.5:3", "--workers", "0"], 1),
+        (["--y", "swing"], 2),
+    ):
         assert main(["chart", file, *args]) == code
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 5 and "cannot reach the Dask scheduler" in err[0] and "unknown chart axis 'stroke'" in err[1]

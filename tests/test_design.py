@@ -32,8 +32,13 @@ def comparison():
 
 
 def _family(problem):
-    return oracles.along(problem, oracles.slider_crank_family(problem.targets["time_ratio"], STROKE),
-                         problem.free["r2"][0] + 1e-6, STROKE / 2 - 1e-6, n=600)  # fmt: skip
+    return oracles.along(
+        problem,
+        oracles.slider_crank_family(problem.targets["time_ratio"], STROKE),
+        problem.free["r2"][0] + 1e-6,
+        STROKE / 2 - 1e-6,
+        n=600,
+    )
 
 
 # ---- the new criterion and the bounds ------------------------------------------------------------------------
@@ -47,8 +52,13 @@ def test_min_peak_velocity_matches_the_closed_form_family():
     assert r.quantities["peak_velocity"] == r.objective
 
 
-BOUNDS = [("max_peak_velocity", 0.26), ("max_peak_accel", 0.8), ("max_sum", 0.4), ("max_footprint", 0.15),
-          ("gamma_min", math.radians(36))]  # fmt: skip
+BOUNDS = [
+    ("max_peak_velocity", 0.26),
+    ("max_peak_accel", 0.8),
+    ("max_sum", 0.4),
+    ("max_footprint", 0.15),
+    ("gamma_min", math.radians(36)),
+]
 
 
 @pytest.mark.parametrize(("key", "bound"), BOUNDS)
@@ -360,8 +370,14 @@ def test_a_type_that_cannot_do_the_task_says_why():
 
 
 def test_design_rejects_bad_input():
-    for kw in ({"types": ["bogus"]}, {"types": "slider-crank"}, {"types": []}, {"objective": "max_speed"},
-               {"bounds": {"q7": (0, 1)}}, {"conditions": {"max_sum": -1}}):  # fmt: skip
+    for kw in (
+        {"types": ["bogus"]},
+        {"types": "slider-crank"},
+        {"types": []},
+        {"objective": "max_speed"},
+        {"bounds": {"q7": (0, 1)}},
+        {"conditions": {"max_sum": -1}},
+    ):
         with pytest.raises(QroptError):
             design(TR, STROKE, **kw)
     for tr, stroke in ((0.5, 0.3), (1.5, -1.0), (float("nan"), 0.3), ("1.5", 0.3)):
@@ -416,16 +432,20 @@ def test_a_dominated_point_is_removed_with_its_reason():
     p = problem_bases.slider_crank(omega2=2.0)
     r1 = qropt.solve(p)
     r2 = qropt.solve(p.replace(objective="min_peak_accel"))
-    f = _front(p, ("max_gamma_min", "min_peak_accel"), ("gamma_min", "peak_accel"), [(None, r1), (0.8, r1),
-                                                                                     (None, r2)])  # fmt: skip
+    f = _front(p, ("max_gamma_min", "min_peak_accel"), ("gamma_min", "peak_accel"), [(None, r1), (0.8, r1), (None, r2)])
     assert len(f.points) == 2 and f.removed[0][1] == "the same design as its neighbour"
 
 
 def test_pareto_rejects_bad_input():
     p = problem_bases.slider_crank()
-    for objectives, n in ((("max_gamma_min", "max_gamma_min"), 5), (("max_gamma_min", "max_fun"), 5),
-                          (("max_gamma_min",), 5), (("max_gamma_min", "min_peak_accel"), 1),
-                          (("max_gamma_min", "min_peak_accel"), 2.5), ("max_gamma_min", 5)):  # fmt: skip
+    for objectives, n in (
+        (("max_gamma_min", "max_gamma_min"), 5),
+        (("max_gamma_min", "max_fun"), 5),
+        (("max_gamma_min",), 5),
+        (("max_gamma_min", "min_peak_accel"), 1),
+        (("max_gamma_min", "min_peak_accel"), 2.5),
+        ("max_gamma_min", 5),
+    ):
         with pytest.raises(QroptError):
             pareto(p, objectives, n=n)
     with pytest.raises(QroptError, match="no slider"):
@@ -438,13 +458,16 @@ def test_bad_command_lines_are_one_line(capsys):
     from qropt.cli import main
 
     file = str(__import__("pathlib").Path(__file__).resolve().parents[1] / "problems" / "slider_crank_gamma.py")
-    cases = [(["design", "--tr", "0.5", "--stroke", "0.3"], 1), (["design", "--tr", "1.5"], 2),
-             (["design", "--tr", "1.5", "--stroke", "0.3", "--types", "bogus"], 1),
-             (["design", "--tr", "1.5", "--stroke", "0.3", "--gamma-min", "forty"], 2),
-             (["design", "--tr", "1.5", "--stroke", "0.3", "--plot", "x.txt"], 2),
-             (["pareto", file, "--objectives", "max_gamma_min", "max_gamma_min"], 1),
-             (["pareto", file, "--objectives", "max_gamma_min", "min_peak_accel", "--n", "1"], 1),
-             (["pareto", file, "--objectives", "max_gamma_min"], 2)]  # fmt: skip
+    cases = [
+        (["design", "--tr", "0.5", "--stroke", "0.3"], 1),
+        (["design", "--tr", "1.5"], 2),
+        (["design", "--tr", "1.5", "--stroke", "0.3", "--types", "bogus"], 1),
+        (["design", "--tr", "1.5", "--stroke", "0.3", "--gamma-min", "forty"], 2),
+        (["design", "--tr", "1.5", "--stroke", "0.3", "--plot", "x.txt"], 2),
+        (["pareto", file, "--objectives", "max_gamma_min", "max_gamma_min"], 1),
+        (["pareto", file, "--objectives", "max_gamma_min", "min_peak_accel", "--n", "1"], 1),
+        (["pareto", file, "--objectives", "max_gamma_min"], 2),
+    ]
     for args, code in cases:
         assert main(args) == code, args
     err = capsys.readouterr().err.strip().splitlines()

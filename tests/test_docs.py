@@ -234,7 +234,7 @@ def test_make_images_draws_every_image_shown():
             " [(0.25042812..., 'optimal'), (0.15434448..., 'local_optimum')]",
             [(0.250428121, "optimal"), (0.154344489, "local_optimum")],
             True,
-        ),  # fmt: skip
+        ),
         (" 2, [0.1543445, 0.2504281]", (2, [0.15434448, 0.25042812]), True),
         (" 1177", 1178, False),
         (" 1.2e-07", 1.24e-07, True),

@@ -81,10 +81,14 @@ def test_design_files_round_trip_through_the_command_line(tmp_path, capsys):
 
 @pytest.mark.parametrize(
     ("text", "words"),
-    [(None, "no design file"), ("{", "not a JSON design"), ('{"type": "x"}', "'type' and 'params'"),
-     ('{"type": "bogus", "params": {}}', "unknown mechanism"), ('{"type": "slider-crank", "params": {"r2": 1}}',
-                                                                 "missing")],
-)  # fmt: skip
+    [
+        (None, "no design file"),
+        ("{", "not a JSON design"),
+        ('{"type": "x"}', "'type' and 'params'"),
+        ('{"type": "bogus", "params": {}}', "unknown mechanism"),
+        ('{"type": "slider-crank", "params": {"r2": 1}}', "missing"),
+    ],
+)
 def test_bad_design_files_are_typed_errors(text, words, tmp_path):
     f = tmp_path / "d.json"
     if text is not None:

@@ -69,8 +69,10 @@ def test_traced_points_lie_on_the_closed_form(paper_family):
 def test_closed_form_points_lie_on_the_traced_curve_without_gaps(paper_family):
     pts = paper_family.points()
     fold_r1 = paper_family.folds[0]["r1"]
-    ds = max(np.linalg.norm([a.params["r1"] - b.params["r1"], a.params["r3"] - b.params["r3"]])
-             for a, b in zip(pts[:-1], pts[1:], strict=True))  # fmt: skip
+    ds = max(
+        np.linalg.norm([a.params["r1"] - b.params["r1"], a.params["r3"] - b.params["r3"]])
+        for a, b in zip(pts[:-1], pts[1:], strict=True)
+    )
     for r1 in np.linspace(0.0827, 0.1106, 300):
         for r3 in closed_form_r3(r1):
             # nearest traced point within one step, and the local cubic through the trace meets it
@@ -133,8 +135,11 @@ def test_adjustable_coupler_for_every_reachable_time_ratio():
 
 
 def test_second_type_family_offset_slider_crank():
-    p = Problem("SliderCrank", free={"r2": (0.05, 0.149), "r3": (0.1, 2.0), "e": (-0.8, 0.8)},
-                targets={"time_ratio": 1.3, "stroke": 0.3})  # fmt: skip
+    p = Problem(
+        "SliderCrank",
+        free={"r2": (0.05, 0.149), "r3": (0.1, 2.0), "e": (-0.8, 0.8)},
+        targets={"time_ratio": 1.3, "stroke": 0.3},
+    )
     f = family(p)
     assert len(f.branches) == 2  # e > 0 and its mirror e < 0
     signs = sorted(np.sign(b[len(b) // 2].params["e"]) for b in f.branches)

@@ -151,8 +151,12 @@ def _grid_peak(f, th):
 
     k = int(np.argmax(np.abs(f(th))))
     h = th[1] - th[0]
-    r = minimize_scalar(lambda t: -abs(float(f(np.array([t]))[0])), bounds=(th[k] - h, th[k] + h), method="bounded",
-                        options={"xatol": 1e-12})  # fmt: skip
+    r = minimize_scalar(
+        lambda t: -abs(float(f(np.array([t]))[0])),
+        bounds=(th[k] - h, th[k] + h),
+        method="bounded",
+        options={"xatol": 1e-12},
+    )
     return -r.fun
 
 

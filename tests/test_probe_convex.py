@@ -160,7 +160,7 @@ CLI_ERRORS = [
         ["servo", "four-bar", "--r1", "0.4", "--r2", "0.1", "--r3", "0.35", "--r4", "0.3", "--omega-max", "10"],
         1,
         "needs a slider output",
-    ),  # fmt: skip
+    ),
     ("servo plot format", ["servo", *SLIDER, "--omega-max", "10", "--plot", "p.xyz"], 2, "picture formats"),
     ("servo plot directory", ["servo", *SLIDER, "--omega-max", "10", "--plot", "."], 2, "is a directory"),
     (
@@ -168,7 +168,7 @@ CLI_ERRORS = [
         ["tolerance", "--limit", "time_ratio=0.01", "--monte-carlo", "10", "--seed", "-1"],
         1,
         "seed must be a non-negative",
-    ),  # fmt: skip
+    ),
     ("tolerance stroke in mm, unit unknown", ["tolerance", *SLIDER, "--limit", "stroke=1mm"], 2, "not declared"),
     ("tolerance time ratio in deg", ["tolerance", "--limit", "time_ratio=1deg"], 2, "dimensionless"),
     ("tolerance gamma_min in mm", ["tolerance", "--limit", "gamma_min=1mm"], 2, "gamma_min is an angle"),
@@ -179,7 +179,7 @@ CLI_ERRORS = [
         ["tolerance", "--limit", "time_ratio=0.01", "--limit", "time_ratio=0.02"],
         2,
         "more than once",
-    ),  # fmt: skip
+    ),
 ]
 
 

@@ -58,8 +58,10 @@ def test_report_checks_its_output_path_first(out, words, tmp_path, capsys):
     _fails_fast(lambda: render(None, tmp_path / out), InvalidParameter, words)
 
 
-@pytest.mark.parametrize(("extra", "words"), [({"note": math.nan}, "'note'.*nan"), ({"note": object()}, "'note'"),
-                                              ({"type": "x"}, "own field")])  # fmt: skip
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [({"note": math.nan}, "'note'.*nan"), ({"note": object()}, "'note'"), ({"type": "x"}, "own field")],
+)
 def test_save_design_rejects_extras_that_are_not_strict_json(extra, words, tmp_path):
     with pytest.raises(InvalidParameter, match=words):
         export.save_design(_m(), tmp_path / "d.json", **extra)
@@ -98,8 +100,9 @@ def test_load_design_of_a_non_path_is_a_typed_error():
         export.load_design(None)
 
 
-@pytest.mark.parametrize(("name", "words"), [("x.xyz", "'.xyz'"), ("x", "no extension"), ("no/x.png", "does not exist"),
-                                             (".", "directory")])  # fmt: skip
+@pytest.mark.parametrize(
+    ("name", "words"), [("x.xyz", "'.xyz'"), ("x", "no extension"), ("no/x.png", "does not exist"), (".", "directory")]
+)
 def test_every_plot_checks_its_path_before_writing(name, words, tmp_path):
     cmp = qropt.design(1.5, 0.3, types=["slider-crank"])
     with pytest.raises(InvalidParameter, match=words):

@@ -37,8 +37,11 @@ def _family_problem() -> Problem:
     return importlib.import_module("problems.paper_family_r1_r3").build()
 
 
-SC = {"mechanism": "slider-crank", "free": {"r2": (0.01, 1), "r3": (0.01, 2), "e": (-1, 1)},
-      "targets": {"time_ratio": 1.2, "stroke": 0.2}}  # fmt: skip
+SC = {
+    "mechanism": "slider-crank",
+    "free": {"r2": (0.01, 1), "r3": (0.01, 2), "e": (-1, 1)},
+    "targets": {"time_ratio": 1.2, "stroke": 0.2},
+}
 
 RAISES = [
     # Result.from_dict: types and statuses
@@ -119,9 +122,13 @@ def small_family():
 
 @pytest.mark.parametrize(
     "kwargs, match",
-    [({"objective": None}, "best takes an objective"), ({"sample": 0}, "sample is how many"),
-     ({"sample": "x"}, "sample is how many"), ({"sample": True}, "sample is how many")],
-)  # fmt: skip
+    [
+        ({"objective": None}, "best takes an objective"),
+        ({"sample": 0}, "sample is how many"),
+        ({"sample": "x"}, "sample is how many"),
+        ({"sample": True}, "sample is how many"),
+    ],
+)
 def test_family_best_bad_input(small_family, kwargs, match):
     with pytest.raises(QroptError, match=match):
         small_family.best(**kwargs)

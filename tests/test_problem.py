@@ -22,10 +22,15 @@ BASE = {
 
 def rich():
     return paper_problem().replace(
-        conditions={"grashof": "drag-link", "gamma_min": 0.2, "linear": [({"r3": 1.0, "r5": -1.0}, 0.0, 1.0)],
-                    "ratio": [("r3", "r5", 0.5, 5.0)]},
-        objective=None, branches={"sigma": (-1, 1)},
-    )  # fmt: skip
+        conditions={
+            "grashof": "drag-link",
+            "gamma_min": 0.2,
+            "linear": [({"r3": 1.0, "r5": -1.0}, 0.0, 1.0)],
+            "ratio": [("r3", "r5", 0.5, 5.0)],
+        },
+        objective=None,
+        branches={"sigma": (-1, 1)},
+    )
 
 
 @pytest.mark.parametrize(
@@ -87,8 +92,24 @@ VALUES = st.recursive(
 
 
 @settings(max_examples=200, deadline=None)
-@given(field=st.sampled_from(["mechanism", "fixed", "free", "targets", "conditions", "objective", "size", "omega2",
-                              "accel_over", "branches", "name"]), value=VALUES)  # fmt: skip
+@given(
+    field=st.sampled_from(
+        [
+            "mechanism",
+            "fixed",
+            "free",
+            "targets",
+            "conditions",
+            "objective",
+            "size",
+            "omega2",
+            "accel_over",
+            "branches",
+            "name",
+        ]
+    ),
+    value=VALUES,
+)
 def test_arbitrary_values_raise_only_problem_errors(field, value):
     with contextlib.suppress(QroptError):
         Problem(**{**BASE, field: value})

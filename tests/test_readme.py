@@ -55,8 +55,18 @@ def services(cwd, address):
     (tcp://host:port) answers and has workers; stopped afterwards."""
     bindir = Path(shutil.which("qropt")).parent
     env = {**os.environ, "PATH": f"{bindir}{os.pathsep}{os.environ['PATH']}"}
-    procs = [subprocess.Popen(c, shell=True, cwd=cwd, env=env, start_new_session=True, stdout=subprocess.DEVNULL,
-                              stderr=subprocess.DEVNULL) for c in background_commands()]  # fmt: skip
+    procs = [
+        subprocess.Popen(
+            c,
+            shell=True,
+            cwd=cwd,
+            env=env,
+            start_new_session=True,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        for c in background_commands()
+    ]
     try:
         host, port = address.removeprefix("tcp://").split(":")
         for _ in range(120):

@@ -36,8 +36,14 @@ def test_the_report_carries_the_numbers_of_the_library(paper_report):
     r = solve(paper_problem())
     for number in (f"{r.params['r3']:.6g}", f"{r.local_optima[1].params['r3']:.6g}", "3.53812", "1.42985", "27.0082"):
         assert number in text
-    for section in ("Design requirement 1", "Design requirement 2", "Discussion issues 3-4", "Analysis 1-2",
-                    "Analysis 3", "printed numbers differ"):  # fmt: skip
+    for section in (
+        "Design requirement 1",
+        "Design requirement 2",
+        "Discussion issues 3-4",
+        "Analysis 1-2",
+        "Analysis 3",
+        "printed numbers differ",
+    ):
         assert section in text
     assert "-21.67" in text and "5.538" in text  # the paper's printed values beside the exact ones
 
@@ -53,9 +59,20 @@ def test_a_problem_file_report(tmp_path):
 def test_chromium_renders_the_report(paper_report, tmp_path):
     path, _ = paper_report
     png = tmp_path / "shot.png"
-    cmd = ["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-           "--disable-component-update", "--disable-sync", "--no-first-run", f"--user-data-dir={tmp_path / 'u'}",
-           "--window-size=1200,3000", f"--screenshot={png}", path.as_uri()]  # fmt: skip
+    cmd = [
+        "chromium",
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--no-first-run",
+        f"--user-data-dir={tmp_path / 'u'}",
+        "--window-size=1200,3000",
+        f"--screenshot={png}",
+        path.as_uri(),
+    ]
     subprocess.run(cmd, capture_output=True, timeout=120, check=False)
     from PIL import Image
 

@@ -211,8 +211,28 @@ def cli(argv, capsys):
 
 def test_cli_text_csv_and_plot(tmp_path, capsys):
     csv_file, png = tmp_path / "p.csv", tmp_path / "p.png"
-    args = ["servo", "slider-crank", "--r2", "0.1", "--r3", "0.4", "--omega-max", "20", "--v-cut", "0.5", "--a-max",
-            "40", "--alpha-max", "400", "--v-max", "2", "--csv", str(csv_file), "--plot", str(png)]  # fmt: skip
+    args = [
+        "servo",
+        "slider-crank",
+        "--r2",
+        "0.1",
+        "--r3",
+        "0.4",
+        "--omega-max",
+        "20",
+        "--v-cut",
+        "0.5",
+        "--a-max",
+        "40",
+        "--alpha-max",
+        "400",
+        "--v-max",
+        "2",
+        "--csv",
+        str(csv_file),
+        "--plot",
+        str(png),
+    ]
     code, out, _ = cli(args, capsys)
     p = speed_profile(INLINE, **CUT)
     assert code == 0
@@ -225,8 +245,23 @@ def test_cli_text_csv_and_plot(tmp_path, capsys):
 
 
 def test_cli_json_torque_example(capsys):
-    code, out, _ = cli(["servo", "--omega-max", "13", "--alpha-max", "200", "--force", "1000", "--inertia", "1",
-                        "--torque-max", "113", "--json"], capsys)  # fmt: skip
+    code, out, _ = cli(
+        [
+            "servo",
+            "--omega-max",
+            "13",
+            "--alpha-max",
+            "200",
+            "--force",
+            "1000",
+            "--inertia",
+            "1",
+            "--torque-max",
+            "113",
+            "--json",
+        ],
+        capsys,
+    )
     r = json.loads(out)
     assert code == 0 and r["type"] == "drag-link-slider" and r["status"] == "optimal"
     assert r["peak_torque"] < 113.02 and r["constant_speed"]["peak_torque"] == pytest.approx(162.0910124, rel=1e-8)
@@ -234,8 +269,9 @@ def test_cli_json_torque_example(capsys):
 
 
 def test_cli_infeasible_and_bad_input(capsys):
-    code, out, _ = cli(["servo", "slider-crank", "--r2", "0.1", "--r3", "0.4", "--omega-max", "2", "--v-cut", "0.5"],
-                       capsys)  # fmt: skip
+    code, out, _ = cli(
+        ["servo", "slider-crank", "--r2", "0.1", "--r3", "0.4", "--omega-max", "2", "--v-cut", "0.5"], capsys
+    )
     assert code == 1 and "infeasible: the limits omega_max, v_cut cannot all hold" in out
     code, out, err = cli(["servo", "slider-crank", "--r2", "0.1", "--r3", "0.4", "--omega-max", "-3"], capsys)
     assert code == 1 and err.count("\n") == 1 and "omega_max must be positive" in err and "Traceback" not in err

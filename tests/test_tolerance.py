@@ -214,8 +214,9 @@ def cli(argv, capsys):
 
 
 def test_cli_text_with_monte_carlo(capsys):
-    code, out, _ = cli(["tolerance", "--limit", "time_ratio=0.01", "--limit", "stroke=1mm", "--monte-carlo", "2000"],
-                       capsys)  # fmt: skip
+    code, out, _ = cli(
+        ["tolerance", "--limit", "time_ratio=0.01", "--limit", "stroke=1mm", "--monte-carlo", "2000"], capsys
+    )
     a = allocate(paper_mechanism(), {"time_ratio": 0.01, "stroke": 0.001})
     assert code == 0
     assert f"+/- {a.tolerances['r1']:.4g}" in out and "+/- inf" in out
@@ -237,8 +238,22 @@ def test_cli_json_from_a_design_file(tmp_path, capsys):
 
 
 def test_cli_units_and_bad_input(capsys):
-    code, out, _ = cli(["tolerance", "slider-crank", "--r2", "0.1", "--r3", "0.35", "--e", "0.06",
-                        "--limit", "gamma_min=0.5deg", "--json"], capsys)  # fmt: skip
+    code, out, _ = cli(
+        [
+            "tolerance",
+            "slider-crank",
+            "--r2",
+            "0.1",
+            "--r3",
+            "0.35",
+            "--e",
+            "0.06",
+            "--limit",
+            "gamma_min=0.5deg",
+            "--json",
+        ],
+        capsys,
+    )
     assert code == 0 and json.loads(out)["limits"]["gamma_min"] == pytest.approx(math.radians(0.5))
     code, _, err = cli(["tolerance", "--limit", "time_ratio=-1"], capsys)
     assert code == 1 and err.count("\n") == 1 and "limit time_ratio must be positive" in err

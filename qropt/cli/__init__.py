@@ -366,8 +366,10 @@ def cmd_family(args):
         sys.stdout.write("\n")
     else:
         free = list(problem.free)
-        print(f"{problem.name or args.problem}: {len(fam.branches)} branch(es), {sum(map(len, fam.branches))} points "
-              f"(lengths in {problem.units})")  # fmt: skip
+        print(
+            f"{problem.name or args.problem}: {len(fam.branches)} branch(es), {sum(map(len, fam.branches))} points "
+            f"(lengths in {problem.units})"
+        )
         for e in fam.ends:
             at = ", ".join(f"{k}={e.params[k]:.10g}" for k in free)
             print(f"  branch {e.branch + 1} {'start' if e.side == 0 else 'end'}: {at}  ({e.reason})")
@@ -378,18 +380,39 @@ def cmd_family(args):
     if args.csv:
         with open(args.csv, "w", newline="") as fh:
             w = csv.writer(fh)
-            head = ["branch", "arclength", *problem.free, "theta_max_deg", "theta_min_deg", "time_ratio", "stroke",
-                    "gamma_min_deg", "peak_accel", "grashof", "units"]  # fmt: skip
+            head = [
+                "branch",
+                "arclength",
+                *problem.free,
+                "theta_max_deg",
+                "theta_min_deg",
+                "time_ratio",
+                "stroke",
+                "gamma_min_deg",
+                "peak_accel",
+                "grashof",
+                "units",
+            ]
             w.writerow(head)
             bar = progress_bar("exact quantities", total=sum(map(len, fam.branches)))
             for b, pts in enumerate(fam.branches):
                 for p in pts:
                     bar.update()
                     q = p.quantities
-                    w.writerow([b + 1, f"{p.arclength:.12g}", *(f"{p.params[k]:.15g}" for k in problem.free),
-                                *(f"{math.degrees(t):.12g}" for t in p.theta), q.get("time_ratio"),
-                                q.get("stroke", q.get("swing")), math.degrees(q["gamma_min"]) if q else None,
-                                q.get("peak_accel"), q.get("grashof"), problem.units])  # fmt: skip
+                    w.writerow(
+                        [
+                            b + 1,
+                            f"{p.arclength:.12g}",
+                            *(f"{p.params[k]:.15g}" for k in problem.free),
+                            *(f"{math.degrees(t):.12g}" for t in p.theta),
+                            q.get("time_ratio"),
+                            q.get("stroke", q.get("swing")),
+                            math.degrees(q["gamma_min"]) if q else None,
+                            q.get("peak_accel"),
+                            q.get("grashof"),
+                            problem.units,
+                        ]
+                    )
             bar.close()
     if args.plot:
         from qropt.io import plots
@@ -420,19 +443,30 @@ def cmd_reachable(args):
     adj = r.adjustable(low, high)
     counts = {t: r.solutions(t) for t in args.tr}
     if args.json:
-        out = {"free": args.free, "units": m.units, "intervals": r.intervals, "time_ratio_range": r.time_ratio_range,
-               "stroke_range": r.stroke_range, "solutions": {str(k): v for k, v in counts.items()},
-               "adjustable": {"time_ratios": [low, high], "interval": adj.interval,
-                              "worst_gamma_min_deg": math.degrees(adj.gamma_min),
-                              "explanation": adj.explanation}}  # fmt: skip
+        out = {
+            "free": args.free,
+            "units": m.units,
+            "intervals": r.intervals,
+            "time_ratio_range": r.time_ratio_range,
+            "stroke_range": r.stroke_range,
+            "solutions": {str(k): v for k, v in counts.items()},
+            "adjustable": {
+                "time_ratios": [low, high],
+                "interval": adj.interval,
+                "worst_gamma_min_deg": math.degrees(adj.gamma_min),
+                "explanation": adj.explanation,
+            },
+        }
         json.dump(out, sys.stdout, indent=2, default=float, allow_nan=False)
         sys.stdout.write("\n")
     else:
         u = m.units
         print(f"{type(m).__name__}: {args.free} varies, the rest as given (lengths in {u})")
         print("  feasible " + " and ".join(f"{args.free} in [{a:.10g}, {b:.10g}] {u}" for a, b in r.intervals))
-        print(f"  time ratio {tmin:.10g} (at {args.free} = {xmin:.10g} {u}) .. {tmax:.10g} "
-              f"(at {args.free} = {xmax:.10g} {u})")  # fmt: skip
+        print(
+            f"  time ratio {tmin:.10g} (at {args.free} = {xmin:.10g} {u}) .. {tmax:.10g} "
+            f"(at {args.free} = {xmax:.10g} {u})"
+        )
         print(f"  stroke {r.stroke_range.low:.10g} .. {r.stroke_range.high:.10g} {u}")
         for t, xs in counts.items():
             print(f"  TR {t:g}: {len(xs)} design(s)" + (": " + ", ".join(f"{x:.10g}" for x in xs) if xs else ""))

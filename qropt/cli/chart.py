@@ -19,15 +19,22 @@ MAX_VALUES = 100_000
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("problem", help="a problem file (build() -> Problem; its X and Y are the default axes)")
-    parser.add_argument("--x", nargs=2, metavar=("NAME", "VALUES"),
-                        help="x axis: a target (time_ratio, stroke, swing) or fixed parameter, and its values as "
-                        "FROM:TO:COUNT or V1,V2,... (swing in deg unless suffixed rad)")  # fmt: skip
+    parser.add_argument(
+        "--x",
+        nargs=2,
+        metavar=("NAME", "VALUES"),
+        help="x axis: a target (time_ratio, stroke, swing) or fixed parameter, and its values as "
+        "FROM:TO:COUNT or V1,V2,... (swing in deg unless suffixed rad)",
+    )
     parser.add_argument("--y", nargs="+", metavar="NAME VALUES", help="y axis, as --x; 'none' for a one-axis chart")
     parser.add_argument("--scheduler", help="'local' or the address of a running Dask scheduler (tcp://host:8786)")
     parser.add_argument("--workers", type=int, help="worker processes of a local Dask cluster")
     parser.add_argument("--tile", nargs=2, type=int, metavar=("NX", "NY"), help="cells per tile (default 10 10)")
-    parser.add_argument("--check", type=int, help="the full solve also runs at the centre of every CHECK x CHECK "
-                        "block (default 10; 1: everywhere)")  # fmt: skip
+    parser.add_argument(
+        "--check",
+        type=int,
+        help="the full solve also runs at the centre of every CHECK x CHECK block (default 10; 1: everywhere)",
+    )
     parser.add_argument("--plot", help="picture (PNG, PDF, SVG): contours of the objective and the optimal links")
     parser.add_argument("--csv", help="CSV file: one row per cell")
     parser.add_argument("--json", help="JSON file: the whole chart, every cell's Result")
@@ -103,20 +110,25 @@ def summary(ch) -> list[str]:
     """A few lines: the chart, how its cells were solved, the objective's range and where it is best."""
     p, s = ch.problem, ch.stats
     axes = _axis_text(ch.x) + (f" x {_axis_text(ch.y)}" if ch.y else "")
-    lines = [f"{p.name or p.mechanism.__name__}: {p.mechanism.KIND}, {p.objective} over {axes}",
-             f"{s['cells']} cells in {s['seconds']:.3g} s ({s['cells_per_second']:.3g} cells/s, {s['scheduler']}): "
-             f"{s['certified']} certified, {s['no_design']} without a design",
-             f"  {s['continued']} continued from a neighbour, {s['full']} full solves ({s['needed']} needed: the "
-             f"warm start failed or jumped), {s['jumps']} jumps, {s['switched']} cells where a better branch "
-             "took over"]  # fmt: skip
+    lines = [
+        f"{p.name or p.mechanism.__name__}: {p.mechanism.KIND}, {p.objective} over {axes}",
+        f"{s['cells']} cells in {s['seconds']:.3g} s ({s['cells_per_second']:.3g} cells/s, {s['scheduler']}): "
+        f"{s['certified']} certified, {s['no_design']} without a design",
+        f"  {s['continued']} continued from a neighbour, {s['full']} full solves ({s['needed']} needed: the "
+        f"warm start failed or jumped), {s['jumps']} jumps, {s['switched']} cells where a better branch "
+        "took over",
+    ]
     z = ch.grid()
     if np.isfinite(z).any():
         deg = maximises(p.objective)  # gamma_min, shown in degrees
         best = np.nanargmax(z) if deg else np.nanargmin(z)
         c = ch.cells[int(best)]
         lo, hi = (math.degrees(v) if deg else v for v in (np.nanmin(z), np.nanmax(z)))
-        at = ", ".join(f"{a.name} {math.degrees(a.values[k]) if a.name == 'swing' else a.values[k]:.6g}"
-                       for a, k in ((ch.x, c.i), (ch.y, c.j)) if a)  # fmt: skip
+        at = ", ".join(
+            f"{a.name} {math.degrees(a.values[k]) if a.name == 'swing' else a.values[k]:.6g}"
+            for a, k in ((ch.x, c.i), (ch.y, c.j))
+            if a
+        )
         design = ", ".join(f"{k}={c.params[k]:.6g}" for k in p.free)
         unit = " deg" if deg else f" {named(of_problem(p).unit, p.units)}" if p.objective else ""
         lines.append(f"objective {lo:.6g}..{hi:.6g}{unit}; best at {at}: {design}")

@@ -17,11 +17,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
     parser.add_argument("--tr", type=real, required=True, help="time ratio (slow/fast, >= 1)")
     parser.add_argument("--stroke", type=real, required=True, help="slider stroke [in --units]")
-    parser.add_argument("--units", default="m", choices=list(LENGTH_UNITS),
-                        help="the length unit of the stroke, the bounds and the answer (default m)")  # fmt: skip
+    parser.add_argument(
+        "--units",
+        default="m",
+        choices=list(LENGTH_UNITS),
+        help="the length unit of the stroke, the bounds and the answer (default m)",
+    )
     parser.add_argument("--objective", default="max_gamma_min", choices=[o for o in criteria.objectives() if o])
-    parser.add_argument("--size", default="footprint", choices=["sum", "longest", "footprint"],
-                        help="size measure of min_size (default footprint)")  # fmt: skip
+    parser.add_argument(
+        "--size",
+        default="footprint",
+        choices=["sum", "longest", "footprint"],
+        help="size measure of min_size (default footprint)",
+    )
     parser.add_argument("--types", nargs="+", metavar="TYPE", help="types (default all): " + ", ".join(TYPES))
     bound_flags(parser)
     parser.add_argument("--omega2", type=real, default=1.0, help="crank speed [rad/s] (default 1)")
@@ -59,10 +67,19 @@ def run(args) -> int:
     plot = picture_path(args.plot) if args.plot else None
     n_types = len(args.types or TYPES)
     with progress_bar("types", total=n_types, unit="type") as bar:
-        cmp = design(args.tr, args.stroke, objective=args.objective, types=args.types, size=args.size,
-                     conditions=conditions_of(args), omega2=args.omega2,
-                     pareto=tuple(args.pareto) if args.pareto else None, n=args.n, progress=bar.update,
-                     units=args.units)  # fmt: skip
+        cmp = design(
+            args.tr,
+            args.stroke,
+            objective=args.objective,
+            types=args.types,
+            size=args.size,
+            conditions=conditions_of(args),
+            omega2=args.omega2,
+            pareto=tuple(args.pareto) if args.pareto else None,
+            n=args.n,
+            progress=bar.update,
+            units=args.units,
+        )
     if args.csv:
         cmp.to_csv(args.csv)
     if plot:
@@ -73,17 +90,23 @@ def run(args) -> int:
         return code
     u = cmp.units
     print(f"TR {args.tr:g}, stroke {args.stroke:g} {u}, omega2 {args.omega2:g} rad/s: best by {args.objective} first")
-    print(f"  {'type':20s} {'gamma_min':>10s} {'footprint':>11s} {'sum':>8s} {'peak accel':>11s} "
-          f"{'peak v':>9s} {'T/F':>8s}")  # fmt: skip
-    print(f"  {'':20s} {'[deg]':>10s} {f'[{u}^2]':>11s} {f'[{u}]':>8s} {f'[{u}/s^2]':>11s} {f'[{u}/s]':>9s} "
-          f"{f'[{u}]':>8s}")  # fmt: skip
+    print(
+        f"  {'type':20s} {'gamma_min':>10s} {'footprint':>11s} {'sum':>8s} {'peak accel':>11s} "
+        f"{'peak v':>9s} {'T/F':>8s}"
+    )
+    print(
+        f"  {'':20s} {'[deg]':>10s} {f'[{u}^2]':>11s} {f'[{u}]':>8s} {f'[{u}/s^2]':>11s} {f'[{u}/s]':>9s} "
+        f"{f'[{u}]':>8s}"
+    )
     for r in cmp.rows:
         if not r.success:
             print(f"  {r.type:20s} no design: {r.reason}")
             continue
         c = r.criteria
-        print(f"  {r.type:20s} {math.degrees(c['gamma_min']):10.3f} {c['footprint']:11.4g} {c['sum']:8.4g} "
-              f"{c['peak_accel']:11.4g} {c['peak_velocity']:9.4g} {c['torque_per_newton']:8.4g}")  # fmt: skip
+        print(
+            f"  {r.type:20s} {math.degrees(c['gamma_min']):10.3f} {c['footprint']:11.4g} {c['sum']:8.4g} "
+            f"{c['peak_accel']:11.4g} {c['peak_velocity']:9.4g} {c['torque_per_newton']:8.4g}"
+        )
     print(f"  (T/F: peak crank torque per newton of cutting force, N {u} per N)")
     if args.csv:
         print(f"table written to {args.csv}")

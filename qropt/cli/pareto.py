@@ -34,8 +34,10 @@ def run(args) -> int:
     with progress_bar("front points", total=max(args.n - 2, 0)) as bar:
         front = pareto(problem, tuple(args.objectives), n=args.n, progress=bar.update)
     a, b = front.criteria
-    print(f"{problem.name or args.problem}: {front.objectives[0]} vs {front.objectives[1]}, "
-          f"{len(front.points)} non-dominated points")  # fmt: skip
+    print(
+        f"{problem.name or args.problem}: {front.objectives[0]} vs {front.objectives[1]}, "
+        f"{len(front.points)} non-dominated points"
+    )
     for va, vb in front.values:
         print(f"  {_show(a, va, problem.units)}   {_show(b, vb, problem.units)}")
     for eps, why in front.removed:

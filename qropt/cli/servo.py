@@ -18,8 +18,16 @@ COMMAND = "servo"
 HELP = "fastest crank-speed profile of a servo-driven crank within speed, acceleration and torque limits"
 PARAM_NAMES = ("r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider")
 LIMITS = ("omega_max", "alpha_max", "v_max", "a_max", "v_cut", "force", "inertia", "torque_max")
-UNITS = {"omega_max": "rad/s", "alpha_max": "rad/s^2", "v_max": "m/s", "a_max": "m/s^2",
-         "v_cut": "m/s", "force": "N", "inertia": "kg m^2", "torque_max": "N m"}  # fmt: skip
+UNITS = {
+    "omega_max": "rad/s",
+    "alpha_max": "rad/s^2",
+    "v_max": "m/s",
+    "a_max": "m/s^2",
+    "v_cut": "m/s",
+    "force": "N",
+    "inertia": "kg m^2",
+    "torque_max": "N m",
+}
 # the servo's dynamics add force x length to inertia x alpha: its designs are given in metres (SI) only
 
 
@@ -48,8 +56,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_mechanism_arguments(parser)
     parser.add_argument("--omega-max", type=float, required=True, help="largest crank speed, rad/s")
     for k in LIMITS[1:]:
-        what = {"force": "cutting force on the working stroke", "inertia": "crank-reduced moment of inertia",
-                "v_cut": "constant cutting speed over the central cut fraction"}.get(k, "limit")  # fmt: skip
+        what = {
+            "force": "cutting force on the working stroke",
+            "inertia": "crank-reduced moment of inertia",
+            "v_cut": "constant cutting speed over the central cut fraction",
+        }.get(k, "limit")
         parser.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"{what}, {UNITS[k]}")
     parser.add_argument("--cut-fraction", type=float, default=0.8, help="cut share of the working travel (0.8)")
     parser.add_argument("--objective", choices=OBJECTIVES, default="min_cycle_time")
@@ -61,13 +72,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def summary(p, m) -> dict:
     """The profile's numbers as plain JSON-ready values."""
-    out = {"type": m.KIND, "params": dict(m.params), "status": p.status, "message": p.message,
-           "limits": {k: v for k, v in p.limits.items() if v is not None}, "binding": list(p.binding),
-           "constant_speed": p.constant_speed()._asdict()}  # fmt: skip
+    out = {
+        "type": m.KIND,
+        "params": dict(m.params),
+        "status": p.status,
+        "message": p.message,
+        "limits": {k: v for k, v in p.limits.items() if v is not None},
+        "binding": list(p.binding),
+        "constant_speed": p.constant_speed()._asdict(),
+    }
     if p.time is not None:
-        out.update(cycle_time=p.cycle_time, working_time=p.working_time, return_time=p.return_time,
-                   time_ratio=p.time_ratio, peak_torque=p.peak_torque, cells=int(p.alpha.size),
-                   excess=p.check())  # fmt: skip
+        out.update(
+            cycle_time=p.cycle_time,
+            working_time=p.working_time,
+            return_time=p.return_time,
+            time_ratio=p.time_ratio,
+            peak_torque=p.peak_torque,
+            cells=int(p.alpha.size),
+            excess=p.check(),
+        )
     return out
 
 
@@ -78,8 +101,7 @@ def write_csv(p, path: str) -> None:
         w = csv.writer(f)
         w.writerow(["t", "theta2_deg", "omega2", "alpha2", "x", "v", "a", "torque"])
         for i in range(0, s.t.size, 2):  # each cell's first sample: the node, alpha2 of the cell it starts
-            w.writerow([f"{q[i]:.12g}" for q in (s.t, np.degrees(s.theta), s.omega, s.alpha, s.x, s.v,
-                                                 s.a, s.torque)])  # fmt: skip
+            w.writerow([f"{q[i]:.12g}" for q in (s.t, np.degrees(s.theta), s.omega, s.alpha, s.x, s.v, s.a, s.torque)])
     finally:
         if f is not sys.stdout:
             f.close()
@@ -103,14 +125,19 @@ def run(args) -> int:
         print(f"  status            {p.status}: {p.message}")
         if p.time is not None:
             c = p.constant_speed()
-            print(f"  cycle time        {p.cycle_time:.6f} s ({p.working_time:.6f} s working, "
-                  f"{p.return_time:.6f} s return); {c.cycle_time:.6f} s at constant omega_max")  # fmt: skip
+            print(
+                f"  cycle time        {p.cycle_time:.6f} s ({p.working_time:.6f} s working, "
+                f"{p.return_time:.6f} s return); {c.cycle_time:.6f} s at constant omega_max"
+            )
             print(f"  time ratio        {p.time_ratio:.6f}; {c.time_ratio:.6f} at constant speed")
             if p.peak_torque is not None:
                 ref = "" if c.peak_torque is None else f"; {c.peak_torque:.6g} at constant speed"
                 print(f"  peak torque       {p.peak_torque:.6g} N m{ref}")
-            print("  largest excess    " + ", ".join(f"{k} {v:+.2e}" for k, v in r["excess"].items())
-                  + " (relative, exact simulation 10x finer)")  # fmt: skip
+            print(
+                "  largest excess    "
+                + ", ".join(f"{k} {v:+.2e}" for k, v in r["excess"].items())
+                + " (relative, exact simulation 10x finer)"
+            )
     if p.time is not None and args.csv:
         write_csv(p, args.csv)
     if p.time is not None and args.plot:

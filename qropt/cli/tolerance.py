@@ -30,8 +30,9 @@ def limit(text: str) -> tuple[str, float, str | None]:
     name, sep, value = text.partition("=")
     name = name.strip()
     if not sep or name not in QUANTITIES:
-        raise argparse.ArgumentTypeError(f"not a limit: {text!r} (use e.g. time_ratio=0.01 or stroke=0.001; "
-                                         f"quantities: {', '.join(QUANTITIES)})")  # fmt: skip
+        raise argparse.ArgumentTypeError(
+            f"not a limit: {text!r} (use e.g. time_ratio=0.01 or stroke=0.001; quantities: {', '.join(QUANTITIES)})"
+        )
     v = value.strip().lower()
     unit = next((u for u in sorted({**LENGTH_UNITS, **ANGLE_UNITS}, key=len, reverse=True) if v.endswith(u)), None)
     if unit is not None:
@@ -57,10 +58,13 @@ def limit(text: str) -> tuple[str, float, str | None]:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("target", nargs="?",
-                        help="mechanism type (" + ", ".join(sorted(REGISTRY)) + ") or a JSON file with 'type' "
-                        "and 'params' (as 'qropt synth --json' or 'qropt analyze --json' print); default: the "
-                        "paper's mechanism")  # fmt: skip
+    parser.add_argument(
+        "target",
+        nargs="?",
+        help="mechanism type (" + ", ".join(sorted(REGISTRY)) + ") or a JSON file with 'type' "
+        "and 'params' (as 'qropt synth --json' or 'qropt analyze --json' print); default: the "
+        "paper's mechanism",
+    )
     for k in PARAM_NAMES:
         parser.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
     parser.add_argument(
@@ -162,12 +166,28 @@ def run(args) -> int:
     if al.status == "optimal" and args.monte_carlo is not None:
         mc = al.monte_carlo(args.monte_carlo, seed=args.seed)
     if args.json:
-        out = {"type": m.KIND, "params": dict(m.params), "units": m.units, "status": al.status, "message": al.message,
-               "method": al.method, "k": al.k, "limits": al.limits, "tolerances": al.tolerances,
-               "sensitivities": al.sensitivities, "usage": al.usage}  # fmt: skip
+        out = {
+            "type": m.KIND,
+            "params": dict(m.params),
+            "units": m.units,
+            "status": al.status,
+            "message": al.message,
+            "method": al.method,
+            "k": al.k,
+            "limits": al.limits,
+            "tolerances": al.tolerances,
+            "sensitivities": al.sensitivities,
+            "usage": al.usage,
+        }
         if mc is not None:
-            out["monte_carlo"] = {"n": mc.n, "within": mc.within, "worst": mc.worst, "all_within": mc.all_within,
-                                  "linearisation": mc.linearisation, "failed": mc.failed}  # fmt: skip
+            out["monte_carlo"] = {
+                "n": mc.n,
+                "within": mc.within,
+                "worst": mc.worst,
+                "all_within": mc.all_within,
+                "linearisation": mc.linearisation,
+                "failed": mc.failed,
+            }
         json.dump(_finite(out), sys.stdout, indent=2)
         sys.stdout.write("\n")
         return 0 if al.status == "optimal" else 1
@@ -187,7 +207,9 @@ def run(args) -> int:
     if mc is not None:
         print(f"  Monte Carlo, {mc.n} mechanisms (exact re-analysis), {mc.failed} not analysable:")
         for q in qs:
-            print(f"    {q}: {100 * mc.within[q]:.2f}% within, worst |deviation| {mc.worst[q]:.6g}, "
-                  f"linearisation error <= {mc.linearisation[q]:.3g}")  # fmt: skip
+            print(
+                f"    {q}: {100 * mc.within[q]:.2f}% within, worst |deviation| {mc.worst[q]:.6g}, "
+                f"linearisation error <= {mc.linearisation[q]:.3g}"
+            )
         print(f"    every limit met: {100 * mc.all_within:.2f}%")
     return 0

@@ -10,9 +10,9 @@ at every node, on both sides of it (alpha2 jumps there). Between nodes a limited
 its node values by at most h^2/8 max|q''| on the cell (linear interpolation error): O(h^2), about
 1e-5..1e-4 relative at n = 720 in the examples; ``SpeedProfile.check`` measures it by exact sampling.
 
-Units: theta2 rad, omega2 rad/s, alpha2 rad/s^2, time s, slider in the mechanism's length unit
-(v length/s, a length/s^2), force N, inertia kg m^2 (constant, reduced to the crank), torque N x length
-(N m for lengths in m); the torque is quasi-static: inertia alpha2 + force |dx/dtheta2| on the working stroke.
+Units: SI (a mechanism's lengths are taken in metres): theta2 rad, omega2 rad/s, alpha2 rad/s^2, time s, slider
+v m/s, a m/s^2, force N, inertia kg m^2 (constant, reduced to the crank), torque N m; the torque is quasi-static:
+inertia alpha2 + force |dx/dtheta2| on the working stroke.
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ import scipy.sparse as sp
 from qropt.errors import InvalidParameter
 from qropt.io.paths import picture_path
 from qropt.mechanisms import Mechanism
+from qropt.units import to_metres
 
 OBJECTIVES = ("min_cycle_time", "min_return_time")
 MIN_CELLS, MAX_CELLS = 36, 100_000
@@ -163,10 +164,18 @@ class SpeedProfile:
         out = ServoMotion(
             *(
                 np.ascontiguousarray(q).ravel()
-                for q in (self.time[:-1, None] + dt, theta, wu, alpha, mo.x.reshape(theta.shape), xp * wu,
-                          xpp * bu + xp * alpha, torque)
+                for q in (
+                    self.time[:-1, None] + dt,
+                    theta,
+                    wu,
+                    alpha,
+                    mo.x.reshape(theta.shape),
+                    xp * wu,
+                    xpp * bu + xp * alpha,
+                    torque,
+                )
             )
-        )  # fmt: skip
+        )
         self._cache[refine] = out
         return out
 
@@ -193,10 +202,13 @@ class SpeedProfile:
 
         path = picture_path(path)  # checked before anything is drawn
         s = self.motion()
-        rows = [("crank omega2 [rad/s]", s.omega, ["omega_max"]), ("slider v [length/s]", s.v, ["v_max", "v_cut"]),
-                ("slider a [length/s^2]", s.a, ["a_max"])]  # fmt: skip
+        rows = [
+            ("crank omega2 [rad/s]", s.omega, ["omega_max"]),
+            ("slider v [m/s]", s.v, ["v_max", "v_cut"]),
+            ("slider a [m/s^2]", s.a, ["a_max"]),
+        ]
         if self.peak_torque is not None:
-            rows.append(("motor torque [N length]", s.torque, ["torque_max"]))
+            rows.append(("motor torque [N m]", s.torque, ["torque_max"]))
         fig, axes = plots.plt.subplots(len(rows), 1, figsize=(8, 2.2 * len(rows) + 0.6), sharex=True)
         tw = self.working_time
         for ax, (label, y, names) in zip(axes, rows, strict=True):
@@ -205,8 +217,16 @@ class SpeedProfile:
             for name in names:
                 v = self.limits.get(name)
                 if v is not None:
-                    for sign in (1, -1) if name != "omega_max" else (1,):
-                        ax.axhline(sign * v, color="tab:red" if name != "v_cut" else "tab:green", ls="--", lw=1)
+                    for i, sign in enumerate((1, -1) if name != "omega_max" else (1,)):
+                        ax.axhline(
+                            sign * v,
+                            color="tab:red" if name != "v_cut" else "tab:green",
+                            ls="--",
+                            lw=1,
+                            label=None if i else ("cutting speed" if name == "v_cut" else f"limit {name}"),
+                        )
+            if ax.get_legend_handles_labels()[0]:
+                ax.legend(loc="lower right", fontsize=7, framealpha=0.9)
             ax.set_ylabel(label)
             ax.grid(alpha=0.3)
         axes[-1].set_xlabel("time [s]")
@@ -217,6 +237,14 @@ class SpeedProfile:
         )
         fig.tight_layout()
         plots.save(fig, path)
+
+
+def in_metres(m: Mechanism) -> Mechanism:
+    """The same mechanism with its lengths in metres (servo limits, forces and torques are SI)."""
+    if getattr(m, "units", "m") == "m":
+        return m
+    k = to_metres(m.units)
+    return type(m)(**{n: v if n in m.BRANCHES else v * k for n, v in m.params.items()}, units="m")
 
 
 def _limit(name, value, *, required=False, zero_ok=False):
@@ -388,6 +416,7 @@ def speed_profile(
             "theta4 (rad), to which the slider limits (v_max, a_max, v_cut in length/s) and the cutting-force "
             "torque do not apply; give the slider type it drives (crank-rocker-slider, drag-link-slider)"
         )
+    mechanism = in_metres(mechanism)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not MIN_CELLS <= n <= MAX_CELLS:
         raise InvalidParameter(f"n (cells per turn) must be an integer in {MIN_CELLS}..{MAX_CELLS}, got {n!r}")
     if objective not in OBJECTIVES:
@@ -459,8 +488,17 @@ def _profile(word, message, beta, g: _Grid, lim, base) -> SpeedProfile:
     with np.errstate(divide="ignore"):
         time = np.concatenate([[0.0], np.cumsum(2 * h / (omega[:-1] + omega[1:]))])
     alpha = np.diff(b) / (2 * h)
-    return SpeedProfile(word, message, theta=g.theta, omega=omega, alpha=alpha, time=time,
-                        working_cells=g.working_cells, cut_cells=g.cut_cells, **base)  # fmt: skip
+    return SpeedProfile(
+        word,
+        message,
+        theta=g.theta,
+        omega=omega,
+        alpha=alpha,
+        time=time,
+        working_cells=g.working_cells,
+        cut_cells=g.cut_cells,
+        **base,
+    )
 
 
 def _envelope(g: _Grid, lim) -> np.ndarray:

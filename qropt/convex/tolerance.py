@@ -202,8 +202,17 @@ def _bounds(bounds, names):
     return lo, hi
 
 
-def allocate(mechanism: Mechanism, limits: dict, *, params=None, method: str = "worst-case", k: float = 3.0,
-             weights=None, bounds=None, omega2: float | None = None) -> Allocation:  # fmt: skip
+def allocate(
+    mechanism: Mechanism,
+    limits: dict,
+    *,
+    params=None,
+    method: str = "worst-case",
+    k: float = 3.0,
+    weights=None,
+    bounds=None,
+    omega2: float | None = None,
+) -> Allocation:
     """The tolerances t maximising sum w_i log t_i with, for each limited quantity Q (limit E):
     sum_i |dQ/dp_i| t_i <= E ('worst-case') or ||dQ/dp * t||_2 <= E / k ('rss').
 
@@ -223,15 +232,25 @@ def allocate(mechanism: Mechanism, limits: dict, *, params=None, method: str = "
     w = _weights(weights, names)
     lo, hi = _bounds(bounds, names)
     S, pieces = _rows(mechanism, names, qs, omega2)
-    base = dict(mechanism=mechanism, limits=dict(zip(qs, E.tolist(), strict=True)), method=method, k=k,
-                sensitivities={q: dict(zip(names, r.tolist(), strict=True)) for q, r in zip(qs, S, strict=True)},
-                omega2=omega2)  # fmt: skip
+    base = dict(
+        mechanism=mechanism,
+        limits=dict(zip(qs, E.tolist(), strict=True)),
+        method=method,
+        k=k,
+        sensitivities={q: dict(zip(names, r.tolist(), strict=True)) for q, r in zip(qs, S, strict=True)},
+        omega2=omega2,
+    )
     base.update(kinks={q: s.kink for q, s in pieces.items() if s.kink}, pieces=pieces)
     A = np.abs(S) / E[:, None] * (1.0 if method == "worst-case" else k)  # each limit: ||A_j t|| <= 1
     over = [q for q, a in zip(qs, A, strict=True) if _stack(a, lo, method) > 1.0]
     if over:
-        return Allocation("infeasible", f"infeasible: the lower bounds alone exceed the limits on {', '.join(over)}",
-                          tolerances={}, usage={}, **base)  # fmt: skip
+        return Allocation(
+            "infeasible",
+            f"infeasible: the lower bounds alone exceed the limits on {', '.join(over)}",
+            tolerances={},
+            usage={},
+            **base,
+        )
     scale = A.max(axis=0)
     live = scale > 0.0  # rounding-level sensitivities are exact zeros (see _rows)
     t = np.where(live, 0.0, hi)

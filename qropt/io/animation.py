@@ -49,8 +49,9 @@ def _render(m, sc, path, omega2, frames, fps, progress, arc):
     sense = 1.0 if omega2 > 0 else -1.0
     theta = sense * np.linspace(0.0, 2 * math.pi, frames, endpoint=False)
     pos = m.positions(theta).points
-    drawn = [[s for s in drawing.shapes(sc, {k: v[i] for k, v in pos.items()}) if s.part != "path"]
-             for i in range(frames)]  # fmt: skip
+    drawn = [
+        [s for s in drawing.shapes(sc, {k: v[i] for k, v in pos.items()}) if s.part != "path"] for i in range(frames)
+    ]
     x0, x1, y0, y1 = drawing.bounds([s for f in drawn for s in f] + drawing.at(sc, 0.0))
     pad = 0.05 * max(x1 - x0, y1 - y0)
     fig, ax = plt.subplots(figsize=(6, 4.3))

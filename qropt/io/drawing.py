@@ -80,8 +80,9 @@ def check(m) -> tuple[tuple[Body, ...], tuple[str, ...], str | None]:
             raise BodyError(f"{name}: body {bname!r} ({kind}) carries {count} joint(s), got {bj!r}")
         for j in bj:
             if j not in have:
-                raise BodyError(f"{name}: body {bname!r} names joint {j!r}, which its positions do not have "
-                                f"(joints: {joints})")  # fmt: skip
+                raise BodyError(
+                    f"{name}: body {bname!r} names joint {j!r}, which its positions do not have (joints: {joints})"
+                )
         checked.append(Body(bname, tuple(bj), kind))
     ground = tuple(m.GROUND)
     for j in ground:
@@ -168,8 +169,11 @@ def shapes(sc: Scene, points: dict) -> list[Shape]:
             out.append(Shape("BLOCKS", "polygon", _square((x, ram), 0.0, big), "ram", name))
     for k, r in p.items():
         ground = k in sc.ground
-        out.append(Shape("PIVOTS" if ground else "JOINTS", "circle", (_xy(r),), "pivot" if ground else "joint", k,
-                         JOINT * scale))  # fmt: skip
+        out.append(
+            Shape(
+                "PIVOTS" if ground else "JOINTS", "circle", (_xy(r),), "pivot" if ground else "joint", k, JOINT * scale
+            )
+        )
     if sc.path is not None:
         out.append(Shape("SLIDER_PATH", "polyline", tuple(map(_xy, sc.path)), "path", sc.output))
     return out

@@ -110,8 +110,14 @@ def to_svg(m: Mechanism, path, theta2: float = 0.0) -> None:
     pad = 0.05 * max(max(xs) - min(xs), max(ys) - min(ys))
     x0, x1, y0, y1 = min(xs) - pad, max(xs) + pad, min(ys) - pad, max(ys) + pad
     width = (x1 - x0) / 200  # stroke widths relative to the drawing
-    colours = {"LINKS": "black", "PIVOTS": "red", "JOINTS": "blue", "SLIDE_LINE": "gray", "SLIDER_PATH": "teal",
-               "BLOCKS": "dimgray"}  # fmt: skip
+    colours = {
+        "LINKS": "black",
+        "PIVOTS": "red",
+        "JOINTS": "blue",
+        "SLIDE_LINE": "gray",
+        "SLIDER_PATH": "teal",
+        "BLOCKS": "dimgray",
+    }
     body = []
     for layer, items in geo.items():
         parts = []

@@ -27,15 +27,22 @@ def draw_shapes(ax, shapes, color="k", alpha=1.0, labels=True, joint_color=None)
         if s.part == "link":
             out += ax.plot(xy[:, 0], xy[:, 1], color=color, lw=2, alpha=alpha, solid_capstyle="round", zorder=2)
         elif s.part == "plate":
-            patch = Polygon(xy, closed=True, facecolor=to_rgba(color, 0.25 * alpha), edgecolor=to_rgba(color, alpha),
-                            lw=2, zorder=2)  # fmt: skip
+            patch = Polygon(
+                xy, closed=True, facecolor=to_rgba(color, 0.25 * alpha), edgecolor=to_rgba(color, alpha), lw=2, zorder=2
+            )
             out.append(ax.add_patch(patch))
         elif s.part == "slot":
-            out.append(ax.add_patch(Polygon(xy, closed=True, fill=False, edgecolor=to_rgba(color, 0.8 * alpha),
-                                            lw=1, zorder=2.5)))  # fmt: skip
+            out.append(
+                ax.add_patch(
+                    Polygon(xy, closed=True, fill=False, edgecolor=to_rgba(color, 0.8 * alpha), lw=1, zorder=2.5)
+                )
+            )
         elif s.part in ("block", "ram"):
-            out.append(ax.add_patch(Polygon(xy, closed=True, facecolor="white", edgecolor=to_rgba(color, alpha),
-                                            lw=1.5, zorder=3)))  # fmt: skip
+            out.append(
+                ax.add_patch(
+                    Polygon(xy, closed=True, facecolor="white", edgecolor=to_rgba(color, alpha), lw=1.5, zorder=3)
+                )
+            )
         elif s.part == "slide":
             out += ax.plot(xy[:, 0], xy[:, 1], color="0.5", lw=1, ls="-.", zorder=1)
         elif s.part == "path":
@@ -45,8 +52,11 @@ def draw_shapes(ax, shapes, color="k", alpha=1.0, labels=True, joint_color=None)
             (x, y), c = s.points[0], color if pivot else joint_color
             out += ax.plot(x, y, "s" if pivot else "o", color=c, ms=7 if pivot else 5, alpha=alpha, zorder=4)
             if labels:
-                out.append(ax.annotate(s.name, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8,
-                                       alpha=alpha, zorder=5))  # fmt: skip
+                out.append(
+                    ax.annotate(
+                        s.name, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8, alpha=alpha, zorder=5
+                    )
+                )
     return out
 
 
@@ -178,8 +188,9 @@ def family_figure(f, x=None, y=None, best=None, max_points=400):
     for k, e in enumerate(f.ends):
         ax.plot(e.params[x], e.params[y], "ks", ms=6)
         why = e.reason.split(":")[0].replace("singularity at a ", "").split(" (")[0]
-        ax.annotate(f"end {k + 1}: {why}", (e.params[x], e.params[y]), textcoords="offset points", xytext=(6, -12),
-                    fontsize=8)  # fmt: skip
+        ax.annotate(
+            f"end {k + 1}: {why}", (e.params[x], e.params[y]), textcoords="offset points", xytext=(6, -12), fontsize=8
+        )
     if best is not None and best.success:
         g = math.degrees(best.objective) if best.objective is not None else float("nan")
         ax.plot(best.params[x], best.params[y], "*", color="tab:red", ms=16, label=f"best gamma_min {g:.2f} deg")
@@ -210,9 +221,14 @@ def family_mechanisms(f, count=4):
 
 
 def _criteria_text(c: dict, unit: str) -> str:
-    return "\n".join([f"gamma_min {math.degrees(c['gamma_min']):.1f} deg", f"footprint {c['footprint']:.3g} {unit}^2",
-                      f"peak accel {c['peak_accel']:.3g} {unit}/s^2",
-                      f"peak working v {c['peak_velocity']:.3g} {unit}/s"])  # fmt: skip
+    return "\n".join(
+        [
+            f"gamma_min {math.degrees(c['gamma_min']):.1f} deg",
+            f"footprint {c['footprint']:.3g} {unit}^2",
+            f"peak accel {c['peak_accel']:.3g} {unit}/s^2",
+            f"peak working v {c['peak_velocity']:.3g} {unit}/s",
+        ]
+    )
 
 
 def comparison_figure(cmp):
@@ -229,8 +245,15 @@ def comparison_figure(cmp):
     span = max((max(x1 - x0, y1 - y0) for x0, x1, y0, y1 in boxes.values()), default=1.0) * 1.15
     for ax, r in zip(axes, rows, strict=False):
         if not r.success:
-            ax.text(0.5, 0.5, "no design:\n" + _wrap(r.reason, 40), transform=ax.transAxes, ha="center",
-                    va="center", fontsize=8)  # fmt: skip
+            ax.text(
+                0.5,
+                0.5,
+                "no design:\n" + _wrap(r.reason, 40),
+                transform=ax.transAxes,
+                ha="center",
+                va="center",
+                fontsize=8,
+            )
             ax.set_title(r.type)
             ax.set_axis_off()
             continue
@@ -241,9 +264,18 @@ def comparison_figure(cmp):
         ax.set_xlim(cx - span / 2, cx + span / 2)
         ax.set_ylim(cy - span / 2, cy + span / 2)
         ax.set_title(r.type, fontsize=10)
-        ax.text(0.02, 0.02, _criteria_text(r.criteria, cmp.units), transform=ax.transAxes, fontsize=7.5, va="bottom",
-                bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "0.8"})  # fmt: skip
+        ax.text(
+            0.02,
+            0.02,
+            _criteria_text(r.criteria, cmp.units),
+            transform=ax.transAxes,
+            fontsize=7.5,
+            va="bottom",
+            bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "0.8"},
+        )
         ax.tick_params(labelsize=7)
+        ax.set_xlabel(f"x [{cmp.units}]", fontsize=8)
+        ax.set_ylabel(f"y [{cmp.units}]", fontsize=8)
     if cmp.fronts:
         ax = axes[len(rows)]
         drawn = {k: f for k, f in cmp.fronts.items() if not isinstance(f, str) and f.values}
@@ -261,8 +293,10 @@ def comparison_figure(cmp):
         ax.legend(fontsize=7)
     for ax in axes[n:]:
         ax.set_axis_off()
-    fig.suptitle(f"TR {cmp.time_ratio:g}, stroke {cmp.stroke:g} {cmp.units}: best by {cmp.objective} first (one scale; "
-                 f"omega2 = {cmp.omega2:g} rad/s)")  # fmt: skip
+    fig.suptitle(
+        f"TR {cmp.time_ratio:g}, stroke {cmp.stroke:g} {cmp.units}: best by {cmp.objective} first (one scale; "
+        f"omega2 = {cmp.omega2:g} rad/s)"
+    )
     fig.tight_layout()
     return fig
 
@@ -316,8 +350,9 @@ def front_figure(front, designs: int = 3):
         cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
         axm.set_xlim(cx - span / 2, cx + span / 2)
         axm.set_ylim(cy - span / 2, cy + span / 2)
-        axm.set_title(f"{k + 1}: {_short(a, va[i], front.problem.units)}, {_short(b, vb[i], front.problem.units)}",
-                      fontsize=9)  # fmt: skip
+        axm.set_title(
+            f"{k + 1}: {_short(a, va[i], front.problem.units)}, {_short(b, vb[i], front.problem.units)}", fontsize=9
+        )
         axm.tick_params(labelsize=7)
     fig.tight_layout()
     return fig

@@ -21,13 +21,28 @@ from qropt.io.paths import output_path
 from qropt.synthesis import analytic
 
 # The paper's printed values (its claims, shown beside the exact ones). Table 5: theta2 = 60 deg, omega2 = 10 rad/s.
-TABLE5 = {"theta3 [rad]": -0.3247, "omega3 [rad/s]": 7.566, "alpha3 [rad/s^2]": -51.18, "theta4 [rad]": 0.4313,
-          "omega4 [rad/s]": 11.69, "alpha4 [rad/s^2]": -45.41, "theta6 [rad]": 2.931, "omega6 [rad/s]": -5.430,
-          "alpha6 [rad/s^2]": 44.00, "L7 [m]": 0.4296, "L7dot [m/s]": -1.074, "L7ddot [m/s^2]": -21.67}  # fmt: skip
-PRINTED = {"theta2a, first root [deg] (eq. 12)": 6.18, "theta2a, second root [deg] (eq. 12)": 39.38,
-           "r3, first root [m]": 0.1544, "min of eqs. (14)-(17), first root [deg]": 10.47,
-           "transmission quality of the chosen design [deg] (eqs. 14-17)": 35.60,
-           "largest TR of the adjustable coupler": 5.538}  # fmt: skip
+TABLE5 = {
+    "theta3 [rad]": -0.3247,
+    "omega3 [rad/s]": 7.566,
+    "alpha3 [rad/s^2]": -51.18,
+    "theta4 [rad]": 0.4313,
+    "omega4 [rad/s]": 11.69,
+    "alpha4 [rad/s^2]": -45.41,
+    "theta6 [rad]": 2.931,
+    "omega6 [rad/s]": -5.430,
+    "alpha6 [rad/s^2]": 44.00,
+    "L7 [m]": 0.4296,
+    "L7dot [m/s]": -1.074,
+    "L7ddot [m/s^2]": -21.67,
+}
+PRINTED = {
+    "theta2a, first root [deg] (eq. 12)": 6.18,
+    "theta2a, second root [deg] (eq. 12)": 39.38,
+    "r3, first root [m]": 0.1544,
+    "min of eqs. (14)-(17), first root [deg]": 10.47,
+    "transmission quality of the chosen design [deg] (eqs. 14-17)": 35.60,
+    "largest TR of the adjustable coupler": 5.538,
+}
 CSS = (
     "body{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222;line-height:1.45}"
     "table{border-collapse:collapse;margin:.6em 0}td,th{border:1px solid #bbb;padding:.25em .6em;text-align:right}"
@@ -67,8 +82,10 @@ def _design_section(title, r, free) -> str:
     rows += [("time ratio", q["time_ratio"]), ("gamma_min [deg]", math.degrees(q["gamma_min"]))]
     rows += [(f"stroke [{u}]", q["stroke"])] if "stroke" in q else [("swing [deg]", math.degrees(q["swing"]))]
     head = ["status", *(f"{k} [{u}]" for k in free), "gamma_min [deg]", "objective"]
-    optima = [(o.status, *(o.params[k] for k in free), math.degrees(o.quantities["gamma_min"]), o.objective)
-              for o in r.local_optima]  # fmt: skip
+    optima = [
+        (o.status, *(o.params[k] for k in free), math.degrees(o.quantities["gamma_min"]), o.objective)
+        for o in r.local_optima
+    ]
     return (
         f"<h2>{title}</h2><p>{html.escape(r.message)}</p>{_table(['quantity', 'value'], rows)}"
         f"<h3>Every certified local optimum</h3>{_table(head, optima)}"
@@ -78,9 +95,20 @@ def _design_section(title, r, free) -> str:
 
 def _table5(m) -> list[float]:
     s = m.slider(math.radians(60), 10.0, 0.0)
-    return [s.angles["theta3"][0], s.omega["theta3"][0], s.alpha["theta3"][0], s.angles["theta4"][0],
-            s.omega["theta4"][0], s.alpha["theta4"][0], s.angles["theta6"][0] + math.pi, s.omega["theta6"][0],
-            s.alpha["theta6"][0], s.x[0] - m.params["r1"], s.v[0], s.a[0]]  # fmt: skip
+    return [
+        s.angles["theta3"][0],
+        s.omega["theta3"][0],
+        s.alpha["theta3"][0],
+        s.angles["theta4"][0],
+        s.omega["theta4"][0],
+        s.alpha["theta4"][0],
+        s.angles["theta6"][0] + math.pi,
+        s.omega["theta6"][0],
+        s.alpha["theta6"][0],
+        s.x[0] - m.params["r1"],
+        s.v[0],
+        s.a[0],
+    ]
 
 
 def _paper(tick) -> str:
@@ -103,8 +131,9 @@ def _paper(tick) -> str:
     for s in roots:
         g_tdc, g_bdc = analytic.paper_transmission_at_dead_centres(0.1, 0.225, s.r3, 0.275)
         m = p.build({"r3": s.r3, "r5": 0.15}, {"sigma": -1.0, "sigma_slider": 1.0})
-        rows.append((s.r3, math.degrees(s.theta2a), math.degrees(g_tdc), math.degrees(g_bdc),
-                     math.degrees(m.gamma_min().value)))  # fmt: skip
+        rows.append(
+            (s.r3, math.degrees(s.theta2a), math.degrees(g_tdc), math.degrees(g_bdc), math.degrees(m.gamma_min().value))
+        )
     tick()
     parts.append(
         "<p>Eqs. (7)-(13) give every coupler for the time ratio; eqs. (14)-(17) evaluate the transmission angle at "
@@ -123,8 +152,12 @@ def _paper(tick) -> str:
         f"Adjustable from TR 1.5 to 2.5: {html.escape(adj.explanation)}.</p>"
         + _png(plots.reachable_figure(reach, (1.5, 2.0)))
     )
-    fam_problem = Problem("DragLinkSlider", fixed={"r2": 0.225, "r4": 0.275, "r5": 0.15, "r6": 0.3},
-                          free={"r1": (0.02, 0.2), "r3": (0.05, 0.6)}, targets={"time_ratio": 1.5})  # fmt: skip
+    fam_problem = Problem(
+        "DragLinkSlider",
+        fixed={"r2": 0.225, "r4": 0.275, "r5": 0.15, "r6": 0.3},
+        free={"r1": (0.02, 0.2), "r3": (0.05, 0.6)},
+        targets={"time_ratio": 1.5},
+    )
     tick()
     fam = family(fam_problem)
     best = fam.best("max_gamma_min")
@@ -159,8 +192,14 @@ def _paper(tick) -> str:
         + _table(["theta2 [deg]", "x [m]", "v [m/s]", "a [m/s^2]"], rows)
     )
     g_lo = analytic.paper_transmission_at_dead_centres(0.1, 0.225, roots[0].r3, 0.275)
-    exact = [math.degrees(roots[0].theta2a), math.degrees(roots[1].theta2a), roots[0].r3,
-             math.degrees(min(g_lo)), math.degrees(m.gamma_min().value), t.high]  # fmt: skip
+    exact = [
+        math.degrees(roots[0].theta2a),
+        math.degrees(roots[1].theta2a),
+        roots[0].r3,
+        math.degrees(min(g_lo)),
+        math.degrees(m.gamma_min().value),
+        t.high,
+    ]
     rows = [(k, printed, v) for (k, printed), v in zip(PRINTED.items(), exact, strict=True)]
     parts.append(
         "<h2>Where the paper's printed numbers differ from the exact ones</h2>"

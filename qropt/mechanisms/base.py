@@ -415,8 +415,12 @@ class Mechanism:
                 margins.append((float(e.value.min()), float(e.theta[np.argmin(e.value)])))
             else:
                 margins.append((least[m], float(cycle.grid(q.shape[1])[at[m]])))
-        return {"max": (res[0].theta, res[0].value), "min": (res[1].theta, res[1].value), "gamma": gammas,
-                "margins": margins}  # fmt: skip
+        return {
+            "max": (res[0].theta, res[0].value),
+            "min": (res[1].theta, res[1].value),
+            "gamma": gammas,
+            "margins": margins,
+        }
 
     def _require_full_turn(self):
         if not self.REQUIRES_FULL_TURN:

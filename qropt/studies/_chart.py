@@ -27,8 +27,20 @@ from qropt.synthesis.result import STATUSES, Result
 from qropt.units import named
 
 METHODS = ("continued", "full")
-STATS = ("cells", "certified", "no_design", "continued", "full", "needed", "jumps", "switched", "seconds",
-         "cells_per_second", "tiles", "scheduler")  # fmt: skip
+STATS = (
+    "cells",
+    "certified",
+    "no_design",
+    "continued",
+    "full",
+    "needed",
+    "jumps",
+    "switched",
+    "seconds",
+    "cells_per_second",
+    "tiles",
+    "scheduler",
+)
 
 
 class Axis(NamedTuple):
@@ -67,8 +79,9 @@ class Cell:
 
     @classmethod
     def of(cls, i, j, r: Result, method, **flags) -> Cell:
-        return cls(i, j, r.status, r.objective, dict(r.params), dict(r.quantities), r.message, method, **flags,
-                   _result=r)  # fmt: skip
+        return cls(
+            i, j, r.status, r.objective, dict(r.params), dict(r.quantities), r.message, method, **flags, _result=r
+        )
 
     @property
     def result(self) -> Result:
@@ -91,9 +104,17 @@ class Cell:
 
     def to_dict(self) -> dict:
         result = self._data if self._result is None else self._result.to_dict()
-        return {"i": self.i, "j": self.j, "method": self.method, "why": self.why,
-                "source": list(self.source) if self.source else None, "jump": self.jump, "switched": self.switched,
-                "seconds": self.seconds, "result": result}  # fmt: skip
+        return {
+            "i": self.i,
+            "j": self.j,
+            "method": self.method,
+            "why": self.why,
+            "source": list(self.source) if self.source else None,
+            "jump": self.jump,
+            "switched": self.switched,
+            "seconds": self.seconds,
+            "result": result,
+        }
 
     @classmethod
     def from_dict(cls, d: dict) -> Cell:
@@ -126,9 +147,22 @@ class Cell:
                 "message": _is_str,
             },
         )
-        return cls(d["i"], d["j"], r["status"], r["objective"], dict(r["params"]), dict(r["quantities"]),
-                   r["message"], d["method"], d["why"], tuple(d["source"]) if d["source"] else None, d["jump"],
-                   d["switched"], d["seconds"], _data=r)  # fmt: skip
+        return cls(
+            d["i"],
+            d["j"],
+            r["status"],
+            r["objective"],
+            dict(r["params"]),
+            dict(r["quantities"]),
+            r["message"],
+            d["method"],
+            d["why"],
+            tuple(d["source"]) if d["source"] else None,
+            d["jump"],
+            d["switched"],
+            d["seconds"],
+            _data=r,
+        )
 
     def __repr__(self):
         obj = "" if self.objective is None else f", objective={self.objective:.10g}"
@@ -205,8 +239,11 @@ class Chart:
 
     def _grid(self, name) -> np.ndarray:
         ok = next((c for c in self.cells if c.success), None)
-        known = {"objective"} | set(ok.params if ok else ()) | {k for k, v in (ok.quantities if ok else {}).items()
-                                                                if isinstance(v, (int, float))}  # fmt: skip
+        known = (
+            {"objective"}
+            | set(ok.params if ok else ())
+            | {k for k, v in (ok.quantities if ok else {}).items() if isinstance(v, (int, float))}
+        )
         if name not in known:
             raise ChartError(f"unknown chart quantity {name!r}; known: {sorted(known)}")
         out = np.full(len(self.cells), np.nan)
@@ -221,10 +258,15 @@ class Chart:
     def mask(self, flag: str) -> np.ndarray:
         """Boolean array of a flag: certified, infeasible (no design: infeasible or failed), continued, full,
         needed (the full solve was needed), jump, switched."""
-        test = {"certified": lambda c: c.success, "infeasible": lambda c: not c.success,
-                "continued": lambda c: c.method == "continued", "full": lambda c: c.method == "full",
-                "needed": lambda c: c.needed_full, "jump": lambda c: c.jump,
-                "switched": lambda c: c.switched}  # fmt: skip
+        test = {
+            "certified": lambda c: c.success,
+            "infeasible": lambda c: not c.success,
+            "continued": lambda c: c.method == "continued",
+            "full": lambda c: c.method == "full",
+            "needed": lambda c: c.needed_full,
+            "jump": lambda c: c.jump,
+            "switched": lambda c: c.switched,
+        }
         if not isinstance(flag, str) or flag not in test:
             raise ChartError(f"unknown chart flag {flag!r}; flags: {', '.join(self.FLAGS)}")
         return np.array([test[flag](c) for c in self.cells]).reshape(self.shape)
@@ -232,10 +274,12 @@ class Chart:
     def __repr__(self):
         s = self.stats
         ax = f"{self.x.name} {len(self.x.values)}" + (f" x {self.y.name} {len(self.y.values)}" if self.y else "")
-        return (f"Chart({self.problem.mechanism.__name__} {self.problem.objective}, {ax}: {s['cells']} cells, "
-                f"{s['certified']} certified, {s['no_design']} without a design; {s['continued']} continued, "
-                f"{s['full']} full ({s['needed']} needed), {s['jumps']} jumps, {s['switched']} switched; "
-                f"{s['seconds']:.3g} s, {s['scheduler']})")  # fmt: skip
+        return (
+            f"Chart({self.problem.mechanism.__name__} {self.problem.objective}, {ax}: {s['cells']} cells, "
+            f"{s['certified']} certified, {s['no_design']} without a design; {s['continued']} continued, "
+            f"{s['full']} full ({s['needed']} needed), {s['jumps']} jumps, {s['switched']} switched; "
+            f"{s['seconds']:.3g} s, {s['scheduler']})"
+        )
 
     # ---- files ------------------------------------------------------------------------------------------
     def rows(self) -> list[dict]:
@@ -245,8 +289,14 @@ class Chart:
         out = []
         for c in self.cells:
             row = {n: a.values[k] for n, a, k in zip(names, (self.x, self.y), (c.i, c.j), strict=False)}
-            row |= {"status": c.status, "method": c.method, "why": c.why, "jump": c.jump, "switched": c.switched,
-                    "objective": c.objective}  # fmt: skip
+            row |= {
+                "status": c.status,
+                "method": c.method,
+                "why": c.why,
+                "jump": c.jump,
+                "switched": c.switched,
+                "objective": c.objective,
+            }
             row |= {k: c.params.get(k) for k in free}
             row |= {k: v for k, v in c.quantities.items() if k not in row}
             row["message"] = c.message
@@ -264,8 +314,13 @@ class Chart:
 
     def to_dict(self) -> dict:
         axis = lambda a: None if a is None else {"name": a.name, "values": list(a.values), "kind": a.kind}  # noqa: E731
-        return {"problem": self.problem.to_dict(), "x": axis(self.x), "y": axis(self.y), "stats": self.stats,
-                "cells": [c.to_dict() for c in self.cells]}  # fmt: skip
+        return {
+            "problem": self.problem.to_dict(),
+            "x": axis(self.x),
+            "y": axis(self.y),
+            "stats": self.stats,
+            "cells": [c.to_dict() for c in self.cells],
+        }
 
     def to_json(self, path) -> None:
         """The whole chart (every cell's Result) as strict JSON; ``Chart.from_json`` reads it back."""
@@ -482,16 +537,26 @@ def chart_figure(ch: Chart):
 
     names = ["objective", *ch.problem.free]
     xs, xlabel = _shown(ch.x, ch.problem)
-    note = ", ".join([f"{k} = {v:g}" for k, v in ch.problem.fixed.items() if k != getattr(ch.y, "name", "")
-                      and k in ch.problem.mechanism.LENGTHS and k != ch.x.name]
-                     + [f"{k} = {v:g}" for k, v in ch.problem.targets.items() if k not in (ch.x.name,
-                        getattr(ch.y, "name", "")) and k != "swing"])  # fmt: skip
+    note = ", ".join(
+        [
+            f"{k} = {v:g}"
+            for k, v in ch.problem.fixed.items()
+            if k != getattr(ch.y, "name", "") and k in ch.problem.mechanism.LENGTHS and k != ch.x.name
+        ]
+        + [
+            f"{k} = {v:g}"
+            for k, v in ch.problem.targets.items()
+            if k not in (ch.x.name, getattr(ch.y, "name", "")) and k != "swing"
+        ]
+    )
     title = f"{ch.problem.name or ch.problem.mechanism.__name__}: {ch.problem.mechanism.KIND}" + (
         f", {note}" if note else ""
     )
     s = ch.stats
-    how = (f"{s['cells']} cells: {s['continued']} continued, {s['full']} full solves ({s['needed']} needed), "
-           f"{s['no_design']} without a design, {s['jumps'] + s['switched']} branch changes")  # fmt: skip
+    how = (
+        f"{s['cells']} cells: {s['continued']} continued, {s['full']} full solves ({s['needed']} needed), "
+        f"{s['no_design']} without a design, {s['jumps'] + s['switched']} branch changes"
+    )
     if ch.y is None:
         fig, axes = plt.subplots(len(names), 1, figsize=(7, 2.2 * len(names)), sharex=True, squeeze=False)
         for ax, name in zip(axes[:, 0], names, strict=True):
@@ -548,9 +613,11 @@ def chart_figure(ch: Chart):
         ax.tick_params(labelsize=7)
     for ax in axes.flat[n:]:
         ax.set_visible(False)
-    fig.suptitle(f"{title}\n{how}\nx: no design, red ring: branch change"
-                 + ("; dashed: best " + ch.y.name + " for each " + ch.x.name if ridge is not None else ""),
-                 fontsize=9)  # fmt: skip
+    fig.suptitle(
+        f"{title}\n{how}\nx: no design, red ring: branch change"
+        + ("; dashed: best " + ch.y.name + " for each " + ch.x.name if ridge is not None else ""),
+        fontsize=9,
+    )
     fig.tight_layout()
     return fig
 

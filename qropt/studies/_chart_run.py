@@ -27,8 +27,9 @@ CHECK = 10  # the full solve also runs at the centre of every CHECK x CHECK bloc
 MAX_CELLS = 1_000_000
 
 
-def chart(problem: Problem, x, y=None, *, scheduler=None, workers=None, progress=True, solver=None,
-          tile=TILE, check=CHECK) -> Chart:  # fmt: skip
+def chart(
+    problem: Problem, x, y=None, *, scheduler=None, workers=None, progress=True, solver=None, tile=TILE, check=CHECK
+) -> Chart:
     """``problem`` solved at every cell of x (and y): each ``(name, values)``, the name a target of the problem
     (time_ratio, stroke, swing in rad) or one of its fixed parameters, at least 2 distinct monotone values.
 
@@ -60,10 +61,17 @@ def chart(problem: Problem, x, y=None, *, scheduler=None, workers=None, progress
                 problem_at(problem, [a], [v])
             except ProblemError as e:
                 raise ChartError(f"{a.name} = {v:g} on the chart's axis: {e}") from None
-    specs = [{"problem": problem.to_dict(), "x": [ax_x.name, list(ax_x.values)],
-              "y": None if ax_y is None else [ax_y.name, list(ax_y.values)],
-              "block": [i0, min(i0 + tile[0], nx), j0, min(j0 + tile[1], ny)], "check": check}
-             for j0 in range(0, ny, tile[1]) for i0 in range(0, nx, tile[0])]  # fmt: skip
+    specs = [
+        {
+            "problem": problem.to_dict(),
+            "x": [ax_x.name, list(ax_x.values)],
+            "y": None if ax_y is None else [ax_y.name, list(ax_y.values)],
+            "block": [i0, min(i0 + tile[0], nx), j0, min(j0 + tile[1], ny)],
+            "check": check,
+        }
+        for j0 in range(0, ny, tile[1])
+        for i0 in range(0, nx, tile[0])
+    ]
     t0 = time.perf_counter()
     bar = _bar(progress, nx * ny)
     try:
@@ -80,11 +88,20 @@ def chart(problem: Problem, x, y=None, *, scheduler=None, workers=None, progress
 
 def _stats(cells, seconds, tiles, where) -> dict:
     n = len(cells)
-    return {"cells": n, "certified": sum(c.success for c in cells), "no_design": sum(not c.success for c in cells),
-            "continued": sum(c.method == "continued" for c in cells), "full": sum(c.method == "full" for c in cells),
-            "needed": sum(c.needed_full for c in cells), "jumps": sum(c.jump for c in cells),
-            "switched": sum(c.switched for c in cells), "seconds": seconds, "cells_per_second": n / seconds,
-            "tiles": tiles, "scheduler": where}  # fmt: skip
+    return {
+        "cells": n,
+        "certified": sum(c.success for c in cells),
+        "no_design": sum(not c.success for c in cells),
+        "continued": sum(c.method == "continued" for c in cells),
+        "full": sum(c.method == "full" for c in cells),
+        "needed": sum(c.needed_full for c in cells),
+        "jumps": sum(c.jump for c in cells),
+        "switched": sum(c.switched for c in cells),
+        "seconds": seconds,
+        "cells_per_second": n / seconds,
+        "tiles": tiles,
+        "scheduler": where,
+    }
 
 
 def _axis(problem, spec, which) -> Axis:
@@ -92,8 +109,9 @@ def _axis(problem, spec, which) -> Axis:
         raise ChartError(f"{which} is (name, values), got {spec!r}")
     name, values = spec
     if name in problem.free:
-        raise ChartError(f"{name!r} is free in the problem: a chart axis is a target or a fixed parameter "
-                         f"(fix {name} to chart it)")  # fmt: skip
+        raise ChartError(
+            f"{name!r} is free in the problem: a chart axis is a target or a fixed parameter (fix {name} to chart it)"
+        )
     names = list(problem.targets) + list(problem.fixed)
     if name not in names:
         raise ChartError(f"unknown chart axis {name!r}; this problem's targets and fixed parameters: {names}")

@@ -85,8 +85,7 @@ class _Tile:
         if a.objective is None or b.objective is None:
             return False
         tol = BETTER * max(1.0, abs(b.objective))
-        return better(self.problem, a.objective, b.objective + (tol if maximises(self.problem.objective)
-                                                                 else -tol))  # fmt: skip
+        return better(self.problem, a.objective, b.objective + (tol if maximises(self.problem.objective) else -tol))
 
     def full(self, problem) -> Result:
         """The default solve; a cell it cannot give a design is explained (a closed form that gives every design
@@ -98,8 +97,9 @@ class _Tile:
         t0 = time.perf_counter()
         problem = self.at(ij)
         if starts.plan(problem).kind == "enumeration":  # a closed form gives every solution: nothing to continue
-            self.cells[ij] = Cell.of(*ij, self.full(problem), "full", why="closed form",
-                                     seconds=time.perf_counter() - t0)  # fmt: skip
+            self.cells[ij] = Cell.of(
+                *ij, self.full(problem), "full", why="closed form", seconds=time.perf_counter() - t0
+            )
             return
         src = self.source(ij)
         warm = self.warm(problem, self.cells[src]) if src else None
@@ -117,8 +117,9 @@ class _Tile:
         keep_warm = warm is not None and self.beats(warm, full)
         switched = warm is not None and warm.success and self.beats(full, warm)
         kept, method = (warm, "continued") if keep_warm else (full, "full")
-        self.cells[ij] = Cell.of(*ij, kept, method, why=why, source=src, jump=jump, switched=switched,
-                                 seconds=time.perf_counter() - t0)  # fmt: skip
+        self.cells[ij] = Cell.of(
+            *ij, kept, method, why=why, source=src, jump=jump, switched=switched, seconds=time.perf_counter() - t0
+        )
         if self.cells[ij].success and (switched or why in ("no certified neighbour", "warm start failed", "jump")):
             self.spread(ij)
 
@@ -134,8 +135,9 @@ class _Tile:
                 t0 = time.perf_counter()
                 r = self.warm(self.at(v), self.cells[u])
                 if self.beats(r, old.result):
-                    self.cells[v] = Cell.of(*v, r, "continued", source=u, switched=True,
-                                            seconds=old.seconds + time.perf_counter() - t0)  # fmt: skip
+                    self.cells[v] = Cell.of(
+                        *v, r, "continued", source=u, switched=True, seconds=old.seconds + time.perf_counter() - t0
+                    )
                     queue.append(v)
 
     def jumped(self, ij, src, r: Result) -> bool:
@@ -155,8 +157,10 @@ class _Tile:
         mid = self.warm(self.at(ij, towards=src), self.cells[src])
         if not mid.success:
             return True
-        halves = _distance(self.problem, mid.params, self.cells[src].params), _distance(self.problem, r.params,
-                                                                                       mid.params)  # fmt: skip
+        halves = (
+            _distance(self.problem, mid.params, self.cells[src].params),
+            _distance(self.problem, r.params, mid.params),
+        )
         return max(halves) > 0.75 * step
 
 

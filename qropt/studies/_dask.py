@@ -75,8 +75,13 @@ def _client(mode: str, workers: int | None):
         cluster = client = None
         try:
             with dask.config.set(LOCAL_CONFIG):
-                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                                       silence_logs=logging.ERROR)  # fmt: skip
+                cluster = LocalCluster(
+                    n_workers=n,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=":0",
+                    silence_logs=logging.ERROR,
+                )
             client = Client(cluster)
         except Exception as e:  # noqa: BLE001 - no ports, processes or memory: one line naming the cause
             for started in (client, cluster):
@@ -94,8 +99,9 @@ def _client(mode: str, workers: int | None):
         client = Client(mode, timeout=CONNECT_TIMEOUT)
     except (OSError, TimeoutError, ValueError, TypeError) as e:
         first = str(e).splitlines()[0] if str(e) else ""
-        raise ChartError(f"cannot reach the Dask scheduler at {mode!r} within {CONNECT_TIMEOUT} s "
-                         f"({type(e).__name__}: {first})") from None  # fmt: skip
+        raise ChartError(
+            f"cannot reach the Dask scheduler at {mode!r} within {CONNECT_TIMEOUT} s ({type(e).__name__}: {first})"
+        ) from None
     with client:
         yield client, f"Dask cluster at {mode} ({len(client.scheduler_info().get('workers', {}))} workers)"
 

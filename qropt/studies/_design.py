@@ -33,9 +33,18 @@ TYPES = {
 }
 
 
-def type_problem(kind: str, time_ratio: float, stroke: float, *, objective="max_gamma_min", bounds=None,
-                 conditions=None, omega2: float = 1.0, size: str = "footprint",
-                 units: str = units_.DEFAULT) -> Problem:  # fmt: skip
+def type_problem(
+    kind: str,
+    time_ratio: float,
+    stroke: float,
+    *,
+    objective="max_gamma_min",
+    bounds=None,
+    conditions=None,
+    omega2: float = 1.0,
+    size: str = "footprint",
+    units: str = units_.DEFAULT,
+) -> Problem:
     """The task as a Problem of one type: default bounds scaled by the stroke, ``bounds`` (name -> (lo, hi))
     overriding those the type has, ``conditions`` added to the type's own; lengths in ``units``."""
     if not isinstance(kind, str) or kind not in TYPES:
@@ -46,9 +55,18 @@ def type_problem(kind: str, time_ratio: float, stroke: float, *, objective="max_
     for k, b in (bounds or {}).items():
         if k in free:
             free[k] = b
-    return Problem(mechanism=mech, fixed=fixed, free=free, targets={"time_ratio": time_ratio, "stroke": stroke},
-                   conditions=dict(conditions or {}), objective=objective, omega2=omega2, size=size,
-                   name=f"{kind} TR {time_ratio:g} stroke {stroke:g} {units}", units=units)  # fmt: skip
+    return Problem(
+        mechanism=mech,
+        fixed=fixed,
+        free=free,
+        targets={"time_ratio": time_ratio, "stroke": stroke},
+        conditions=dict(conditions or {}),
+        objective=objective,
+        omega2=omega2,
+        size=size,
+        name=f"{kind} TR {time_ratio:g} stroke {stroke:g} {units}",
+        units=units,
+    )
 
 
 @dataclass(frozen=True)
@@ -93,10 +111,12 @@ class Comparison:
         for r in self.rows:
             if r.success:
                 c = r.criteria
-                lines.append(f"  {r.type:20s} gamma_min {math.degrees(c['gamma_min']):6.2f} deg  footprint "
-                             f"{c['footprint']:.4g} {u['footprint']}  peak accel {c['peak_accel']:.4g} "
-                             f"{u['peak_accel']}  peak velocity {c['peak_velocity']:.4g} "
-                             f"{u['peak_velocity']}")  # fmt: skip
+                lines.append(
+                    f"  {r.type:20s} gamma_min {math.degrees(c['gamma_min']):6.2f} deg  footprint "
+                    f"{c['footprint']:.4g} {u['footprint']}  peak accel {c['peak_accel']:.4g} "
+                    f"{u['peak_accel']}  peak velocity {c['peak_velocity']:.4g} "
+                    f"{u['peak_velocity']}"
+                )
             else:
                 lines.append(f"  {r.type:20s} no design: {r.reason}")
         return "\n".join(lines)
@@ -107,9 +127,14 @@ class Comparison:
 
     def to_json(self) -> str:
         """The comparison as JSON; "units" names each criterion's unit, "length" the length unit."""
-        d = {"time_ratio": self.time_ratio, "stroke": self.stroke, "objective": self.objective,
-             "omega2": self.omega2, "units": {"length": self.units, **criteria.units(self.units)},
-             "rows": self.table()}  # fmt: skip
+        d = {
+            "time_ratio": self.time_ratio,
+            "stroke": self.stroke,
+            "objective": self.objective,
+            "omega2": self.omega2,
+            "units": {"length": self.units, **criteria.units(self.units)},
+            "rows": self.table(),
+        }
         return json.dumps(json_safe(d), indent=2, allow_nan=False)
 
     def to_csv(self, path) -> None:
@@ -120,8 +145,17 @@ class Comparison:
             w = csv.writer(fh)
             w.writerow(["type", "status", "objective", *columns(), *names, "reason", "units"])
             for r in rows:
-                w.writerow([r["type"], r["status"], _cell(r["objective"]), *(_cell(r[k]) for k in columns()),
-                            *(_cell(r["params"].get(k)) for k in names), r["reason"], self.units])  # fmt: skip
+                w.writerow(
+                    [
+                        r["type"],
+                        r["status"],
+                        _cell(r["objective"]),
+                        *(_cell(r[k]) for k in columns()),
+                        *(_cell(r["params"].get(k)) for k in names),
+                        r["reason"],
+                        self.units,
+                    ]
+                )
 
     def plot(self, path) -> None:
         """The designs side by side at one scale, each with its numbers (and the fronts, if computed)."""
@@ -130,9 +164,22 @@ class Comparison:
         save(comparison_figure(self), path)
 
 
-def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min", types=None, bounds=None,
-           conditions=None, omega2: float = 1.0, size: str = "footprint", pareto=None, n: int = 12,
-           solver=None, progress=None, units: str = units_.DEFAULT) -> Comparison:  # fmt: skip
+def design(
+    time_ratio: float,
+    stroke: float,
+    *,
+    objective: str = "max_gamma_min",
+    types=None,
+    bounds=None,
+    conditions=None,
+    omega2: float = 1.0,
+    size: str = "footprint",
+    pareto=None,
+    n: int = 12,
+    solver=None,
+    progress=None,
+    units: str = units_.DEFAULT,
+) -> Comparison:
     """Solve the task (TR, stroke) for every type (or ``types``) and compare; see the module docstring.
 
     objective: as Problem.objective; conditions: bound conditions for every type (e.g. {'gamma_min': 0.7});
@@ -167,9 +214,20 @@ def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min"
     unknown = sorted(set(bounds or {}) - known, key=str)
     if unknown:
         raise ProblemError(f"bounds name {unknown}, which no type of {types} has (they have {sorted(known)})")
-    problems = {kind: type_problem(kind, time_ratio, stroke, objective=objective, bounds=bounds,
-                                   conditions=conditions, omega2=omega2, size=size, units=units)
-                for kind in types}  # fmt: skip
+    problems = {
+        kind: type_problem(
+            kind,
+            time_ratio,
+            stroke,
+            objective=objective,
+            bounds=bounds,
+            conditions=conditions,
+            omega2=omega2,
+            size=size,
+            units=units,
+        )
+        for kind in types
+    }
     if pareto is not None:
         from qropt.studies._pareto import _check
 
@@ -201,8 +259,9 @@ def design(time_ratio: float, stroke: float, *, objective: str = "max_gamma_min"
 def _row(kind, problem, r: Result) -> Row:
     if r.status not in SOLUTION_PRESENT:
         return Row(kind, r, {}, r.message)
-    values = {name: c.value(problem, r.mechanism) for name, c in criteria.CRITERIA.items()
-              if c.applies(problem.mechanism)}  # fmt: skip
+    values = {
+        name: c.value(problem, r.mechanism) for name, c in criteria.CRITERIA.items() if c.applies(problem.mechanism)
+    }
     values["torque_per_newton"] = r.quantities["torque_per_newton"]
     return Row(kind, r, {k: values.get(k) for k in columns()}, "")
 

@@ -192,8 +192,17 @@ class _Curve:
         return None
 
 
-def family(problem: Problem, along: str | None = None, *, ds: float | None = None, max_points: int = 5000,
-           starts_n: int = 8, seed: int = 0, progress=None, solver: Solver | None = None) -> Family:  # fmt: skip
+def family(
+    problem: Problem,
+    along: str | None = None,
+    *,
+    ds: float | None = None,
+    max_points: int = 5000,
+    starts_n: int = 8,
+    seed: int = 0,
+    progress=None,
+    solver: Solver | None = None,
+) -> Family:
     """Trace every branch of a one-parameter family of designs.
 
     along: the parameter in which folds are counted (default: the first free one); ds: the largest
@@ -228,8 +237,10 @@ def family(problem: Problem, along: str | None = None, *, ds: float | None = Non
     diagonal = float(np.linalg.norm(box))
     least = max(MIN_DS * diagonal, 1e-12 * max(abs(b) for bounds in problem.free.values() for b in bounds))
     if ds is not None and ds < least:
-        raise ProblemError(f"ds = {ds:g} is below {least:.3g} {problem.units} (MIN_DS = {MIN_DS:g} of the free "
-                           "box's diagonal, and 1e-12 of its largest bound): its points would not differ")  # fmt: skip
+        raise ProblemError(
+            f"ds = {ds:g} is below {least:.3g} {problem.units} (MIN_DS = {MIN_DS:g} of the free "
+            "box's diagonal, and 1e-12 of its largest bound): its points would not differ"
+        )
     ds_max = ds or diagonal / 200
     traced, ends, folds, n_points = [], [], [], 0
     seeds = list(starts_.plan(problem).analytic) + starts_.sobol(problem, starts_n, seed)
@@ -251,15 +262,21 @@ def family(problem: Problem, along: str | None = None, *, ds: float | None = Non
                 continue
             b = len(traced)
             traced.append((curve, br, us))
-            ends += [End(b, 0, end0, _params(problem, curve, us[0], br)),
-                     End(b, 1, end1, _params(problem, curve, us[-1], br))]  # fmt: skip
+            ends += [
+                End(b, 0, end0, _params(problem, curve, us[0], br)),
+                End(b, 1, end1, _params(problem, curve, us[-1], br)),
+            ]
             n_points += len(us)
     out = []
     for curve, br, us in traced:
         s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(np.array(us), axis=0), axis=1))])
         res = [float(np.max(np.abs(curve.eval_fj(u)[0]))) for u in us]
-        out.append([FamilyPoint(problem, _params(problem, curve, u, br), (u[-2], u[-1]), float(a), r)
-                    for u, a, r in zip(us, s, res, strict=True)])  # fmt: skip
+        out.append(
+            [
+                FamilyPoint(problem, _params(problem, curve, u, br), (u[-2], u[-1]), float(a), r)
+                for u, a, r in zip(us, s, res, strict=True)
+            ]
+        )
     fold_params = [_params(problem, c, u, br) for c, br, u in folds]
     return Family(problem, along, out, ends, fold_params, {"points": n_points, "branches": len(out)})
 
@@ -331,8 +348,12 @@ def _trace(curve, u0, direction, ds_max, max_points, ia, progress):
             def edge(x, g, jj, row=row, target=target):
                 val = g[row] - target
                 eps = 1e-7
-                grad = np.array([(curve.eval(x + eps * e)[2][row] - curve.eval(x - eps * e)[2][row]) / (2 * eps)
-                                 for e in np.eye(curve.n)])  # fmt: skip
+                grad = np.array(
+                    [
+                        (curve.eval(x + eps * e)[2][row] - curve.eval(x - eps * e)[2][row]) / (2 * eps)
+                        for e in np.eye(curve.n)
+                    ]
+                )
                 return val, grad
 
             hit = curve.correct(u, t, u, extra=edge)

@@ -37,8 +37,10 @@ class Front:
     def __repr__(self):
         a, b = self.criteria
         ua, ub = (named(criteria.CRITERIA[q].unit, self.problem.units) for q in (a, b))
-        lines = [f"Front({self.objectives[0]} vs {self.objectives[1]}: {len(self.points)} points, "
-                 f"{len(self.removed)} removed)"]  # fmt: skip
+        lines = [
+            f"Front({self.objectives[0]} vs {self.objectives[1]}: {len(self.points)} points, "
+            f"{len(self.removed)} removed)"
+        ]
         for va, vb in self.values[:6]:
             lines.append(f"  {a} {va:.6g} {ua}  {b} {vb:.6g} {ub}")
         if len(self.values) > 6:
@@ -47,8 +49,9 @@ class Front:
 
     def table(self) -> list[dict]:
         a, b = self.criteria
-        return [{a: va, b: vb, "status": r.status, **r.params} for r, (va, vb) in zip(self.points, self.values,
-                                                                                        strict=True)]  # fmt: skip
+        return [
+            {a: va, b: vb, "status": r.status, **r.params} for r, (va, vb) in zip(self.points, self.values, strict=True)
+        ]
 
     def to_csv(self, path) -> None:
         rows = self.table()
@@ -66,8 +69,9 @@ class Front:
         save(front_figure(self), path)
 
 
-def pareto(problem: Problem, objectives=("max_gamma_min", "min_peak_accel"), n: int = 20, *, solver=None,
-           progress=None) -> Front:  # fmt: skip
+def pareto(
+    problem: Problem, objectives=("max_gamma_min", "min_peak_accel"), n: int = 20, *, solver=None, progress=None
+) -> Front:
     """The trade-off front between two objectives of ``problem`` (its own objective is replaced); see the
     module docstring. n: sweep points including the two ends (>= 2)."""
     from qropt.synthesis.solver import DEFAULT
@@ -131,11 +135,14 @@ def _front(problem, objectives, names, runs) -> Front:
         pts.append((eps, r, (_value(problem, names[0], r), _value(problem, names[1], r))))
     keep = []
     for i, (eps, r, (va, vb)) in enumerate(pts):
-        by = next((j for j, (_, _, (wa, wb)) in enumerate(pts) if j != i and _dominates(sa * wa, sb * wb, sa * va,
-                                                                                        sb * vb)), None)  # fmt: skip
+        by = next(
+            (j for j, (_, _, (wa, wb)) in enumerate(pts) if j != i and _dominates(sa * wa, sb * wb, sa * va, sb * vb)),
+            None,
+        )
         if by is not None:
-            removed.append((eps, f"dominated by the point with {names[0]} {pts[by][2][0]:.6g}, {names[1]} "
-                                 f"{pts[by][2][1]:.6g}"))  # fmt: skip
+            removed.append(
+                (eps, f"dominated by the point with {names[0]} {pts[by][2][0]:.6g}, {names[1]} {pts[by][2][1]:.6g}")
+            )
         elif (
             keep
             and abs(keep[-1][2][0] - va) <= 1e-9 * max(1, abs(va))
@@ -144,8 +151,14 @@ def _front(problem, objectives, names, runs) -> Front:
             removed.append((eps, "the same design as its neighbour"))
         else:
             keep.append((eps, r, (va, vb)))
-    return Front(problem, tuple(objectives), tuple(names), tuple(r for _, r, _ in keep),
-                 tuple(v for _, _, v in keep), tuple(removed))  # fmt: skip
+    return Front(
+        problem,
+        tuple(objectives),
+        tuple(names),
+        tuple(r for _, r, _ in keep),
+        tuple(v for _, _, v in keep),
+        tuple(removed),
+    )
 
 
 def _dominates(a1, b1, a2, b2, tol=1e-9) -> bool:

@@ -136,8 +136,10 @@ class Reachable:
             )
         cands.sort(key=lambda c: -c[1])
         (x0, x1), g, (a, b) = cands[0]
-        why = (f"{self.free} from {x0:.6g} to {x1:.6g} covers TR {tr_low:g}..{tr_high:g} once, on the branch "
-               f"{a:.6g}..{b:.6g} where TR is monotone; its worst gamma_min is {math.degrees(g):.2f} deg")  # fmt: skip
+        why = (
+            f"{self.free} from {x0:.6g} to {x1:.6g} covers TR {tr_low:g}..{tr_high:g} once, on the branch "
+            f"{a:.6g}..{b:.6g} where TR is monotone; its worst gamma_min is {math.degrees(g):.2f} deg"
+        )
         if len(cands) > 1:
             why += "; the other branch(es) " + ", ".join(
                 f"{c[0][0]:.6g}..{c[0][1]:.6g} (worst gamma_min {math.degrees(c[1]):.2f} deg)" for c in cands[1:]
@@ -227,8 +229,9 @@ def _edge(base, free, good, bad):
     return good
 
 
-def reachable(mechanism: Mechanism, free: str = "r3", bounds: tuple | None = None, n: int = 301,
-              progress=None) -> Reachable:  # fmt: skip
+def reachable(
+    mechanism: Mechanism, free: str = "r3", bounds: tuple | None = None, n: int = 301, progress=None
+) -> Reachable:
     """TR and stroke reachable by varying ``free`` (the mechanism supplies the other parameters).
 
     bounds: the parameter's interval (cut to where the type's rules hold: no value works outside; at most SPAN

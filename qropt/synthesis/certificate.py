@@ -46,13 +46,15 @@ class Certificate:
         def num(v):
             return isinstance(v, (int, float)) and not isinstance(v, bool)
 
-        checks = {"exact": (lambda v: isinstance(v, bool), "true or false"),
-                  "nlp": (lambda v: v is None or num(v), "null or a number"),
-                  "certified": (lambda v: v is None or num(v), "null or a number"),
-                  "gap": (num, "a number"),
-                  "rounds": (lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0, "a count"),
-                  "local": (lambda v: isinstance(v, str), "a string"),
-                  "global_claim": (lambda v: isinstance(v, str), "a string")}  # fmt: skip
+        checks = {
+            "exact": (lambda v: isinstance(v, bool), "true or false"),
+            "nlp": (lambda v: v is None or num(v), "null or a number"),
+            "certified": (lambda v: v is None or num(v), "null or a number"),
+            "gap": (num, "a number"),
+            "rounds": (lambda v: isinstance(v, int) and not isinstance(v, bool) and v >= 0, "a count"),
+            "local": (lambda v: isinstance(v, str), "a string"),
+            "global_claim": (lambda v: isinstance(v, str), "a string"),
+        }
         if not isinstance(d, dict) or set(d) - set(checks) or set(checks) - {"global_claim"} - set(d):
             raise ProblemError(f"a certificate is a table of {list(checks)}, got {d!r:.80}")
         for k, v in d.items():

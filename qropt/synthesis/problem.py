@@ -216,8 +216,12 @@ class Problem:
                 raise self._err(f"{self.mechanism.__name__} has no slider: {k} does not apply")
         linear = []
         for row in c.get("linear", ()):
-            if not (isinstance(row, (list, tuple)) and len(row) == 3 and isinstance(row[0], Mapping)
-                    and all(finite(v) for v in (*row[0].values(), row[1], row[2]))):  # fmt: skip
+            if not (
+                isinstance(row, (list, tuple))
+                and len(row) == 3
+                and isinstance(row[0], Mapping)
+                and all(finite(v) for v in (*row[0].values(), row[1], row[2]))
+            ):
                 raise self._err(f"a linear condition is (coefficients dict, lower, upper) of numbers, got {row!r}")
             coeffs, lo, hi = dict(row[0]), float(row[1]), float(row[2])
             self._check_names(coeffs)
@@ -226,8 +230,12 @@ class Problem:
             linear.append((coeffs, lo, hi))
         ratio = []
         for row in c.get("ratio", ()):
-            if not (isinstance(row, (list, tuple)) and len(row) == 4 and all(isinstance(v, str) for v in row[:2])
-                    and all(finite(v) for v in row[2:])):  # fmt: skip
+            if not (
+                isinstance(row, (list, tuple))
+                and len(row) == 4
+                and all(isinstance(v, str) for v in row[:2])
+                and all(finite(v) for v in row[2:])
+            ):
                 raise self._err(f"a ratio condition is (numerator, denominator, lower, upper), got {row!r}")
             num, den, lo, hi = row[0], row[1], float(row[2]), float(row[3])
             self._check_names({num: 1, den: 1})

@@ -161,28 +161,32 @@ class Result:
             obj = "" if c.certified is None else f"objective {c.certified:.12g}"
             if c.nlp is not None:
                 obj += f" (NLP {c.nlp:.12g}, gap {c.gap:.2e})"
-            lines.append(f"certificate: {obj + ', ' if obj else ''}max violation {self.max_violation:.2e}, "
-                         f"{c.rounds} exchange round(s); {c.global_claim}")  # fmt: skip
+            lines.append(
+                f"certificate: {obj + ', ' if obj else ''}max violation {self.max_violation:.2e}, "
+                f"{c.rounds} exchange round(s); {c.global_claim}"
+            )
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
         """Strict-JSON dictionary (no NaN: None); the mechanism as its type kind and parameters."""
-        return json_safe({
-            "units": unit_names(self.units),
-            "status": self.status,
-            "success": self.success,
-            "message": self.message,
-            "type": getattr(self.mechanism, "KIND", None),
-            "params": dict(self.params),
-            "objective": self.objective,
-            "quantities": self.quantities,
-            "residuals": self.residuals,
-            "max_violation": self.max_violation,
-            "certificate": self.certificate.to_dict() if self.certificate is not None else None,
-            "stats": self.stats,
-            "reachable": {k: list(v) for k, v in self.reachable.items()},
-            "local_optima": [r.to_dict() for r in self.local_optima],
-        })  # fmt: skip
+        return json_safe(
+            {
+                "units": unit_names(self.units),
+                "status": self.status,
+                "success": self.success,
+                "message": self.message,
+                "type": getattr(self.mechanism, "KIND", None),
+                "params": dict(self.params),
+                "objective": self.objective,
+                "quantities": self.quantities,
+                "residuals": self.residuals,
+                "max_violation": self.max_violation,
+                "certificate": self.certificate.to_dict() if self.certificate is not None else None,
+                "stats": self.stats,
+                "reachable": {k: list(v) for k, v in self.reachable.items()},
+                "local_optima": [r.to_dict() for r in self.local_optima],
+            }
+        )
 
     @classmethod
     def from_dict(cls, d, _depth: int = 0) -> Result:
@@ -228,8 +232,12 @@ class Result:
         residuals = need("residuals", lambda v: numbers(v, none=True), "a table of numbers", {})
         cert = need("certificate", lambda v: v is None or isinstance(v, Mapping), "null or a table")
         stats = need("stats", lambda v: isinstance(v, Mapping), "a table", {})
-        reach = need("reachable", lambda v: isinstance(v, Mapping) and all(map(pair, v.values())),
-                     "a table of [low, high] pairs", {})  # fmt: skip
+        reach = need(
+            "reachable",
+            lambda v: isinstance(v, Mapping) and all(map(pair, v.values())),
+            "a table of [low, high] pairs",
+            {},
+        )
         local = need("local_optima", lambda v: isinstance(v, (list, tuple)), "a list of Result tables", [])
         unit = d.get("units")
         if isinstance(unit, Mapping):  # to_dict's table names its length unit; older files: the default
