@@ -224,6 +224,13 @@ class Mechanism:
             REGISTRY[cls.KIND] = cls
 
     @classmethod
+    def warm_starts(cls, problem):
+        """Starting designs for a synthesis problem of this type (override): a ``WarmStarts`` of
+        ``qropt.synthesis.analytic`` (free-parameter dicts, their kind and how they were found), or None for the
+        closed forms registered for the type's kind (the shipped types') and otherwise a multi-start."""
+        return None
+
+    @classmethod
     def completed(cls, params: dict) -> dict:
         """Defaults that depend on which parameters are given (override; e.g. a rod's slide line at h = 0)."""
         return {}

@@ -338,37 +338,52 @@ FAMILY_POINTS = 17  # closed-form family points scanned when a family holds ever
 
 
 def warm_starts(problem) -> WarmStarts:
-    """Starts from every closed form that applies to a problem (other free parameters at mid-bounds).
+    """Starts from every closed form that applies to a problem (other free parameters at mid-bounds): the type's
+    own ``warm_starts`` hook where it has one, else the closed forms registered for its kind (``CLOSED_FORMS``).
 
     Each start is verified later by the solver; a start that does not build is dropped there.
     """
-    from qropt.mechanisms import (
-        CrankRockerSlider,
-        CrankShaper,
-        DragLinkSlider,
-        FourBar,
-        FourBarSlider,
-        SliderCrank,
-        Whitworth,
-    )
+    own = problem.mechanism.warm_starts(problem)
+    if own is not None:
+        return own
+    c = _Context(problem)
+    for closed_form in CLOSED_FORMS.get(problem.mechanism.KIND, ()):
+        w = closed_form(c)
+        if w is not None:
+            return w
+    return c.result("none", "")
 
-    cls, fixed, free, tg = problem.mechanism, problem.fixed, problem.free, problem.targets
-    val = {**fixed, **{k: 0.5 * (lo + hi) for k, (lo, hi) in free.items()}}
-    tr, stroke = tg.get("time_ratio"), tg.get("stroke")
-    square = len(free) == len(tg)
-    out = []
 
-    def emit(**set_):
-        if all(k in free for k in set_):
-            v = {**val, **set_}
-            out.append({k: v[k] for k in free})
+class _Context:
+    """What every closed form reads of a problem: fixed values, free bounds (others at mid-bounds), targets;
+    ``emit`` adds a start (its free values), ``result`` closes the starts with their kind."""
 
-    def result(kind, how):
+    def __init__(self, problem):
+        self.fixed, self.free, self.tg = problem.fixed, problem.free, problem.targets
+        self.val = {**self.fixed, **{k: 0.5 * (lo + hi) for k, (lo, hi) in self.free.items()}}
+        self.tr, self.stroke = self.tg.get("time_ratio"), self.tg.get("stroke")
+        self.square = len(self.free) == len(self.tg)
+        self.kind = problem.mechanism.CLASS  # the four-bar's Grashof class, if the type has one
+        self.out = []
+
+    def emit(self, **set_):
+        if all(k in self.free for k in set_):
+            v = {**self.val, **set_}
+            self.out.append({k: v[k] for k in self.free})
+
+    def result(self, kind, how):
         if kind == "enumeration":  # complete: no point is a proof that no design exists
-            return WarmStarts(out, kind, how)
-        return WarmStarts(out, kind if out else "none", how if out else "no closed form applies")
+            return WarmStarts(self.out, kind, how)
+        return WarmStarts(self.out, kind if self.out else "none", how if self.out else "no closed form applies")
 
-    if cls is CrankRockerSlider and set(free) == {"r3", "r4", "r5"} and fixed.get("h", 0.0) == 0.0 and tr and stroke:
+    def names(self):
+        return self.fixed, self.free, self.tg, self.val, self.tr, self.stroke, self.square, self.emit, self.result
+
+
+def _crank_rocker_slider(c: _Context):
+    """The rocker's TR gives r3 and the stroke r5 for each r4 (slide line through the pivots)."""
+    fixed, free, tg, val, tr, stroke, square, emit, result = c.names()
+    if set(free) == {"r3", "r4", "r5"} and fixed.get("h", 0.0) == 0.0 and tr and stroke:
         for k in (0, 1):  # each root of the rocker's TR in r3 is a branch of the family; r4 walks it
             for r4 in np.linspace(*free["r4"], FAMILY_POINTS):
                 roots = crank_rocker_r3(tr, val["r1"], val["r2"], float(r4))
@@ -377,8 +392,14 @@ def warm_starts(problem) -> WarmStarts:
                         emit(r3=roots[k], r4=float(r4), r5=r5)
         how = "the rocker's TR gives r3 and the stroke r5 for each r4 (slide line through the pivots); r4 walks it"
         return result("family", how)
+    return None
+
+
+def _drag_link_slider(c: _Context):
+    """Eqs. (7)-(13): every r3 for the TR; r5 = stroke/2."""
+    fixed, free, tg, val, tr, stroke, square, emit, result = c.names()
     lifted = {"r2", "r4", "r5"} <= set(free)  # every link of the four-bar and the arm free: the generic starts
-    if cls is DragLinkSlider and tr is not None and "r3" in free and fixed.get("h", 0.0) == 0.0 and not lifted:
+    if tr is not None and "r3" in free and fixed.get("h", 0.0) == 0.0 and not lifted:
         r5 = {"r5": stroke / 2} if stroke is not None and "r5" in free else {}
         for s in drag_link_r3(tr, val["r1"], val["r2"], val["r4"]):
             emit(r3=s.r3, **r5)
@@ -387,10 +408,16 @@ def warm_starts(problem) -> WarmStarts:
         if exact:
             lo, hi = free.get("r3", (val["r3"], val["r3"]))
             return WarmStarts(
-                out, "enumeration", how, {"time_ratio": drag_link_tr_range(val["r1"], val["r2"], val["r4"], lo, hi)}
+                c.out, "enumeration", how, {"time_ratio": drag_link_tr_range(val["r1"], val["r2"], val["r4"], lo, hi)}
             )
         return result("partial", how)
-    if cls is CrankShaper and tr is not None:
+    return None
+
+
+def _crank_shaper(c: _Context):
+    """sin(beta) = r2/r1 fixes the TR; stroke = 2 r4 r2/r1."""
+    fixed, free, tg, val, tr, stroke, square, emit, result = c.names()
+    if tr is not None:
         ratio = crank_shaper_ratio(tr)
         lever = {"r4": stroke / (2 * ratio)} if stroke is not None and "r4" in free else {}
         yoke = "r6" not in fixed and "r6" not in free
@@ -418,7 +445,13 @@ def warm_starts(problem) -> WarmStarts:
             emit(r4=stroke * val["r1"] / (2 * val["r2"]))
         exact = square and "r6" not in fixed and "r6" not in free
         return result("enumeration" if exact else "partial", "sin(beta) = r2/r1 fixes the TR; stroke = 2 r4 r2/r1")
-    if cls is Whitworth and tr is not None and fixed.get("h", 0.0) == 0.0:
+    return None
+
+
+def _whitworth(c: _Context):
+    """sin(beta) = r1/r2 fixes the TR; stroke = 2 r5."""
+    fixed, free, tg, val, tr, stroke, square, emit, result = c.names()
+    if tr is not None and fixed.get("h", 0.0) == 0.0:
         ratio = whitworth_ratio(tr)
         r5 = {"r5": stroke / 2} if stroke is not None and "r5" in free else {}
         rod = "r6" in free and "r5" in free and not square
@@ -437,7 +470,13 @@ def warm_starts(problem) -> WarmStarts:
         if rod and len(free) == len(tg) + 1 and stroke is not None:
             return result("family", how + "; the rod r6 walks the family")
         return result("partial", how)
-    if cls is SliderCrank and tr is not None and stroke is not None:
+    return None
+
+
+def _slider_crank(c: _Context):
+    """The stroke triangle gives r3 and e for each r2."""
+    fixed, free, tg, val, tr, stroke, square, emit, result = c.names()
+    if tr is not None and stroke is not None:
         family = "r2" in free and len(free) == 3
         crank = [val["r2"]] if "r2" not in free else list(np.geomspace(*free["r2"], FAMILY_POINTS if family else 7))
         for r2 in crank:
@@ -447,7 +486,13 @@ def warm_starts(problem) -> WarmStarts:
         if square and set(free) == {"r3", "e"}:
             return result("enumeration", how)
         return result("family" if family else "partial", how + "; r2 walks the family")
-    if cls is FourBar and tr is not None and "swing" in tg:
+    return None
+
+
+def _four_bar(c: _Context):
+    """The classical crank-rocker construction."""
+    fixed, free, tg, val, tr, stroke, square, emit, result = c.names()
+    if tr is not None and "swing" in tg:
         family = set(free) == {"r2", "r3", "r4"}
         for pos in np.linspace(0.01, 0.49, FAMILY_POINTS) if family else np.linspace(0.04, 0.46, 7):
             d = crank_rocker_design(tr, tg["swing"], val["r1"], float(pos))
@@ -455,12 +500,13 @@ def warm_starts(problem) -> WarmStarts:
                 emit(**{k: getattr(d, k) for k in ("r2", "r3", "r4") if k in free})
         how = "the classical crank-rocker construction (O2 on the circle that sees the rocker chord under phi)"
         return result("family" if family else "partial", how)
-    if (
-        issubclass(cls, FourBarSlider)
-        and tr is not None
-        and stroke is not None
-        and {"r2", "r3", "r4", "r5"} <= set(free)
-    ):
+    return None
+
+
+def _four_bar_slider(c: _Context):
+    """Generic starts for a four-bar-driven slider with every link free."""
+    fixed, free, tg, val, tr, stroke, square, emit, result = c.names()
+    if tr is not None and stroke is not None and {"r2", "r3", "r4", "r5"} <= set(free):
         # the four-bar from its closed form, the slide line through the pivots (h = 0), the output arm r5 sized
         # for the stroke and a rod twice as long: starts near the targets for every other free parameter
         r1 = stroke if "r1" in free else val["r1"]
@@ -468,7 +514,7 @@ def warm_starts(problem) -> WarmStarts:
         def emit_free(**design):  # the fixed parameters keep their values
             emit(**{k: x for k, x in design.items() if k in free})
 
-        if cls is DragLinkSlider:
+        if c.kind == "drag-link":
             for k2, k4 in ((2.0, 2.5), (3.0, 3.5), (2.5, 4.0)):
                 for d in drag_link_r3(tr, r1, k2 * r1, k4 * r1):
                     emit_free(r1=r1, r2=k2 * r1, r3=d.r3, r4=k4 * r1, r5=stroke / 2, r6=stroke, h=0.0)
@@ -482,4 +528,14 @@ def warm_starts(problem) -> WarmStarts:
                         emit_free(r1=r1, r2=d.r2, r3=d.r3, r4=d.r4, r5=r5, r6=2 * r5, h=0.0)
             how = "the classical crank-rocker construction at swings 40-80 deg; r5 from the stroke, h = 0"
         return result("partial", how)
-    return result("none", "")
+    return None
+
+
+CLOSED_FORMS = {  # a type's kind -> its closed forms, tried in order (the first that applies gives the starts)
+    "crank-rocker-slider": (_crank_rocker_slider, _four_bar_slider),
+    "drag-link-slider": (_drag_link_slider, _four_bar_slider),
+    "crank-shaper": (_crank_shaper,),
+    "whitworth": (_whitworth,),
+    "slider-crank": (_slider_crank,),
+    "four-bar": (_four_bar,),
+}
