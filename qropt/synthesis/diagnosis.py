@@ -47,7 +47,9 @@ class Diagnosis:
         if beyond:
             return done("infeasible", beyond[0], reachable=beyond[1])
         if found:  # a design optimising a bounded criterion meets every bound: refine from it
-            r = solve(problem, targets=targets, starts_n=0, seed=seed, extra_starts=found, diagnose=False)
+            r = solve(
+                problem, targets=targets, starts_n=0, seed=seed, extra_starts=found, use_analytic=False, diagnose=False
+            )
             if r.success:
                 return r
         # a complete enumeration that gives no design proves there is none: its ranges are sampled only
@@ -70,7 +72,15 @@ class Diagnosis:
             r = solve(problem.replace(objective=None), targets=targets, starts_n=n, seed=seed, diagnose=False)
             found = [{k: r.params[k] for k in problem.free}] if r.success else []
             if found:
-                r = solve(problem, targets=targets, starts_n=0, seed=seed, extra_starts=found, diagnose=False)
+                r = solve(
+                    problem,
+                    targets=targets,
+                    starts_n=0,
+                    seed=seed,
+                    extra_starts=found,
+                    use_analytic=False,
+                    diagnose=False,
+                )
                 if r.success:
                     return r
         if plan.kind in ("family", "enumeration", "partial") and plan.analytic and not found:  # closed forms missed?

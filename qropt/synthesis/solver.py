@@ -297,7 +297,8 @@ class Solver:
         self, problem, targets, names, *, starts_n=None, seed=None, solves: int = RANGE_SOLVES, toward: bool = False
     ):
         """{target: (low, high)} over the free bounds and conditions, each target alone: the exact values of
-        RANGE_SAMPLES designs spread over the bounds (and the closed forms' points), built once for every target
+        RANGE_SAMPLES designs spread over the bounds (with the corners of the bounds and the closed forms' points),
+        built once for every target
         (or the closed form's range where the plan has one),
         then at most ``solves`` local solves per target that push it down and up from the samples nearest each
         end (``toward``: only for a target outside the samples' range). Every value is that
@@ -307,7 +308,12 @@ class Solver:
         plan = starts_.plan(problem)
         exact = {k: plan.ranges[k] for k in names if k in plan.ranges}  # the closed form's own, where it has one
         names = [k for k in names if k not in exact]
-        pts = list(plan.analytic) + starts_.rule_points(problem, max(RANGE_SAMPLES, starts_n), seed) if names else []
+        pts = (
+            list(plan.analytic)
+            + starts_.corners(problem)
+            + starts_.rule_points(problem, max(RANGE_SAMPLES, starts_n), seed)
+        )
+        pts = pts if names else []
         seen = []  # (mechanism, start values, branch)
         for v in pts:
             for br in starts_.branches(problem):

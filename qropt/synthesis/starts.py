@@ -77,6 +77,20 @@ def rule_points(problem, n: int, seed: int) -> list[dict]:
     ]
 
 
+MAX_CORNERS = 64  # the corners of the free bounds tried as designs (every one up to six free parameters)
+
+
+def corners(problem) -> list[dict]:
+    """The corners of the free bounds (where extremes of a target often lie), at most MAX_CORNERS of them."""
+    names = list(problem.free)
+    if 2 ** len(names) > MAX_CORNERS:
+        return []
+    return [
+        {k: problem.free[k][bit] for k, bit in zip(names, bits, strict=True)}
+        for bits in itertools.product((0, 1), repeat=len(names))
+    ]
+
+
 def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
     """Up to n of the ``rule_points`` (POOL * n drawn) whose mechanism turns fully on the first branch; if none
     does, the first n points as they are. Where every length and offset is free, each point is scaled to meet
@@ -98,7 +112,7 @@ def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
 def _to_stroke(problem, values, branch, build) -> dict:
     """The design scaled so that its stroke meets the target, if scaling is free and stays in bounds."""
     stroke = problem.targets.get("stroke")
-    scalable = [k for k in problem.mechanism.PARAMS if k in problem.mechanism.LENGTHS or k in ("e", "h")]
+    scalable = [k for k, kind in problem.mechanism.kinds().items() if kind in ("length", "offset")]
     if stroke is None or any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable):
         return values
     try:
