@@ -17,12 +17,14 @@ from qropt.errors import (
     QroptError,
 )
 from qropt.mechanisms import (
+    CouplerSlider,
     CrankRockerSlider,
     CrankShaper,
     DragLinkSlider,
     FourBar,
     Mechanism,
     SliderCrank,
+    SlotRamShaper,
     Whitworth,
     grashof,
     mechanism_type,
@@ -43,6 +45,8 @@ __all__ = [
     "CrankRockerSlider",
     "DragLinkSlider",
     "FourBar",
+    "CouplerSlider",
+    "SlotRamShaper",
     "Mechanism",
     "grashof",
     "mechanism_type",

@@ -125,3 +125,101 @@ def gamma_min(kind, p):
         )
         best = min(best, float(r.fun), float(g[i]))
     return best
+
+
+# ---- the two six-bar types, from scratch ------------------------------------------------------------------------
+# Coupler slider: B from the triangle O4-A-B (the cosine law at O4, sigma = sign((A - O4) x (B - O4))); the coupler
+# point P by rotating the unit vector A->B by beta; D from the rod's right triangle on y = h. Slot-ram shaper: the
+# ram's pin D where the line O4-A meets y = -r1 + h, by similar triangles. Everything complex-safe (complex step).
+
+
+def sixbar_joints(kind, p, th):
+    """Joint coordinates of a coupler slider or a slot-ram shaper at crank angles th (complex-safe)."""
+    ax, ay = p["r2"] * np.cos(th), p["r2"] * np.sin(th)
+    if kind == "slot-ram-shaper":
+        o4y = -p["r1"]
+        t = p["h"] / (ay - o4y)  # D = O4 + t (A - O4) on y = o4y + h
+        return {"A": (ax, ay), "O4": (0.0 + 0 * th, o4y + 0 * th), "D": (t * ax, o4y + p["h"] + 0 * th)}
+    r1, r3, r4 = p["r1"], p["r3"], p["r4"]
+    vx, vy = ax - r1, ay  # O4 -> A
+    d = np.sqrt(vx * vx + vy * vy)
+    c = (r4 * r4 + d * d - r3 * r3) / (2 * r4 * d)  # cosine of the angle at O4 between O4->A and O4->B
+    s = p["sigma"] * np.sqrt(1 - c * c)
+    bx, by = r1 + r4 * (c * vx - s * vy) / d, r4 * (s * vx + c * vy) / d
+    ux, uy = (bx - ax) / r3, (by - ay) / r3
+    cb, sb = np.cos(p["beta"]), np.sin(p["beta"])
+    px, py = ax + p["r5"] * (ux * cb - uy * sb), ay + p["r5"] * (ux * sb + uy * cb)
+    h = p.get("h", 0.0)
+    dx = px + p.get("sigma_slider", 1.0) * np.sqrt(p["r6"] ** 2 - (h - py) ** 2)
+    return {"A": (ax, ay), "B": (bx, by), "O4": (r1 + 0 * th, 0 * th), "P": (px, py), "D": (dx, h + 0 * th)}
+
+
+def sixbar_x(kind, p, th):
+    return sixbar_joints(kind, p, th)["D"][0]
+
+
+def sixbar_transmissions(kind, p, th):
+    """Transmission angles (rad) at each transmitting joint (the block at A of the slot-ram shaper is 90 degrees)."""
+    j = sixbar_joints(kind, p, th)
+    if kind == "slot-ram-shaper":  # the lever O4->A against the slide line (x)
+        lx, ly = j["A"][0] - j["O4"][0], j["A"][1] - j["O4"][1]
+        return {"D": np.arctan2(np.abs(ly), np.abs(lx))}
+    (ax, ay), (bx, by), (px, py), (dx, dy) = j["A"], j["B"], j["P"], j["D"]
+    ux, uy, wx, wy = ax - bx, ay - by, p["r1"] - bx, -by
+    return {
+        "B": np.arctan2(np.abs(ux * wy - uy * wx), np.abs(ux * wx + uy * wy)),
+        "D": np.arctan2(np.abs(dx - px), np.abs(dy - py)),
+    }
+
+
+def sixbar_reversals(kind, p, n=N):
+    """Local maxima of x over a turn on an n-point grid."""
+    x = sixbar_x(kind, p, 2 * np.pi * np.arange(n) / n)
+    return int(np.count_nonzero((x > np.roll(x, 1)) & (x >= np.roll(x, -1))))
+
+
+def sixbar_cycle(kind, p):
+    """(theta_max, theta_min, x_max, x_min, TR, stroke, gamma_min) by dense sampling (N points) refined by brentq on
+    the complex-step dx/dtheta2 (dead centres) and bounded Brent (transmission minima)."""
+    x = sixbar_x(kind, p, TH)
+    h = 2 * np.pi / N
+
+    def dx(t):
+        return float(np.imag(sixbar_x(kind, p, t + 1j * STEP)) / STEP)
+
+    ext = []
+    for pick in (np.argmax, np.argmin):
+        i = int(pick(x))
+        t = brentq(dx, TH[i] - h, TH[i] + h, xtol=1e-15)
+        ext.append((t % (2 * np.pi), float(sixbar_x(kind, p, t))))
+    (t_max, x_max), (t_min, x_min) = ext
+    best = np.pi / 2
+    for name, g in sixbar_transmissions(kind, p, TH).items():
+        i = int(np.argmin(g))
+        r = minimize_scalar(
+            lambda t, n=name: float(sixbar_transmissions(kind, p, np.array([t]))[n][0]),
+            bounds=(TH[i] - h, TH[i] + h),
+            method="bounded",
+            options={"xatol": 1e-13},
+        )
+        best = min(best, float(r.fun), float(g[i]))
+    return t_max, t_min, x_max, x_min, time_ratio(t_max, t_min), x_max - x_min, best
+
+
+def sixbar_motion(kind, p, th, omega2=1.0, step=1e-3):
+    """x, v, a at crank angles th for a constant omega2 by central finite differences (Richardson-extrapolated,
+    O(step^4)); truncation ~ step^4 x^(6) and rounding ~ 1e-16 x / step^2: ~1e-11 for v, ~1e-8 for a at 1e-3."""
+    th = np.asarray(th, float)
+
+    def f(t):
+        return sixbar_x(kind, p, t)
+
+    def d1(k):
+        return (f(th + k) - f(th - k)) / (2 * k)
+
+    def d2(k):
+        return (f(th + k) - 2 * f(th) + f(th - k)) / k**2
+
+    v = (4 * d1(step / 2) - d1(step)) / 3
+    a = (4 * d2(step / 2) - d2(step)) / 3
+    return f(th), v * omega2, a * omega2**2

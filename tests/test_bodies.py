@@ -140,6 +140,8 @@ def _every_type():
         qropt.Whitworth(r1=0.1, r2=0.2, r5=0.12, r6=0.3),
         qropt.CrankRockerSlider(r1=0.4, r2=0.1, r3=0.35, r4=0.3, r5=0.4, r6=0.5, h=0.1),
         qropt.FourBar(r1=0.4, r2=0.1, r3=0.35, r4=0.3),
+        qropt.CouplerSlider(r1=0.4, r2=0.1, r3=0.35, r4=0.3, r5=0.15, beta=0.5, r6=0.6, h=0.1),
+        qropt.SlotRamShaper(r1=0.3, r2=0.1, h=0.5),
     ]
 
 

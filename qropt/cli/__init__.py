@@ -16,7 +16,7 @@ import numpy as np
 
 from qropt import units as units_
 from qropt.errors import QroptError
-from qropt.mechanisms import REGISTRY, Mechanism, mechanism_type
+from qropt.mechanisms import REGISTRY, Mechanism, mechanism_type, type_reference
 from qropt.synthesis import criteria
 
 QUIET = False  # --quiet: no progress bars
@@ -55,6 +55,76 @@ def real(text: str) -> float:
     return v
 
 
+def _param_pair(text: str) -> tuple[str, str]:
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip() or not value.strip():
+        raise argparse.ArgumentTypeError(f"--param is NAME=VALUE (e.g. r2=0.1, beta=30deg), got {text!r}")
+    return name.strip(), value.strip()
+
+
+def param_argument(parser) -> None:
+    """--param NAME=VALUE, repeatable: any parameter of any type (its kind from ``Mechanism.kinds()``)."""
+    parser.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        type=_param_pair,
+        metavar="NAME=VALUE",
+        help="a parameter of the type, repeatable: a length or offset in the length unit, an angle in rad or with "
+        "a suffix (30deg, 0.52rad), a branch sign +1 or -1",
+    )
+
+
+def param_value(name: str, text: str, kind: str) -> float:
+    """The value of --param NAME=TEXT for a parameter of this kind: an angle in rad or with a suffix deg/rad."""
+    t = text.strip().lower()
+    if kind == "angle" and t.endswith("deg"):
+        v = real_or_none(t[:-3])
+        v = None if v is None else math.radians(v)
+    else:
+        v = real_or_none(t.removesuffix("rad") if kind == "angle" else t)
+    if v is None:
+        unit = " (rad, or e.g. 30deg)" if kind == "angle" else ""
+        raise CliError(f"--param {name}={text}: not a finite number{unit}")
+    return v
+
+
+def real_or_none(text: str) -> float | None:
+    try:
+        v = float(text)
+    except ValueError:
+        return None
+    return v if math.isfinite(v) else None
+
+
+def flag_params(args, names=None) -> dict:
+    """The parameters given by the fixed flags (--r1 ... --sigma-slider)."""
+    return {k: getattr(args, k) for k in names or PARAM_NAMES if getattr(args, k, None) is not None}
+
+
+def mechanism_params(args, cls, names=None) -> dict:
+    """Every parameter given on the command line for type cls: the fixed flags and each --param NAME=VALUE."""
+    given = flag_params(args, names)
+    kinds = cls.kinds()
+    for name, text in getattr(args, "param", None) or []:
+        if name not in kinds:
+            raise CliError(f"--param {name}: {cls.__name__} has no parameter {name!r}; it takes {list(kinds)}")
+        if name in given:
+            raise CliError(f"parameter {name} is given twice")
+        given[name] = param_value(name, text, kinds[name])
+    return given
+
+
+def cli_type(name: str) -> type[Mechanism]:
+    """A type named on the command line: a KIND, class name or "module:Class" (importable from the current
+    directory too, as ``python -m`` finds modules)."""
+    import os
+
+    if ":" in name and os.getcwd() not in sys.path:
+        sys.path.append(os.getcwd())
+    return mechanism_type(name)
+
+
 MIN_STEP = math.radians(0.01)  # the finest full-cycle table: 36,000 rows
 
 
@@ -83,7 +153,7 @@ def stated(m: Mechanism, units: str | None, where: str) -> Mechanism:
 
 
 def build_mechanism(args) -> Mechanism:
-    given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
+    given = {**flag_params(args), **dict(getattr(args, "param", None) or [])}
     units = getattr(args, "units", None)
     if getattr(args, "design", None):
         if given or args.type is not None:
@@ -97,7 +167,8 @@ def build_mechanism(args) -> Mechanism:
         from qropt.examples import paper_mechanism
 
         return stated(paper_mechanism(), units, "the built-in paper design")
-    return mechanism_type(args.type)(**given, units=units or units_.DEFAULT)
+    cls = cli_type(args.type)
+    return cls(**mechanism_params(args, cls), units=units or units_.DEFAULT)
 
 
 def analysis_report(m: Mechanism, theta2: float, omega2: float, alpha2: float) -> dict:
@@ -106,7 +177,8 @@ def analysis_report(m: Mechanism, theta2: float, omega2: float, alpha2: float) -
     a, b = m.stroke_angles()
     mo = m.motion(np.array([theta2]), omega2, alpha2)
     out = {
-        "type": m.KIND,
+        "type": type_reference(type(m)),
+        "output": m.OUTPUT,
         "params": dict(m.params),
         "units": m.units,
         "time_ratio": m.time_ratio(),
@@ -146,7 +218,8 @@ def analysis_report(m: Mechanism, theta2: float, omega2: float, alpha2: float) -
 def print_report(r: dict, out=None):
     w = (out or sys.stdout).write
     u = r.get("units", units_.DEFAULT)
-    out_name = "follower theta4 [rad]" if r["type"] == "four-bar" else f"slider x [{u}]"
+    follower = r.get("output", "follower" if r["type"] == "four-bar" else "slider") == "follower"
+    out_name = "follower theta4 [rad]" if follower else f"slider x [{u}]"
     w(f"{r['type']} ({u}): " + ", ".join(f"{k}={v:g}" for k, v in r["params"].items()) + "\n")
     if "grashof" in r:
         g = r["grashof"]
@@ -156,7 +229,7 @@ def print_report(r: dict, out=None):
         )
     d = r["dead_centres"]
     w(f"  time ratio        {r['time_ratio']:.10f}\n")
-    if r["type"] == "four-bar":
+    if follower:
         w(f"  swing             {math.degrees(r['stroke']):.6f} deg\n")
     else:
         w(f"  stroke            {r['stroke']:.10g} {u}\n")
@@ -173,7 +246,7 @@ def print_report(r: dict, out=None):
     w(f"  gamma_min         {g['value_deg']:.6f} deg at theta2 = {g['theta2_deg']:.6f} deg, joint {g['joint']}\n")
     s = r["state"]
     w(f"  at theta2 = {s['theta2_deg']:g} deg, omega2 = {s['omega2']:g} rad/s, alpha2 = {s['alpha2']:g} rad/s^2:\n")
-    if r["type"] == "four-bar":
+    if follower:
         w(f"    follower: theta4 = {s['x']:.6g} rad, omega4 = {s['v']:.6g} rad/s, alpha4 = {s['a']:.6g} rad/s^2\n")
     else:
         w(f"    slider: x = {s['x']:.6g} {u}, v = {s['v']:.6g} {u}/s, a = {s['a']:.6g} {u}/s^2\n")
@@ -273,6 +346,7 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("type", nargs="?", help="mechanism type: " + ", ".join(sorted(REGISTRY)))
     for k in PARAM_NAMES:
         a.add_argument(f"--{k.replace('_', '-')}", dest=k, type=real, help=f"parameter {k}")
+    param_argument(a)
     a.add_argument("--theta2", type=angle, default=math.radians(60.0), help="crank angle (deg, or 1.05rad)")
     a.add_argument("--omega2", type=real, default=1.0, help="crank speed, rad/s (sign = direction)")
     a.add_argument("--alpha2", type=real, default=0.0, help="crank acceleration, rad/s^2")
@@ -304,6 +378,7 @@ def parser() -> argparse.ArgumentParser:
     r.add_argument("type", nargs="?", help="mechanism type (default: the paper's mechanism)")
     for k in PARAM_NAMES:
         r.add_argument(f"--{k.replace('_', '-')}", dest=k, type=real, help=f"parameter {k}")
+    param_argument(r)
     r.add_argument("--free", default="r3", help="the adjustable parameter (default r3)")
     r.add_argument("--bounds", nargs=2, type=real, metavar=("LOW", "HIGH"), help="its interval")
     r.add_argument("--tr", type=real, action="append", default=[], help="count the designs for this TR")
@@ -423,7 +498,7 @@ def cmd_family(args):
 def cmd_reachable(args):
     from qropt.studies._reachable import reachable
 
-    given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
+    given = {**flag_params(args), **dict(args.param)}
     if args.type is None and not given:
         from qropt.examples import paper_mechanism
 
@@ -431,7 +506,8 @@ def cmd_reachable(args):
     elif args.type is None:
         raise CliError("give the mechanism TYPE before its parameters")
     else:
-        m = mechanism_type(args.type)(**given, units=args.units or units_.DEFAULT)
+        cls = cli_type(args.type)
+        m = cls(**mechanism_params(args, cls), units=args.units or units_.DEFAULT)
     with progress_bar(f"scanning {args.free}", total=301) as bar:
         r = reachable(m, args.free, tuple(args.bounds) if args.bounds else None, progress=bar.update)
     tmin, xmin, tmax, xmax = r.time_ratio_range
@@ -489,6 +565,7 @@ def load_problem(path: str):
     if not file.is_file():
         raise CliError(f"no problem file {path!r}")
     if file.suffix in (".toml", ".json"):
+        _importable(file)  # a type of one's own named "module:Class" may sit beside the file
         try:
             text = file.read_text()
         except (OSError, UnicodeDecodeError) as e:
@@ -500,20 +577,48 @@ def load_problem(path: str):
     if file.suffix != ".py":
         raise CliError(f"{path}: a problem file is .py (with build()), .toml or .json")
     _importable(file)
-    spec = importlib.util.spec_from_file_location(f"qropt_problem_{file.stem}", file)
+    name = _module_name(file)
+    spec = importlib.util.spec_from_file_location(name, file)
     module = importlib.util.module_from_spec(spec)
+    if not name.startswith("qropt_problem_"):  # importable by its name: a type it defines travels by reference
+        sys.modules[name] = module
     try:
         spec.loader.exec_module(module)
         built = module.build() if callable(getattr(module, "build", None)) else None
     except QroptError as e:
+        sys.modules.pop(name, None)
         raise type(e)(f"{path}: {e}") from None
     except (Exception, SystemExit) as e:  # noqa: BLE001 - a user's file may fail in any way: one line naming it
+        sys.modules.pop(name, None)
         raise CliError(f"{path} does not load: {type(e).__name__}: {e}") from None
     if not callable(getattr(module, "build", None)):
         raise CliError(f"{path} has no build() function")
     if not isinstance(built, Problem):
         raise CliError(f"{path}: build() must return a qropt.Problem, got {type(built).__name__}")
     return built
+
+
+def _module_name(file) -> str:
+    """The name under which a problem file is loaded: the one ``import`` finds it by from its folder (``stem``, or
+    ``package.stem`` in a package folder), so that a mechanism type it defines is found by its "module:Class"
+    reference in other processes (Dask workers, a Result reloaded); a private name where that name finds another
+    module."""
+    import importlib.util
+    from pathlib import Path
+
+    here = file.resolve()
+    folder = here.parent
+    names = ([f"{folder.name}.{file.stem}"] if (folder / "__init__.py").is_file() else []) + [file.stem]
+    for name in names:
+        if not all(part.isidentifier() for part in name.split(".")):
+            continue
+        try:
+            spec = importlib.util.find_spec(name)
+        except Exception:  # noqa: BLE001 - a folder that does not import as a package: the private name
+            continue
+        if spec is not None and spec.origin and Path(spec.origin).resolve() == here:
+            return name
+    return f"qropt_problem_{file.stem}"
 
 
 def _importable(file) -> None:
@@ -550,7 +655,7 @@ def cmd_synth(args):
         json.dump(r.to_dict(), sys.stdout, indent=2, default=str, allow_nan=False)
         sys.stdout.write("\n")
     else:
-        print(f"{problem.name or args.problem}: {problem.mechanism.KIND}, objective {problem.objective}")
+        print(f"{problem.name or args.problem}: {type_reference(problem.mechanism)}, objective {problem.objective}")
         print(r.summary())
         for k, (lo, hi) in r.reachable.items():
             unit = {"stroke": f" {problem.units}", "swing": " rad"}.get(k, "")

@@ -9,6 +9,7 @@ import math
 import numpy as np
 
 import qropt.cli as cli
+from qropt.mechanisms import type_reference
 from qropt.synthesis.criteria import maximises, of_problem
 from qropt.units import named
 
@@ -111,7 +112,7 @@ def summary(ch) -> list[str]:
     p, s = ch.problem, ch.stats
     axes = _axis_text(ch.x) + (f" x {_axis_text(ch.y)}" if ch.y else "")
     lines = [
-        f"{p.name or p.mechanism.__name__}: {p.mechanism.KIND}, {p.objective} over {axes}",
+        f"{p.name or p.mechanism.__name__}: {type_reference(p.mechanism)}, {p.objective} over {axes}",
         f"{s['cells']} cells in {s['seconds']:.3g} s ({s['cells_per_second']:.3g} cells/s, {s['scheduler']}): "
         f"{s['certified']} certified, {s['no_design']} without a design",
         f"  {s['continued']} continued from a neighbour, {s['full']} full solves ({s['needed']} needed: the "

@@ -30,7 +30,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         choices=["sum", "longest", "footprint"],
         help="size measure of min_size (default footprint)",
     )
-    parser.add_argument("--types", nargs="+", metavar="TYPE", help="types (default all): " + ", ".join(TYPES))
+    parser.add_argument(
+        "--types",
+        nargs="+",
+        metavar="TYPE",
+        help="types (default all): " + ", ".join(TYPES) + ", or any slider type's KIND or module:Class",
+    )
     bound_flags(parser)
     parser.add_argument("--omega2", type=real, default=1.0, help="crank speed [rad/s] (default 1)")
     parser.add_argument("--pareto", nargs=2, metavar=("A", "B"), help="also each type's front between two objectives")
@@ -61,17 +66,18 @@ def conditions_of(args) -> dict:
 
 
 def run(args) -> int:
-    from qropt.cli import picture_path, progress_bar
+    from qropt.cli import cli_type, picture_path, progress_bar
     from qropt.studies._design import TYPES, design
 
     plot = picture_path(args.plot) if args.plot else None
+    types = None if args.types is None else [cli_type(t) if ":" in t else t for t in args.types]
     n_types = len(args.types or TYPES)
     with progress_bar("types", total=n_types, unit="type") as bar:
         cmp = design(
             args.tr,
             args.stroke,
             objective=args.objective,
-            types=args.types,
+            types=types,
             size=args.size,
             conditions=conditions_of(args),
             omega2=args.omega2,

@@ -12,7 +12,7 @@ import numpy as np
 
 from qropt.convex.servo import OBJECTIVES, speed_profile
 from qropt.io.paths import picture_path
-from qropt.mechanisms import REGISTRY, mechanism_type
+from qropt.mechanisms import REGISTRY, type_reference
 
 COMMAND = "servo"
 HELP = "fastest crank-speed profile of a servo-driven crank within speed, acceleration and torque limits"
@@ -34,13 +34,18 @@ UNITS = {
 def add_mechanism_arguments(parser: argparse.ArgumentParser) -> None:
     """TYPE (default: the paper's drag-link mechanism) and its parameters --r1 ... --sigma-slider."""
     parser.add_argument("type", nargs="?", help="mechanism type: " + ", ".join(sorted(REGISTRY)))
+    from qropt.cli import param_argument
+
     for k in PARAM_NAMES:
         parser.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
+    param_argument(parser)
 
 
 def mechanism_from(args):
     """The mechanism named by args (InvalidParameter for an unknown type or bad parameters)."""
-    given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
+    from qropt.cli import cli_type, flag_params, mechanism_params
+
+    given = {**flag_params(args, PARAM_NAMES), **dict(args.param)}
     if args.type is None and not given:
         from qropt.examples import paper_mechanism
 
@@ -49,7 +54,8 @@ def mechanism_from(args):
         from qropt.errors import InvalidParameter
 
         raise InvalidParameter("give the mechanism TYPE before its parameters: " + ", ".join(sorted(REGISTRY)))
-    return mechanism_type(args.type)(**given)
+    cls = cli_type(args.type)
+    return cls(**mechanism_params(args, cls, PARAM_NAMES))
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -73,7 +79,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def summary(p, m) -> dict:
     """The profile's numbers as plain JSON-ready values."""
     out = {
-        "type": m.KIND,
+        "type": type_reference(type(m)),
         "params": dict(m.params),
         "status": p.status,
         "message": p.message,
@@ -118,7 +124,7 @@ def run(args) -> int:
         json.dump(r, sys.stdout, indent=2)
         sys.stdout.write("\n")
     else:
-        print(f"{m.KIND}: " + ", ".join(f"{k}={v:g}" for k, v in m.params.items()))
+        print(f"{type_reference(type(m))}: " + ", ".join(f"{k}={v:g}" for k, v in m.params.items()))
         print("  limits            " + ", ".join(f"{k} {v:g} {UNITS[k]}" for k, v in r["limits"].items()))
         if p.force or p.inertia:
             print(f"  load              force {p.force:g} N on the working stroke, inertia {p.inertia:g} kg m^2")

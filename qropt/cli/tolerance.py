@@ -12,7 +12,7 @@ from pathlib import Path
 from qropt import units as units_
 from qropt.convex.tolerance import QUANTITIES, allocate
 from qropt.errors import InvalidParameter, QroptError
-from qropt.mechanisms import REGISTRY, mechanism_type
+from qropt.mechanisms import REGISTRY, mechanism_type, type_reference
 
 COMMAND = "tolerance"
 HELP = "exact sensitivities and the largest tolerances keeping TR, stroke, gamma_min within limits"
@@ -167,7 +167,7 @@ def run(args) -> int:
         mc = al.monte_carlo(args.monte_carlo, seed=args.seed)
     if args.json:
         out = {
-            "type": m.KIND,
+            "type": type_reference(type(m)),
             "params": dict(m.params),
             "units": m.units,
             "status": al.status,
@@ -192,7 +192,7 @@ def run(args) -> int:
         sys.stdout.write("\n")
         return 0 if al.status == "optimal" else 1
     stated = m.units if design_unit else "not stated"
-    print(f"{m.KIND} (lengths: {stated}): " + ", ".join(f"{k}={v:g}" for k, v in m.params.items()))
+    print(f"{type_reference(type(m))} (lengths: {stated}): " + ", ".join(f"{k}={v:g}" for k, v in m.params.items()))
     rule = "sum |S| t <= E" if al.method == "worst-case" else f"||S t|| <= E / {al.k:g}"
     print(f"  {al.method} ({rule}); status {al.status}: {al.message}")
     if al.status != "optimal":

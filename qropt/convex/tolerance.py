@@ -24,7 +24,7 @@ from qropt.mechanisms import Mechanism
 
 QUANTITIES = ("time_ratio", "stroke", "gamma_min", "peak_acceleration")
 METHODS = ("worst-case", "rss")
-OFFSETS = ("e", "h")
+TOLERANCED = ("length", "offset", "angle")  # the parameter kinds (Mechanism.kinds()) given tolerances by default
 CHUNK = 2000  # samples analysed at once (bounded memory)
 MAX_SAMPLES = 10_000_000
 ROUNDING = 1e-12  # a sensitivity below this fraction of its row's largest is rounding: zero
@@ -34,8 +34,11 @@ def _names(m: Mechanism, params) -> list[str]:
     if not isinstance(m, Mechanism):
         raise InvalidParameter(f"expected a qropt mechanism, got {m!r}")
     if params is None:
-        return [k for k in (*type(m).LENGTHS, *OFFSETS) if k in m.params]
-    allowed = [k for k in m.params if not k.startswith("sigma")]
+        kinds = type(m).kinds()  # the lengths first (in LENGTHS order), then the offsets and angles
+        return [k for k in type(m).LENGTHS if k in m.params] + [
+            k for k in m.params if kinds.get(k) in TOLERANCED and k not in type(m).LENGTHS
+        ]
+    allowed = [k for k in m.params if k not in type(m).BRANCHES]
     if isinstance(params, str):
         params = [params]
     if isinstance(params, dict) or not isinstance(params, (list, tuple, set, frozenset, np.ndarray)):
@@ -43,7 +46,7 @@ def _names(m: Mechanism, params) -> list[str]:
     names = list(params)
     for k in names:
         if k not in allowed:
-            why = "branch signs have no tolerance" if str(k).startswith("sigma") else "unknown parameter"
+            why = "branch signs have no tolerance" if k in type(m).BRANCHES else "unknown parameter"
             raise InvalidParameter(f"{k!r}: {why}; {type(m).__name__} takes tolerances on {allowed}")
     if not names or len(set(names)) != len(names):
         raise InvalidParameter(f"params must name distinct parameters of {allowed}, got {names}")

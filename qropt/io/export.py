@@ -20,7 +20,7 @@ from qropt import units as units_
 from qropt.errors import InvalidParameter, QroptError
 from qropt.io import drawing
 from qropt.io.paths import output_path
-from qropt.mechanisms import Mechanism, mechanism_type
+from qropt.mechanisms import Mechanism, mechanism_type, type_reference
 
 LAYERS = drawing.LAYERS  # name -> DXF colour
 RESERVED = ("type", "params", "units")  # the design file's own fields
@@ -155,8 +155,9 @@ def _coords(args):
 
 
 def save_design(m: Mechanism, path, **extra) -> None:
-    """A design file: the type (kind), every parameter, its length unit ("units": "mm"; angles in rad), and any
-    extra JSON-ready fields (strict JSON: finite numbers, strings, lists, dictionaries, booleans and null)."""
+    """A design file: the type (its KIND; a type not shipped with qropt as "module:Class"), every parameter, its
+    length unit ("units": "mm"; angles in rad), and any extra JSON-ready fields (strict JSON: finite numbers,
+    strings, lists, dictionaries, booleans and null)."""
     _mechanism(m)
     p = output_path(path, (".json",), "design file")
     clash = [k for k in extra if k in RESERVED]
@@ -168,7 +169,7 @@ def save_design(m: Mechanism, path, **extra) -> None:
         except (ValueError, TypeError, RecursionError) as e:
             why = "nan or infinite numbers" if isinstance(e, ValueError) else type(e).__name__
             raise InvalidParameter(f"save_design: extra field {k!r} is not strict JSON ({why}): {v!r:.80}") from None
-    d = {"type": m.KIND, "params": dict(m.params), "units": m.units, **extra}
+    d = {"type": type_reference(type(m)), "params": dict(m.params), "units": m.units, **extra}
     text = json.dumps(d, indent=2, allow_nan=False) + "\n"
     _write(p, lambda q: q.write_text(text))
 

@@ -94,3 +94,18 @@ def transmission_cos2(xp, lines):
     (ux, uy), (wx, wy) = lines
     d = ux * wx + uy * wy
     return d * d / ((ux * ux + uy * uy) * (wx * wx + wy * wy))
+
+
+def slot_to_line(xp, pivot, pin, h):
+    """PP: the pin D that rides in a slotted lever (about ``pivot``, its slot along the ray through ``pin``) and on
+    the slide line y = h: where the lever's line crosses the slide line. Returns ``(D, t)``, ``t`` D's distance
+    from the pivot along the ray in units of ``|pin - pivot|`` (> 0: D on the ray; the lever must not be parallel
+    to the slide line)."""
+    t = (h - pivot[1]) / (pin[1] - pivot[1])
+    return (pivot[0] + t * (pin[0] - pivot[0]), h + 0.0 * pin[0]), t
+
+
+def slot_line_lines(pivot, pin):
+    """A slotted lever driving a pin on a +x slide line: the lever pushes along its normal and the pin moves along
+    x, so the transmission angle is the acute angle between the lever (pivot -> pin) and the slide line."""
+    return (pin[0] - pivot[0], pin[1] - pivot[1]), (1.0, 0.0)

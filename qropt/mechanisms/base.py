@@ -25,8 +25,9 @@ from qropt.kinematics.closures import transmission_angle
 from qropt.kinematics.kernel import derivative_on_grid, kernel, resolved
 from qropt.kinematics.ops import JET, NUMPY, Jet
 
-REQUIRED = object()
-REGISTRY: dict[str, type[Mechanism]] = {}
+REQUIRED = object()  # a PARAMS default: the parameter has none and must be given
+REGISTRY: dict[str, type[Mechanism]] = {}  # KIND -> the type (shipped types and every user type with a KIND)
+PARAMETER_KINDS = ("length", "offset", "angle", "branch")  # what ``Mechanism.kinds()`` says of each parameter
 MAGNITUDE = 1e100  # lengths and offsets beyond this (or lengths below its inverse) overflow their squares
 MAX_ANGLES = 10_000_000  # crank angles evaluated in one call
 
@@ -60,6 +61,45 @@ def crank_angles(theta2) -> np.ndarray:
     if not np.isfinite(t).all():
         raise InvalidParameter("theta2 must be finite (got nan or inf)")
     return t
+
+
+class RegistryError(InvalidParameter):
+    """A mechanism type cannot be registered (its KIND or class name is another class's) or found (an unknown
+    name, a ``"module:Class"`` reference whose module does not import, that has no such class, or that names
+    something that is not a Mechanism)."""
+
+
+def _identity(cls) -> str:
+    """module + qualname: the same class re-imported (a module reload) has the same identity."""
+    return f"{cls.__module__}.{cls.__qualname__}"
+
+
+def register(cls) -> None:
+    """Register a type by its own KIND (``Mechanism.__init_subclass__`` calls it). A KIND or class name (either
+    compared without case, '_' as '-') already held by another class is refused with RegistryError naming both;
+    the same class again (same module and qualname, e.g. a reloaded module) replaces itself."""
+    kind = cls.__dict__.get("KIND")
+    if not kind:
+        return
+    if not isinstance(kind, str):
+        raise RegistryError(f"{_identity(cls)}: KIND is a string (e.g. 'my-slider'), got {kind!r}")
+    key, name = kind.lower().replace("_", "-"), cls.__name__.lower()
+    for other in list(REGISTRY.values()):
+        if _identity(other) == _identity(cls):
+            continue
+        if other.KIND.lower().replace("_", "-") == key:
+            raise RegistryError(
+                f"mechanism KIND {kind!r} of {_identity(cls)} is already taken by {_identity(other)}; "
+                "give the new type its own KIND"
+            )
+        if other.__name__.lower() == name:
+            raise RegistryError(
+                f"mechanism class name {cls.__name__!r} of {_identity(cls)} is already taken by {_identity(other)} "
+                f"(KIND {other.KIND!r}); give the new type its own class name"
+            )
+    for k in [k for k, v in REGISTRY.items() if _identity(v) == _identity(cls)]:
+        del REGISTRY[k]  # a reloaded class (and its earlier KIND, if it changed)
+    REGISTRY[kind] = cls
 
 
 class Rule(NamedTuple):
@@ -201,12 +241,15 @@ class Body(NamedTuple):
 class Mechanism:
     """Base of every quick-return type; instances are immutable."""
 
+    KIND: ClassVar[str] = ""  # the type's registered name (e.g. 'slider-crank'); '' for an unregistered type
     PARAMS: ClassVar[dict[str, Any]] = {}
     LENGTHS: ClassVar[tuple[str, ...]] = ()
     REQUIRES_FULL_TURN: ClassVar[bool] = True
     OUTPUT: ClassVar[str] = "slider"  # 'slider' (x in length along +x) or 'follower' (an angle in rad)
     TRAVEL: ClassVar[str] = "stroke"  # the output's travel target: 'stroke' (slider) or 'swing' (follower)
     BRANCHES: ClassVar[tuple[str, ...]] = ()  # branch-sign parameters (default: PARAMS named sigma...)
+    ANGLES: ClassVar[tuple[str, ...]] = ()  # parameters that are angles (rad); the rest but lengths and branches
+    # are offsets (lengths that may be negative or zero)
     FOUR_BAR: ClassVar[bool] = False  # driven by a four-bar whose Grashof class is a problem condition
     CLASS: ClassVar[str] = ""  # the Grashof class the type requires ('' any)
     EXACT_TRANSMISSION: ClassVar[dict[str, tuple[float, ...]]] = {}  # joint -> crank angles of its extremes
@@ -220,8 +263,24 @@ class Mechanism:
         super().__init_subclass__(**kw)
         if "BRANCHES" not in cls.__dict__:
             cls.BRANCHES = tuple(k for k in cls.PARAMS if k.startswith("sigma"))
-        if getattr(cls, "KIND", None):
-            REGISTRY[cls.KIND] = cls
+        register(cls)
+
+    @classmethod
+    def kinds(cls) -> dict[str, str]:
+        """Each parameter's kind, in PARAMS order: 'length' (LENGTHS, positive), 'angle' (ANGLES, rad), 'branch'
+        (BRANCHES, a sign +1 or -1) or 'offset' (every other: a length that may be negative). Bounds, scaling,
+        tolerances, starts and the command line's --param read them."""
+        out = {}
+        for k in cls.PARAMS:
+            if k in cls.BRANCHES:
+                out[k] = "branch"
+            elif k in cls.LENGTHS:
+                out[k] = "length"
+            elif k in cls.ANGLES:
+                out[k] = "angle"
+            else:
+                out[k] = "offset"
+        return out
 
     @classmethod
     def warm_starts(cls, problem):
@@ -255,7 +314,7 @@ class Mechanism:
                 raise InvalidParameter(f"{name}: length {k} must be positive, got {v:g}")
             if abs(v) > MAGNITUDE or (k in self.LENGTHS and v < 1 / MAGNITUDE):
                 raise InvalidParameter(f"{name}: {k} = {v:g} is out of range (|value| in [1e-100, 1e100])")
-            if k.startswith("sigma") and v not in (-1.0, 1.0):
+            if k in self.BRANCHES and v not in (-1.0, 1.0):
                 raise InvalidParameter(f"{name}: branch sign {k} must be +1 or -1, got {v:g}")
             values[k] = v
         object.__setattr__(self, "params", values)
@@ -299,7 +358,8 @@ class Mechanism:
 
     def broken_rules(self, grashof: str | None = None) -> list[str]:
         """Names of the rules these parameters break (beyond rounding)."""
-        scale = max(abs(v) for k, v in self.params.items() if not k.startswith("sigma"))
+        kinds = self.kinds()
+        scale = max((abs(v) for k, v in self.params.items() if kinds[k] in ("length", "offset")), default=1.0)
         broken = [r.name for r in self.rules(NUMPY, self.params, grashof) if r.value < -1e-12 * scale]
         return list(dict.fromkeys(broken))
 
@@ -677,7 +737,7 @@ class Mechanism:
         self._require_full_turn()
         k, p = self._kernel, self._kernel.vector(self.params)
         n = p.size
-        names = tuple(q for q in self.params if not q.startswith("sigma"))
+        names = tuple(q for q in self.params if q not in self.BRANCHES)
         cols = [list(self.params).index(q) for q in names]
         combine, kink = "max", ""
         if quantity in ("time_ratio", "stroke"):

@@ -1,7 +1,11 @@
 """Type synthesis: one task (time ratio, stroke) solved for every quick-return type, compared criterion by criterion.
 
 Each type's problem has bounds that scale with the stroke s (every length in [s/20, 5 s], offsets in
-[-5 s, 5 s]) and its own conditions (the Grashof class of the four-bar types). Every row is a certified solve;
+[-5 s, 5 s]; angles, which a stroke does not scale, in [-pi, pi]) and its own conditions (the Grashof class of the
+four-bar types). The built-in rows are ``TYPES``; any other slider type (a class of one's own, its KIND or a
+``"module:Class"`` reference) gets a default row from its parameter kinds (``Mechanism.kinds()``): every length
+and offset free, its angles fixed at their defaults (free in [-pi, pi] where they have none, or where ``bounds``
+names them), its branch signs at their defaults. Every row is a certified solve;
 every criterion of a row is evaluated exactly on its design. Lengths in the stated unit (``units``, that of the
 stroke and the bounds; metres by default), angles in radians.
 """
@@ -17,12 +21,13 @@ from dataclasses import dataclass, field
 
 from qropt import units as units_
 from qropt.errors import ProblemError, QroptError
-from qropt.mechanisms.base import MAGNITUDE
+from qropt.mechanisms import mechanism_type
+from qropt.mechanisms.base import MAGNITUDE, REQUIRED
 from qropt.synthesis import criteria
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import SOLUTION_PRESENT, Result, json_safe
 
-# type name -> (mechanism kind, free lengths, free offsets, fixed values)
+# type name -> (mechanism kind, free lengths, free offsets, fixed values[, free angles])
 TYPES = {
     "slider-crank": ("slider-crank", ("r2", "r3"), ("e",), {}),
     "crank-shaper": ("crank-shaper", ("r1", "r2", "r4"), (), {}),
@@ -30,11 +35,43 @@ TYPES = {
     "whitworth": ("whitworth", ("r1", "r2", "r5", "r6"), ("h",), {}),
     "crank-rocker-slider": ("crank-rocker-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}),
     "drag-link-slider": ("drag-link-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}),
+    "coupler-slider": ("coupler-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}, ("beta",)),
+    "slot-ram-shaper": ("slot-ram-shaper", ("r1", "r2"), ("h",), {}),
 }
 
 
+def bounds_of(kind: str, stroke: float) -> tuple:
+    """The default bounds of a parameter of this kind ('length', 'offset' or 'angle') for a stroke s."""
+    return {"length": (stroke / 20, 5 * stroke), "offset": (-5 * stroke, 5 * stroke), "angle": (-math.pi, math.pi)}[
+        kind
+    ]
+
+
+def type_row(t, bounds=None) -> tuple:
+    """(name, (mechanism, free lengths, free offsets, fixed values, free angles)) of a type: a built-in row of
+    ``TYPES`` by its name, or the default row of any other slider type (a Mechanism class, its KIND, class name
+    or "module:Class"); ProblemError naming the types where there is none."""
+    if isinstance(t, str) and t in TYPES:
+        row = TYPES[t]
+        return t, (*row, ()) if len(row) == 4 else row
+    try:
+        cls = mechanism_type(t) if isinstance(t, (str, type)) else None
+    except QroptError as e:
+        raise ProblemError(f"unknown type {t!r}; types are {list(TYPES)}, or a slider type of your own ({e})") from None
+    if cls is None:
+        raise ProblemError(f"unknown type {t!r}; types are {list(TYPES)}, or a slider type of your own")
+    if cls.TRAVEL != "stroke":
+        raise ProblemError(f"{cls.__name__} has no slider (its output is a {cls.TRAVEL}): design compares strokes")
+    name = cls.__dict__.get("KIND") or cls.__name__
+    kinds, given = cls.kinds(), set(bounds or ())
+    lengths = tuple(k for k, v in cls.PARAMS.items() if kinds[k] == "length" and v is not None)
+    offsets = tuple(k for k, v in cls.PARAMS.items() if kinds[k] == "offset" and v is not None)
+    angles = tuple(k for k, v in cls.PARAMS.items() if kinds[k] == "angle" and (v is REQUIRED or k in given))
+    return name, (cls, lengths, offsets, {}, angles)
+
+
 def type_problem(
-    kind: str,
+    kind,
     time_ratio: float,
     stroke: float,
     *,
@@ -45,13 +82,13 @@ def type_problem(
     size: str = "footprint",
     units: str = units_.DEFAULT,
 ) -> Problem:
-    """The task as a Problem of one type: default bounds scaled by the stroke, ``bounds`` (name -> (lo, hi))
-    overriding those the type has, ``conditions`` added to the type's own; lengths in ``units``."""
-    if not isinstance(kind, str) or kind not in TYPES:
-        raise ProblemError(f"unknown type {kind!r}; types are {list(TYPES)}")
-    mech, lengths, offsets, fixed = TYPES[kind]
+    """The task as a Problem of one type (a name of ``TYPES``, or a slider type of one's own: see ``type_row``):
+    default bounds scaled by the stroke, ``bounds`` (name -> (lo, hi)) overriding those the type has,
+    ``conditions`` added to the type's own; lengths in ``units``."""
+    kind, (mech, lengths, offsets, fixed, angles) = type_row(kind, bounds)
     s = stroke
-    free = {k: (s / 20, 5 * s) for k in lengths} | {k: (-5 * s, 5 * s) for k in offsets}
+    free = {k: bounds_of("length", s) for k in lengths} | {k: bounds_of("offset", s) for k in offsets}
+    free |= {k: bounds_of("angle", s) for k in angles}
     for k, b in (bounds or {}).items():
         if k in free:
             free[k] = b
@@ -199,24 +236,29 @@ def design(
         units = units_.length_unit(units)
     except QroptError as e:
         raise ProblemError(f"design: {e}") from None
-    types = list(TYPES) if types is None else _types(types)
+    if bounds is not None and not isinstance(bounds, Mapping):
+        raise ProblemError(f"bounds is a dict name -> (lower, upper), got {bounds!r}")
+    chosen = _types(list(TYPES) if types is None else types)  # row name -> the type as given
+    types = list(chosen)
     if not (criteria.finite(time_ratio) and time_ratio >= 1):
         raise ProblemError(f"time_ratio is slow/fast >= 1, got {time_ratio!r}")
     if not (criteria.finite(stroke) and stroke > 0):
         raise ProblemError(f"stroke must be a positive number, got {stroke!r}")
     if not 20 / MAGNITUDE <= stroke <= MAGNITUDE / 5:  # the default bounds [s/20, 5 s] within the magnitude range
         raise ProblemError(f"stroke {stroke:g} {units} is out of range [2e-99, 2e99] (its bounds reach s/20 and 5 s)")
-    if bounds is not None and not isinstance(bounds, Mapping):
-        raise ProblemError(f"bounds is a dict name -> (lower, upper), got {bounds!r}")
     if conditions is not None and not isinstance(conditions, Mapping):
         raise ProblemError(f"conditions is a dict name -> bound (e.g. {{'gamma_min': 0.7}}), got {conditions!r}")
-    known = {k for t in types for k in TYPES[t][1] + TYPES[t][2]}
+    known = set()
+    for t in types:
+        mech, lengths, offsets, _, _ = type_row(chosen[t])[1]
+        angles = [k for k, kind in mechanism_type(mech).kinds().items() if kind == "angle"]
+        known |= {*lengths, *offsets, *angles}
     unknown = sorted(set(bounds or {}) - known, key=str)
     if unknown:
         raise ProblemError(f"bounds name {unknown}, which no type of {types} has (they have {sorted(known)})")
     problems = {
         kind: type_problem(
-            kind,
+            chosen[kind],
             time_ratio,
             stroke,
             objective=objective,
@@ -272,14 +314,13 @@ def columns() -> tuple:
 
 
 def _types(types) -> list[str]:
+    """Row name -> the type as given: names of TYPES, or slider types of one's own (classes, KINDs, "module:Class")."""
     if isinstance(types, str) or not hasattr(types, "__iter__"):
-        raise ProblemError(f"types is a list of type names from {list(TYPES)}, got {types!r}")
-    out = list(types)
-    for t in out:
-        if not isinstance(t, str) or t not in TYPES:
-            raise ProblemError(f"unknown type {t!r}; types are {list(TYPES)}")
-    if not out or len(set(out)) != len(out):
-        raise ProblemError(f"types must name at least one type, each once; got {out}")
+        raise ProblemError(f"types is a list of type names from {list(TYPES)} or types of your own, got {types!r}")
+    given = list(types)
+    out = {type_row(t)[0]: t for t in given}
+    if not out or len(out) != len(given):
+        raise ProblemError(f"types must name at least one type, each once; got {[type_row(t)[0] for t in given]}")
     return out
 
 

@@ -448,6 +448,52 @@ def _crank_shaper(c: _Context):
     return None
 
 
+def slot_ram_shaper_stroke(r1: float, r2: float, h: float) -> float:
+    """Stroke 2 h r2 / sqrt(r1^2 - r2^2) of a slot-ram shaper: the lever's extremes (tangent to the crank circle,
+    sin(beta) = r2/r1 from the vertical) cross the slide line at x = +/- h tan(beta); TR is the crank-shaper's."""
+    return 2.0 * h * r2 / math.sqrt(r1 * r1 - r2 * r2)
+
+
+def slot_ram_shaper_gamma_min(r1: float, r2: float) -> float:
+    """gamma_min = acos(r2/r1) of a slot-ram shaper: at D, the lever at its extremes meets the slide line at
+    pi/2 - beta (the block at A transmits at 90 degrees)."""
+    return math.acos(r2 / r1)
+
+
+def _slot_ram_shaper(c: _Context):
+    """sin(beta) = r2/r1 fixes the TR; h = stroke sqrt(r1^2 - r2^2) / (2 r2); with r1 and r2 free r1 walks the
+    family (the motion depends on r2/r1 and h only: every kinematic criterion is the same along it)."""
+    fixed, free, tg, val, tr, stroke, square, emit, result = c.names()
+    crank = [k for k in ("r1", "r2") if k in free]
+    if not crank:  # r2/r1 given: only the stroke can be met, by h
+        if tr is None and stroke is not None and "h" in free:
+            emit(h=stroke * math.sqrt(val["r1"] ** 2 - val["r2"] ** 2) / (2.0 * val["r2"]))
+            return result("enumeration" if square else "partial", "h = stroke sqrt(r1^2 - r2^2) / (2 r2)")
+        return None
+    if tr is not None:
+        ratio = crank_shaper_ratio(tr)
+    elif stroke is not None and "h" not in free:
+        q = stroke / (2.0 * val["h"])  # tan(beta) from the stroke at the given h
+        ratio = q / math.sqrt(1.0 + q * q)
+    else:
+        return None
+    if not 0.0 < ratio < 1.0:
+        return None
+    both = tr is not None and stroke is not None
+    h = {"h": stroke * math.sqrt(1.0 - ratio * ratio) / (2.0 * ratio)} if both and "h" in free else {}
+    how = "sin(beta) = r2/r1 fixes the TR; h = stroke sqrt(r1^2 - r2^2) / (2 r2)"
+    if len(crank) == 2:  # the family: r1 over its bounds (and r2's over the ratio)
+        lo, hi = max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1], free["r2"][1] / ratio)
+        if lo <= hi:
+            for r1 in np.geomspace(lo, hi, FAMILY_POINTS) if lo < hi else [lo]:
+                emit(r1=float(r1), r2=float(ratio * r1), **h)
+        exact = len(free) == len(tg) + 1 and ("h" in free) == both
+        return result("family" if exact else "partial", how + "; r1 walks the family (the least size at its least)")
+    emit(**({"r2": ratio * val["r1"]} if "r2" in free else {"r1": val["r2"] / ratio}), **h)
+    exact = square and ("h" in free) == both
+    return result("enumeration" if exact else "partial", how)
+
+
 def _whitworth(c: _Context):
     """sin(beta) = r1/r2 fixes the TR; stroke = 2 r5."""
     fixed, free, tg, val, tr, stroke, square, emit, result = c.names()
@@ -535,6 +581,7 @@ CLOSED_FORMS = {  # a type's kind -> its closed forms, tried in order (the first
     "crank-rocker-slider": (_crank_rocker_slider, _four_bar_slider),
     "drag-link-slider": (_drag_link_slider, _four_bar_slider),
     "crank-shaper": (_crank_shaper,),
+    "slot-ram-shaper": (_slot_ram_shaper,),
     "whitworth": (_whitworth,),
     "slider-crank": (_slider_crank,),
     "four-bar": (_four_bar,),

@@ -83,8 +83,8 @@ class Diagnosis:
                 )
                 if r.success:
                     return r
-        if plan.kind in ("family", "enumeration", "partial") and plan.analytic and not found:  # closed forms missed?
-            r = solve(problem, targets=targets, starts_n=starts_n, seed=seed, use_analytic=False, diagnose=False)
+        if plan.kind in ("family", "enumeration", "partial") and plan.analytic:  # the closed forms may have missed
+            r = solve(problem, targets=targets, starts_n=n, seed=seed, use_analytic=False, diagnose=False)
             if r.success:
                 return r
         feas = self.solver.tolerances["feasibility"]

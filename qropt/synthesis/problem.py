@@ -20,7 +20,7 @@ from typing import Any
 
 from qropt import units as units_
 from qropt.errors import ProblemError, QroptError
-from qropt.mechanisms import Mechanism, mechanism_type
+from qropt.mechanisms import Mechanism, mechanism_type, type_reference
 from qropt.mechanisms.base import MAGNITUDE, REQUIRED
 from qropt.synthesis import criteria
 from qropt.synthesis.criteria import SIZES, finite
@@ -105,7 +105,12 @@ class Problem:
         if not self.free:
             raise self._err("no free parameter: give free={name: (lower, upper)}")
         for k in list(self.fixed) + list(self.free):
-            if k not in params or (k in cls.BRANCHES and k in self.free):
+            if k in cls.BRANCHES and k in self.free:
+                raise self._err(
+                    f"{k!r} is a branch sign (+1 or -1), not a continuous parameter: fix it, or give "
+                    f"branches={{{k!r}: (-1, 1)}} to try both"
+                )
+            if k not in params:
                 raise self._err(f"unknown or non-continuous parameter {k!r}; {cls.__name__} takes {list(params)}")
         both = sorted(set(self.fixed) & set(self.free))
         if both:
@@ -270,14 +275,15 @@ class Problem:
 
     # ---- equality and serialisation (angles in radians, lengths in the problem's unit) -------------
     def to_dict(self) -> dict:
-        """Plain JSON-ready values: the mechanism by its kind, bounds as [lower, upper], objective None or a name."""
+        """Plain JSON-ready values: the mechanism by its kind (a type not shipped with qropt as "module:Class",
+        which ``from_dict`` imports), bounds as [lower, upper], objective None or a name."""
         c = dict(self.conditions)
         if "linear" in c:
             c["linear"] = [[dict(k), lo, hi] for k, lo, hi in c["linear"]]
         if "ratio" in c:
             c["ratio"] = [list(r) for r in c["ratio"]]
         return {
-            "mechanism": self.mechanism.KIND,
+            "mechanism": type_reference(self.mechanism),
             "fixed": dict(self.fixed),
             "free": {k: [lo, hi] for k, (lo, hi) in self.free.items()},
             "targets": dict(self.targets),

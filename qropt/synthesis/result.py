@@ -168,14 +168,17 @@ class Result:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
-        """Strict-JSON dictionary (no NaN: None); the mechanism as its type kind and parameters."""
+        """Strict-JSON dictionary (no NaN: None); the mechanism as its type kind (a type not shipped with qropt as
+        "module:Class", see ``qropt.mechanisms.type_reference``) and parameters."""
+        from qropt.mechanisms import type_reference
+
         return json_safe(
             {
                 "units": unit_names(self.units),
                 "status": self.status,
                 "success": self.success,
                 "message": self.message,
-                "type": getattr(self.mechanism, "KIND", None),
+                "type": None if self.mechanism is None else type_reference(type(self.mechanism)),
                 "params": dict(self.params),
                 "objective": self.objective,
                 "quantities": self.quantities,

@@ -42,8 +42,9 @@ def factor(problem) -> float:
 
 
 def _scales(problem, name: str) -> bool:
-    """Whether a parameter is a length or an offset (everything but branch signs)."""
-    return name not in problem.mechanism.BRANCHES
+    """Whether a parameter scales with the lengths: a length or an offset (``Mechanism.kinds()``), not an angle or
+    a branch sign."""
+    return problem.mechanism.kinds().get(name) in ("length", "offset")
 
 
 def scaled(problem, k: float):
