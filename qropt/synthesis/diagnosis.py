@@ -20,7 +20,9 @@ import math
 import time
 
 from qropt.synthesis import criteria
+from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import PROVES
+from qropt.synthesis.certificate import Designs
 from qropt.synthesis.result import Result
 
 DIAGNOSIS_STARTS = 4  # space-filling starts of each solve a diagnosis runs
@@ -84,9 +86,13 @@ class Diagnosis:
                 if r.success:
                     return r
         if plan.kind in ("family", "enumeration", "partial") and plan.analytic:  # the closed forms may have missed
-            r = solve(problem, targets=targets, starts_n=n, seed=seed, use_analytic=False, diagnose=False)
-            if r.success:
-                return r
+            # space-filling starts, each in its own TR orientation only (a second chance, not a second multi-start)
+            none = starts_.plan(problem, use_analytic=False)
+            more, how, _ = self.solver.multistart.candidates(
+                problem, none, [], targets, n, seed, self.solver.max_rounds, Designs(), retry=False
+            )
+            if any(c.ok for c in more):
+                return self.solver.best(problem, more, how, none, t0)
         feas = self.solver.tolerances["feasibility"]
         if all(max(c.residuals.values(), default=0.0) > feas or c.mechanism is None for c in cands):
             ends: dict = {}

@@ -1,0 +1,624 @@
+"""Planar one-degree-of-freedom linkages declared from Assur groups: a type in a few lines instead of a loop.
+
+A ``Linkage`` is built from a frame, a crank and dyads, each named after the joint it places (the geometry contract,
+``shared/CONVENTIONS.md``: x to the right, y up, theta2 counter-clockwise from +x; a link angle is the direction
+from its first-named joint to its second, e.g. theta3 = A->B). Its ``loop(xp, theta2, p)`` is the same closed-form
+loop a type would write by hand, built from the closures of ``qropt.kinematics.closures`` only, so it runs on numpy
+arrays, Taylor jets and CasADi symbols alike (no branching on values). A type then says::
+
+    L = Linkage()
+    L.ground("O2", (0, 0))
+    L.crank("A", about="O2", length="r2")                       # A = r2 (cos theta2, sin theta2)
+    L.rrr("B", ("A", "r3"), ("O4", "r4"), sign="sigma", around=math.pi)
+    L.ground("O4", ("r1", 0))                                   # declared after B: the points keep this order
+    L.on_ray("C", "O4", "B", "r5")                              # C on the follower, along O4->B
+    L.rrp("D", ("C", "r6"), line_y="h", sign="sigma_slider")    # the rod CD and the ram D on y = h
+    L.output("D")
+
+    class MySlider(Mechanism):
+        PARAMS = {...}
+        loop = staticmethod(L.loop)
+        BODIES, GROUND, OUTPUT_JOINT = L.bodies(), L.ground_joints(), L.output_joint()
+
+Numbers and parameters. A coordinate, length or slide-line height is a number, a parameter name, or a short linear
+expression of them (``"-r1 + h"``, ``"2*r1 - e"``), evaluated left to right exactly as written (``-r1 + h`` is
+``-p["r1"] + p["h"]``); or a callable ``f(xp, p)``. A branch sign is a parameter name (``"sigma"``) or +1 / -1.
+
+Points are emitted in declaration order and may refer to points declared later (the loop is evaluated in dependency
+order), so a type reproduces a hand-written loop's point order. Angles, transmission joints and margins are
+emitted in the order the elements that define them were declared.
+
+The elements (each: the closure it is, its branch sign, its assembly margin, its transmission rule, the angles it
+defines and the bodies it makes):
+
+- ``ground(name, (x, y))``: a frame pivot. No sign, margin or transmission.
+- ``crank(name, about, length)``: the input link, the pin at ``length`` from the ground pivot along theta2;
+  angle ``theta2`` (the crank angle itself); body ``crank`` (pivot, pin), a bar.
+- ``rrr(name, (P, a), (Q, b), sign)``: RRR, a joint X on two circles (``circle_circle``). Two solutions: the branch
+  sign by the contract, ``sigma = sign((P - Q) x (X - Q))``. Margin ``1 - c^2`` (c the cosine of the angle at Q),
+  >= 0 where the circles meet; named ``"four-bar closure at X"`` when P is a crank's pin and Q a ground pivot (the
+  four-bar of the contract), else ``"closure at X"``. Transmission at X by the contract's four-bar rule:
+  ``joint_lines(P, Q, X)``, the coupler X->P (P's side drives: name it first) against the follower X->Q (exact for a
+  ground Q, whose X moves normal to QX; with a moving Q it is the classical angle between the dyad's links).
+  Angles: P->X and Q->X, named theta<k> after lengths named r<k> (theta3 = A->B, theta4 = O4->B); Q->X is the
+  closure's continuous angle (``around`` as in ``circle_circle``: ``math.pi`` keeps a follower that rocks about
+  -x continuous, as the four-bar does). Bodies: ``coupler`` (P, X) and ``follower`` (Q, X), bars.
+- ``rrp(name, (P, r), line_y, sign)``: RRP, a rod of length r from pin P to the slider X on the slide line
+  y = line_y, sliding along +x (``rod_to_line``). Two solutions: ``sign = +1`` puts X on the +x side of P (the
+  contract's ``sigma_slider``). Margin ``(r^2 - (line_y - y_P)^2) / r^2``, named ``"rod PX reaching the slide
+  line"``. Transmission at X: ``rod_lines(P, X)``, the rod against the slide line's normal. Angle P->X (theta6 for
+  a rod r6). Bodies: ``rod`` (P, X), a bar, and ``ram`` (X,).
+- ``rpr(pin, pivot, angle)``: RPR, a crank-pin block in a slotted link that turns about a ground pivot and passes
+  through the pin (``pin_in_slot``): it defines the link's angle pivot->pin (``theta4``). One solution, no margin
+  (it assembles wherever the pin is off the pivot). Transmission at the pin: ``RIGHT_ANGLE`` (a block in a slot
+  carries force normal to the slot, along the pin's velocity: 90 degrees). Bodies: ``block`` (pin, pivot) and
+  ``lever`` (pivot, pin), a slot-lever.
+- ``rpp(pin)``: RPP, a yoke: the pin slides in a slot normal to the slide line, so the ram follows the pin's x
+  (``output(pin)``). No new point, sign or margin; transmission at the pin: ``RIGHT_ANGLE``; body ``yoke`` (pin,).
+- ``slot_line(name, (pivot, through), line_y)``: a pin on two lines (``slot_to_line``): the ram's pin rides in the
+  slotted lever pivot->through and on the slide line y = line_y, where the lever's line crosses it. One solution;
+  no margin by default (the lines cross unless parallel; ``margin="..."`` records t >= 0, the pin on the ray's side
+  of the pivot). Transmission at the pin: ``slot_line_lines(pivot, through)``, the lever against the slide line.
+  The pin joins the lever's body; body ``ram`` (name,).
+- ``on_ray(name, origin, through, length)``: a point fixed on the body that carries origin and through, at
+  ``length`` along the ray origin->through (``on_ray``; the ray's angle is the one the dyad that made it defined,
+  e.g. the follower's theta4). ``coupler_point(name, origin, through, length, angle)``: at ``length`` and
+  ``angle`` (counter-clockwise) from that ray, ``P = A + r5 (cos(theta3 + beta), sin(theta3 + beta))``; it makes
+  the body a plate. Neither has a sign, margin or transmission.
+- ``output(name)``: the output: a point's x (the ram on its +x slide line) or an angle (a follower's theta4).
+
+``bodies()`` gives every moving body in declaration order (``Body``; a point fixed on a body joins it),
+``ground_joints()`` the frame pivots, ``output_joint()`` the output point (None for an angle) and ``parameters()``
+the parameter names the linkage reads, in first-use order.
+
+Limits of this first step: one crank and one output per linkage; no optional dyads (a type whose structure depends
+on which parameters are given, as the crank-shaper's yoke or rod, declares one linkage per variant and picks by the
+keys of p); the RRR's transmission rule assumes its second centre is a ground pivot (see above).
+"""
+
+from __future__ import annotations
+
+import re
+
+from qropt.errors import InvalidParameter
+from qropt.kinematics import closures as cl
+from qropt.mechanisms.base import Body, Loop
+
+__all__ = ["Linkage", "LinkageError"]
+
+
+class LinkageError(InvalidParameter):
+    """A linkage declaration that cannot be built: a name used twice, a point never placed, a cycle of references,
+    an expression that does not parse, or a point fixed on a body that no element made."""
+
+
+# ---- numbers, parameters and linear expressions ------------------------------------------------------------------
+_TERM = re.compile(
+    r"\s*([+-])?\s*(?:((?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)\s*(?:\*\s*([A-Za-z_]\w*))?|([A-Za-z_]\w*))\s*"
+)
+
+
+class _Scalar:
+    """A number, a parameter, a linear expression of parameters (left to right) or a callable f(xp, p)."""
+
+    def __init__(self, spec, what: str):
+        self.spec, self.names, self.zero = spec, (), False
+        if callable(spec):
+            self.f = lambda xp, p: spec(xp, p)
+            return
+        if isinstance(spec, bool) or not isinstance(spec, (int, float, str)):
+            raise LinkageError(f"{what}: a number, a parameter name, a linear expression or f(xp, p); got {spec!r}")
+        if not isinstance(spec, str):
+            v = float(spec)
+            self.zero = v == 0.0
+            self.f = lambda xp, p: v
+            return
+        terms, pos = [], 0
+        while pos < len(spec):
+            m = _TERM.match(spec, pos)
+            if not m or m.end() == pos or (terms and not m.group(1)):
+                raise LinkageError(f"{what}: cannot read {spec!r} (terms like 'r1', '-r1 + h', '2*e')")
+            sign, num, name = m.group(1) or "+", m.group(2), m.group(3) or m.group(4)
+            terms.append((sign, float(num) if num is not None else None, name))
+            pos = m.end()
+        if not terms:
+            raise LinkageError(f"{what}: empty expression")
+        self.names = tuple(dict.fromkeys(n for _, _, n in terms if n is not None))
+        self.zero = all(n is None and c == 0.0 for _, c, n in terms)
+
+        def f(xp, p):
+            out = None
+            for k, (sign, coef, name) in enumerate(terms):
+                if name is None:
+                    v = -coef if sign == "-" and k == 0 else coef
+                elif coef is None:
+                    v = -p[name] if sign == "-" and k == 0 else p[name]
+                else:
+                    v = (-coef if sign == "-" and k == 0 else coef) * p[name]
+                out = v if k == 0 else (out - v if sign == "-" else out + v)
+            return out
+
+        self.f = f
+
+    def __call__(self, xp, p):
+        return self.f(xp, p)
+
+
+def _theta(length) -> str | None:
+    """theta<k> for a length named r<k> (the hand-written loops' names), else None."""
+    return f"theta{length[1:]}" if isinstance(length, str) and re.fullmatch(r"r\d+", length) else None
+
+
+class _Lazy:
+    """An angle computed on first use (a ray's atan2 that only a recorded angle or a fixed point reads)."""
+
+    __slots__ = ("f",)
+
+    def __init__(self, f):
+        self.f = f
+
+
+# ---- evaluation environment ---------------------------------------------------------------------------------------
+class _Env:
+    def __init__(self, xp, theta2, p):
+        self.xp, self.theta2, self.p = xp, theta2, p
+        self.pts: dict = {}
+        self.rays: dict = {}  # (origin, through) -> angle, or a thunk computing it on first use
+        self.angles: dict = {}
+        self.trans: dict = {}  # element index -> [(joint, lines)]
+        self.margins: dict = {}  # element index -> [(name, value)]
+
+    def ray(self, origin: str, through: str):
+        """The angle of the ray origin->through: the one a dyad defined, else atan2 of the two points."""
+        v = self.rays.get((origin, through))
+        if v is None:
+            v = cl.pin_in_slot(self.xp, self.pts[origin], self.pts[through])
+        elif isinstance(v, _Lazy):
+            v = v.f()
+        self.rays[(origin, through)] = v
+        return v
+
+
+# ---- elements -----------------------------------------------------------------------------------------------------
+class _Element:
+    kind = ""
+    point: str | None = None  # the point it places (None: rpr, rpp, output)
+    needs: tuple = ()  # points it reads
+
+    def angle_names(self) -> tuple:
+        return ()
+
+    def joints(self) -> tuple:
+        """Transmission joints (in order)."""
+        return ()
+
+    def margin_names(self) -> tuple:
+        return ()
+
+    def evaluate(self, env: _Env, i: int) -> None:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+
+class _Ground(_Element):
+    kind = "ground"
+
+    def __init__(self, name, xy):
+        if not isinstance(xy, (tuple, list)) or len(xy) != 2:
+            raise LinkageError(f"ground {name!r}: coordinates are a pair (x, y), got {xy!r}")
+        self.point, self.xy = name, (_Scalar(xy[0], f"ground {name} x"), _Scalar(xy[1], f"ground {name} y"))
+
+    def evaluate(self, env, i):
+        env.pts[self.point] = (self.xy[0](env.xp, env.p), self.xy[1](env.xp, env.p))
+
+
+class _Crank(_Element):
+    kind = "crank"
+
+    def __init__(self, name, about, length, angle, body):
+        self.point, self.about, self.needs = name, about, (about,)
+        self.length, self.angle, self.body = _Scalar(length, f"crank {name} length"), angle, body
+        self.pivot_zero = (False, False)  # set by the plan (a ground pivot at a literal 0 adds nothing)
+
+    def angle_names(self):
+        return (self.angle,) if self.angle else ()
+
+    def evaluate(self, env, i):
+        xp, r = env.xp, self.length(env.xp, env.p)
+        x, y = r * xp.cos(env.theta2), r * xp.sin(env.theta2)
+        o = env.pts[self.about]
+        x = x if self.pivot_zero[0] else o[0] + x
+        y = y if self.pivot_zero[1] else o[1] + y
+        env.pts[self.point] = (x, y)
+        env.rays[(self.about, self.point)] = env.theta2
+        if self.angle:
+            env.angles[self.angle] = env.theta2
+
+
+class _RRR(_Element):
+    kind = "rrr"
+
+    def __init__(self, name, first, second, sign, around, angles, margin, bodies):
+        (self.p_, a), (self.q_, b) = _pair(first, f"rrr {name}"), _pair(second, f"rrr {name}")
+        self.point, self.needs = name, (self.p_, self.q_)
+        self.a, self.b = _Scalar(a, f"rrr {name} first length"), _Scalar(b, f"rrr {name} second length")
+        self.sign, self.around = _Scalar(sign, f"rrr {name} sign"), float(around)
+        self.angles = (_theta(a), _theta(b)) if angles == "default" else tuple(angles)
+        self.margin = self.margin_given = margin  # the default name is set by the plan
+        self.bodies = tuple(bodies)
+
+    def angle_names(self):
+        return tuple(a for a in self.angles if a)
+
+    def joints(self):
+        return (self.point,)
+
+    def margin_names(self):
+        return (self.margin,)
+
+    def evaluate(self, env, i):
+        xp, p, pts = env.xp, env.p, env.pts
+        P, Q = pts[self.p_], pts[self.q_]
+        x, ang_q, m = cl.circle_circle(xp, P, self.a(xp, p), Q, self.b(xp, p), self.sign(xp, p), self.around)
+        pts[self.point] = x
+        env.rays[(self.q_, self.point)] = ang_q
+        env.rays[(self.p_, self.point)] = _Lazy(lambda: xp.atan2(x[1] - P[1], x[0] - P[0]))
+        for name, ray in zip(self.angles, ((self.p_, self.point), (self.q_, self.point)), strict=True):
+            if name:
+                env.angles[name] = env.ray(*ray)
+        env.trans[i] = [(self.point, cl.joint_lines(P, Q, x))]
+        env.margins[i] = [(self.margin, m)]
+
+
+class _RRP(_Element):
+    kind = "rrp"
+
+    def __init__(self, name, rod, line_y, sign, angle, margin, bodies):
+        self.pin, r = _pair(rod, f"rrp {name}")
+        self.point, self.needs = name, (self.pin,)
+        self.r, self.h = _Scalar(r, f"rrp {name} rod length"), _Scalar(line_y, f"rrp {name} line_y")
+        self.sign = _Scalar(sign, f"rrp {name} sign")
+        self.angle = _theta(r) if angle == "default" else angle
+        self.margin = margin or f"rod {self.pin}{name} reaching the slide line"
+        self.bodies = tuple(bodies)
+
+    def angle_names(self):
+        return (self.angle,) if self.angle else ()
+
+    def joints(self):
+        return (self.point,)
+
+    def margin_names(self):
+        return (self.margin,)
+
+    def evaluate(self, env, i):
+        xp, p = env.xp, env.p
+        c = env.pts[self.pin]
+        d, m = cl.rod_to_line(xp, c, self.r(xp, p), self.h(xp, p), self.sign(xp, p))
+        env.pts[self.point] = d
+        env.rays[(self.pin, self.point)] = _Lazy(lambda: xp.atan2(d[1] - c[1], d[0] - c[0]))
+        if self.angle:
+            env.angles[self.angle] = env.ray(self.pin, self.point)
+        env.trans[i] = [(self.point, cl.rod_lines(c, d))]
+        env.margins[i] = [(self.margin, m)]
+
+
+class _RPR(_Element):
+    kind = "rpr"
+
+    def __init__(self, pin, pivot, angle, bodies):
+        self.pin, self.pivot, self.needs = pin, pivot, (pin, pivot)
+        self.angle, self.bodies = angle, tuple(bodies)
+
+    def angle_names(self):
+        return (self.angle,) if self.angle else ()
+
+    def joints(self):
+        return (self.pin,)
+
+    def evaluate(self, env, i):
+        theta = cl.pin_in_slot(env.xp, env.pts[self.pivot], env.pts[self.pin])
+        env.rays[(self.pivot, self.pin)] = theta
+        if self.angle:
+            env.angles[self.angle] = theta
+        env.trans[i] = [(self.pin, cl.RIGHT_ANGLE)]
+
+
+class _RPP(_Element):
+    kind = "rpp"
+
+    def __init__(self, pin, body):
+        self.pin, self.needs, self.body = pin, (pin,), body
+
+    def joints(self):
+        return (self.pin,)
+
+    def evaluate(self, env, i):
+        env.trans[i] = [(self.pin, cl.RIGHT_ANGLE)]
+
+
+class _SlotLine(_Element):
+    kind = "slot_line"
+
+    def __init__(self, name, lever, line_y, margin, body):
+        if not isinstance(lever, (tuple, list)) or len(lever) != 2 or not all(isinstance(j, str) for j in lever):
+            raise LinkageError(f"slot_line {name!r}: the lever is (pivot, through), got {lever!r}")
+        self.pivot, self.through = lever
+        self.point, self.needs = name, (self.pivot, self.through)
+        self.h, self.margin, self.body = _Scalar(line_y, f"slot_line {name} line_y"), margin, body
+
+    def joints(self):
+        return (self.point,)
+
+    def margin_names(self):
+        return (self.margin,) if self.margin else ()
+
+    def evaluate(self, env, i):
+        o, a = env.pts[self.pivot], env.pts[self.through]
+        d, t = cl.slot_to_line(env.xp, o, a, self.h(env.xp, env.p))
+        env.pts[self.point] = d
+        env.rays[(self.pivot, self.point)] = _Lazy(lambda: env.ray(self.pivot, self.through))
+        env.trans[i] = [(self.point, cl.slot_line_lines(o, a))]
+        if self.margin:
+            env.margins[i] = [(self.margin, t)]
+
+
+class _OnBody(_Element):
+    kind = "on_ray"
+
+    def __init__(self, name, origin, through, length, angle):
+        self.point, self.origin, self.through, self.needs = name, origin, through, (origin, through)
+        self.length = _Scalar(length, f"{name} length")
+        self.offset = None if angle is None else _Scalar(angle, f"{name} angle")
+        if self.offset is not None:
+            self.kind = "coupler_point"
+
+    def evaluate(self, env, i):
+        phi = env.ray(self.origin, self.through)
+        if self.offset is not None:
+            phi = phi + self.offset(env.xp, env.p)
+        env.pts[self.point] = cl.on_ray(env.xp, env.pts[self.origin], phi, self.length(env.xp, env.p))
+        env.rays[(self.origin, self.point)] = phi
+
+
+def _pair(v, what):
+    if not isinstance(v, (tuple, list)) or len(v) != 2 or not isinstance(v[0], str):
+        raise LinkageError(f"{what}: a (joint, length) pair, got {v!r}")
+    return v[0], v[1]
+
+
+# ---- the linkage --------------------------------------------------------------------------------------------------
+class Linkage:
+    """A planar one-degree-of-freedom linkage declared element by element (see the module docstring)."""
+
+    def __init__(self):
+        self._elements: list[_Element] = []
+        self._output: str | None = None
+        self._plan: tuple | None = None
+
+    # -- declarations
+    def _add(self, e: _Element) -> Linkage:
+        taken = {x.point for x in self._elements if x.point}
+        if e.point is not None:
+            if not isinstance(e.point, str) or not e.point:
+                raise LinkageError(f"a joint is named by a non-empty string, got {e.point!r}")
+            if e.point in taken:
+                raise LinkageError(f"joint {e.point!r} is placed twice")
+        angles = [a for x in self._elements for a in x.angle_names()]
+        for a in e.angle_names():
+            if a in angles:
+                raise LinkageError(f"angle {a!r} is defined twice")
+        joints = [j for x in self._elements for j in x.joints()]
+        for j in e.joints():
+            if j in joints:
+                raise LinkageError(f"joint {j!r} has two transmission rules")
+        margins = [m for x in self._elements for m in x.margin_names() if m]
+        for m in e.margin_names():
+            if m and m in margins:
+                raise LinkageError(f"margin {m!r} is recorded twice")
+        self._elements.append(e)
+        self._plan = None
+        return self
+
+    def ground(self, name: str, xy) -> Linkage:
+        """A frame pivot at (x, y): numbers, parameter names or linear expressions ('-r1 + h')."""
+        return self._add(_Ground(name, xy))
+
+    def crank(self, name: str, about: str, length, angle: str = "theta2", body: str = "crank") -> Linkage:
+        """The input crank: pin ``name`` at ``length`` from the ground pivot ``about`` along theta2."""
+        if any(e.kind == "crank" for e in self._elements):
+            raise LinkageError("a one-degree-of-freedom linkage has one crank")
+        return self._add(_Crank(name, about, length, angle, body))
+
+    def rrr(
+        self,
+        name: str,
+        first,
+        second,
+        sign="sigma",
+        around: float = 0.0,
+        angles="default",
+        margin: str | None = None,
+        bodies=("coupler", "follower"),
+    ) -> Linkage:
+        """RRR: joint ``name`` at distance a from P and b from Q, ``first = (P, a)`` (the driving side),
+        ``second = (Q, b)``, on the branch ``sign`` = sign((P - Q) x (X - Q)). ``angles``: names of P->X and Q->X
+        (None to skip; default theta<k> for lengths r<k>); ``margin``: its name (default: see the module)."""
+        e = _RRR(name, first, second, sign, around, angles, margin, bodies)
+        if len(e.angles) != 2 or len(e.bodies) != 2:
+            raise LinkageError(f"rrr {name!r}: angles and bodies are pairs (P->X, Q->X)")
+        return self._add(e)
+
+    def rrp(
+        self,
+        name: str,
+        rod,
+        line_y,
+        sign="sigma_slider",
+        angle="default",
+        margin: str | None = None,
+        bodies=("rod", "ram"),
+    ) -> Linkage:
+        """RRP: slider ``name`` on the slide line y = ``line_y`` (along +x) driven by the rod ``rod = (P, r)``;
+        ``sign`` +1 puts it on the +x side of P. ``angle``: the rod's angle P->X (default theta<k> for r<k>)."""
+        return self._add(_RRP(name, rod, line_y, sign, angle, margin, bodies))
+
+    def rpr(self, pin: str, pivot: str, angle: str = "theta4", bodies=("block", "lever")) -> Linkage:
+        """RPR: the block on ``pin`` in a slotted lever turning about the ground ``pivot``; defines the lever's
+        angle pivot->pin (``angle``)."""
+        return self._add(_RPR(pin, pivot, angle, bodies))
+
+    def rpp(self, pin: str, body: str = "yoke") -> Linkage:
+        """RPP: a yoke, the pin in a slot normal to the slide line; the ram follows the pin's x (``output(pin)``)."""
+        return self._add(_RPP(pin, body))
+
+    def slot_line(self, name: str, lever, line_y, margin: str | None = None, body: str = "ram") -> Linkage:
+        """A pin on two lines: ``name`` rides in the slotted lever ``lever = (pivot, through)`` and on the slide line
+        y = ``line_y``. ``margin``: record t >= 0 (the pin on the pivot's ray) under this name (default none)."""
+        return self._add(_SlotLine(name, lever, line_y, margin, body))
+
+    def on_ray(self, name: str, origin: str, through: str, length) -> Linkage:
+        """A point fixed on the body carrying ``origin`` and ``through``, at ``length`` along origin->through."""
+        return self._add(_OnBody(name, origin, through, length, None))
+
+    def coupler_point(self, name: str, origin: str, through: str, length, angle) -> Linkage:
+        """A point fixed on the body carrying ``origin`` and ``through``, at ``length`` from origin and ``angle``
+        (rad, counter-clockwise) from the ray origin->through: P = A + r5 (cos(theta3 + beta), sin(theta3 + beta))."""
+        return self._add(_OnBody(name, origin, through, length, angle))
+
+    def output(self, name: str) -> Linkage:
+        """The output: a point's x (a ram on a +x slide line) or a declared angle (a follower's theta4)."""
+        if not isinstance(name, str):
+            raise LinkageError(f"output: a joint or angle name, got {name!r}")
+        self._output, self._plan = name, None
+        return self
+
+    # -- the plan: evaluation order and checks
+    def _build(self) -> tuple:
+        if self._plan is not None:
+            return self._plan
+        els = self._elements
+        placed = {e.point: i for i, e in enumerate(els) if e.point}
+        for e in els:
+            for j in e.needs:
+                if j not in placed:
+                    raise LinkageError(f"{e.kind} {e.point or getattr(e, 'pin', '')!r} reads joint {j!r}, never placed")
+        if not any(e.kind == "crank" for e in els):
+            raise LinkageError("a linkage needs a crank")
+        angles = [a for e in els for a in e.angle_names()]
+        if self._output is None:
+            raise LinkageError("no output: call output(joint or angle)")
+        if self._output not in placed and self._output not in angles:
+            raise LinkageError(f"output {self._output!r} is neither a placed joint nor a declared angle")
+        for e in els:
+            if e.kind == "crank":
+                pivot = els[placed[e.about]]
+                if pivot.kind != "ground":
+                    raise LinkageError(f"crank {e.point!r} turns about {e.about!r}, which is not a ground pivot")
+                e.pivot_zero = (pivot.xy[0].zero, pivot.xy[1].zero)
+        order, done, visiting = [], set(), set()
+
+        def visit(i):
+            if i in done:
+                return
+            if i in visiting:
+                raise LinkageError(f"joint {els[i].point!r} depends on itself")
+            visiting.add(i)
+            for j in els[i].needs:
+                visit(placed[j])
+            visiting.discard(i)
+            done.add(i)
+            order.append(i)
+
+        for i in range(len(els)):
+            visit(i)
+        cranks = {e.point for e in els if e.kind == "crank"}
+        grounds = {e.point for e in els if e.kind == "ground"}
+        for e in els:
+            if e.kind == "rrr":
+                four = e.p_ in cranks and e.q_ in grounds
+                e.margin = e.margin_given or (f"four-bar closure at {e.point}" if four else f"closure at {e.point}")
+        self._plan = (tuple(order), self._bodies(order))
+        return self._plan
+
+    def _bodies(self, order) -> tuple:
+        els = self._elements
+        bodies: list = []  # [declaration index, sub-index, name, joints, kind]
+
+        def carrier(a, b, who):
+            for body in bodies:
+                if body[4] in ("bar", "plate", "slot-lever") and a in body[3] and b in body[3]:
+                    return body
+            raise LinkageError(f"{who}: no link carries both {a!r} and {b!r}")
+
+        for i in order:
+            e = els[i]
+            if e.kind == "crank":
+                bodies.append([i, 0, e.body, [e.about, e.point], "bar"])
+            elif e.kind == "rrr":
+                bodies.append([i, 0, e.bodies[0], [e.p_, e.point], "bar"])
+                bodies.append([i, 1, e.bodies[1], [e.q_, e.point], "bar"])
+            elif e.kind == "rrp":
+                bodies.append([i, 0, e.bodies[0], [e.pin, e.point], "bar"])
+                bodies.append([i, 1, e.bodies[1], [e.point], "ram"])
+            elif e.kind == "rpr":
+                bodies.append([i, 0, e.bodies[0], [e.pin, e.pivot], "block"])
+                bodies.append([i, 1, e.bodies[1], [e.pivot, e.pin], "slot-lever"])
+            elif e.kind == "rpp":
+                bodies.append([i, 0, e.body, [e.pin], "yoke"])
+            elif e.kind == "slot_line":
+                carrier(e.pivot, e.through, f"slot_line {e.point!r}")[3].append(e.point)
+                bodies.append([i, 0, e.body, [e.point], "ram"])
+            elif e.kind in ("on_ray", "coupler_point"):
+                body = carrier(e.origin, e.through, f"{e.kind} {e.point!r}")
+                body[3].append(e.point)
+                if e.kind == "coupler_point" and body[4] == "bar":
+                    body[4] = "plate"
+        bodies.sort(key=lambda b: (b[0], b[1]))
+        names = [b[2] for b in bodies]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise LinkageError(f"body names {dup} are used twice: name the dyads' bodies (bodies=...)")
+        return tuple(Body(name, tuple(joints), kind) for _, _, name, joints, kind in bodies)
+
+    # -- what a type reads
+    def loop(self, xp, theta2, p) -> Loop:
+        """The closed-form loop at crank angle theta2 with parameters p in the math namespace xp (a type's
+        ``loop = staticmethod(L.loop)``)."""
+        order, _ = self._build()
+        env = _Env(xp, theta2, p)
+        for i in order:
+            self._elements[i].evaluate(env, i)
+        els = range(len(self._elements))
+        angles_order = [a for e in self._elements for a in e.angle_names()]
+        out = self._output
+        x = env.pts[out][0] if out in env.pts else env.angles[out]
+        return Loop(
+            points={e.point: env.pts[e.point] for e in self._elements if e.point},
+            angles={a: env.angles[a] for a in angles_order},
+            x=x,
+            transmission={j: lines for i in els for j, lines in env.trans.get(i, ())},
+            margins=[m for i in els for m in env.margins.get(i, ())],
+        )
+
+    def bodies(self) -> tuple[Body, ...]:
+        """Every moving body (``Body``), in the order the elements that make them were declared."""
+        return self._build()[1]
+
+    def ground_joints(self) -> tuple[str, ...]:
+        """The frame pivots, in declaration order (a type's GROUND)."""
+        return tuple(e.point for e in self._elements if e.kind == "ground")
+
+    def output_joint(self) -> str | None:
+        """The joint whose x is the output (a type's OUTPUT_JOINT); None for an angle output."""
+        self._build()
+        return self._output if any(e.point == self._output for e in self._elements) else None
+
+    def parameters(self) -> tuple[str, ...]:
+        """The parameter names the linkage reads, in first-use order (declaration order)."""
+        names: list[str] = []
+        for e in self._elements:
+            for v in vars(e).values():
+                for s in v if isinstance(v, tuple) else (v,):
+                    if isinstance(s, _Scalar):
+                        names += s.names
+        return tuple(dict.fromkeys(names))
