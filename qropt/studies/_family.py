@@ -209,7 +209,7 @@ def family(
     arclength step (default 1/200 of the free box's diagonal; at least MIN_DS of it, and 1e-12 of the largest
     bound, so that points differ); max_points: the most points one trace takes (at most MAX_POINTS);
     starts_n, seed: the Sobol seeds of the branches; progress: callable(points traced);
-    solver: whose formulations to use (default ``qropt.solve.DEFAULT``).
+    solver: whose formulations to use (default ``qropt.synthesis.solver.DEFAULT``).
     """
     if not isinstance(problem, Problem):
         raise ProblemError(f"family takes a qropt.Problem, got {type(problem).__name__}")
