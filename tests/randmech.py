@@ -7,6 +7,7 @@ import numpy as np
 import qropt
 
 KINDS = ("slider-crank", "crank-shaper", "whitworth", "crank-rocker-slider", "drag-link-slider", "four-bar")
+SIXBARS = ("coupler-slider", "slot-ram-shaper")  # drawn too (their brute force is sixbar_*)
 
 
 def _draw(kind, rng):
@@ -32,7 +33,24 @@ def _draw(kind, rng):
             "h": u(-0.1, 0.1) * r5,
             "sigma_slider": rng.choice([-1.0, 1.0]),
         }
+    if kind == "slot-ram-shaper":
+        r1 = u(0.1, 1.0)
+        return {"r1": r1, "r2": r1 * u(0.05, 0.9), "h": r1 * u(0.1, 3.0)}
     r = u(0.1, 1.0, size=4)
+    if kind == "coupler-slider":  # a crank-rocker or a drag-link four-bar, a coupler point, a long rod
+        r[int(rng.random() < 0.5)] = r.min() * u(0.3, 0.95)
+        return {
+            "r1": r[0],
+            "r2": r[1],
+            "r3": r[2],
+            "r4": r[3],
+            "r5": u(0.2, 1.2) * r[2],
+            "beta": u(-np.pi, np.pi),
+            "r6": u(2.0, 4.0),
+            "h": u(-0.5, 0.5),
+            "sigma": rng.choice([-1.0, 1.0]),
+            "sigma_slider": rng.choice([-1.0, 1.0]),
+        }
     if kind in ("crank-rocker-slider", "four-bar"):
         r[1] = r.min() * u(0.3, 0.99)
     else:
@@ -47,6 +65,8 @@ def _one_reversal(kind, p):
     """True if the brute-force output rises once and falls once per turn (a proper quick-return)."""
     from tests import brute
 
+    if kind in SIXBARS:
+        return brute.sixbar_reversals(kind, p) == 1
     if kind == "four-bar":
         g = brute.output(kind, p, brute.TH)
         return int(np.count_nonzero(np.sign(g) != np.sign(np.roll(g, -1)))) == 2
