@@ -4,7 +4,9 @@ A ``Linkage`` is built from a frame, a crank and dyads, each named after the joi
 ``shared/CONVENTIONS.md``: x to the right, y up, theta2 counter-clockwise from +x; a link angle is the direction
 from its first-named joint to its second, e.g. theta3 = A->B). Its ``loop(xp, theta2, p)`` is the same closed-form
 loop a type would write by hand, built from the closures of ``qropt.kinematics.closures`` only, so it runs on numpy
-arrays, Taylor jets and CasADi symbols alike (no branching on values). A type then says::
+arrays, Taylor jets and CasADi symbols alike (no branching on values). It is generated once, on first use, as
+one straight-line Python function (every expression spelled out, nothing interpreted per evaluation), so it costs
+what the hand-written loop did. A type then says::
 
     L = Linkage()
     L.ground("O2", (0, 0))
@@ -105,6 +107,7 @@ class _Scalar:
         self.spec, self.names, self.zero = spec, (), False
         if callable(spec):
             self.f = lambda xp, p: spec(xp, p)
+            self.code = None  # the compiled loop calls it: f(xp, p)
             return
         if isinstance(spec, bool) or not isinstance(spec, (int, float, str)):
             raise LinkageError(f"{what}: a number, a parameter name, a linear expression or f(xp, p); got {spec!r}")
@@ -112,6 +115,7 @@ class _Scalar:
             v = float(spec)
             self.zero = v == 0.0
             self.f = lambda xp, p: v
+            self.code = repr(v)
             return
         terms, pos = [], 0
         while pos < len(spec):
@@ -139,6 +143,17 @@ class _Scalar:
             return out
 
         self.f = f
+        code = ""
+        for k, (sign, coef, name) in enumerate(terms):  # the same operations, in the same order, as f
+            neg = sign == "-" and k == 0
+            if name is None:
+                v = repr(-coef if neg else coef)
+            elif coef is None:
+                v = f"(-p[{name!r}])" if neg else f"p[{name!r}]"
+            else:
+                v = f"({(-coef if neg else coef)!r} * p[{name!r}])"
+            code = v if k == 0 else f"({code} {'-' if sign == '-' else '+'} {v})"
+        self.code = code
 
     def __call__(self, xp, p):
         return self.f(xp, p)
@@ -147,36 +162,6 @@ class _Scalar:
 def _theta(length) -> str | None:
     """theta<k> for a length named r<k> (the hand-written loops' names), else None."""
     return f"theta{length[1:]}" if isinstance(length, str) and re.fullmatch(r"r\d+", length) else None
-
-
-class _Lazy:
-    """An angle computed on first use (a ray's atan2 that only a recorded angle or a fixed point reads)."""
-
-    __slots__ = ("f",)
-
-    def __init__(self, f):
-        self.f = f
-
-
-# ---- evaluation environment ---------------------------------------------------------------------------------------
-class _Env:
-    def __init__(self, xp, theta2, p):
-        self.xp, self.theta2, self.p = xp, theta2, p
-        self.pts: dict = {}
-        self.rays: dict = {}  # (origin, through) -> angle, or a thunk computing it on first use
-        self.angles: dict = {}
-        self.trans: dict = {}  # element index -> [(joint, lines)]
-        self.margins: dict = {}  # element index -> [(name, value)]
-
-    def ray(self, origin: str, through: str):
-        """The angle of the ray origin->through: the one a dyad defined, else atan2 of the two points."""
-        v = self.rays.get((origin, through))
-        if v is None:
-            v = cl.pin_in_slot(self.xp, self.pts[origin], self.pts[through])
-        elif isinstance(v, _Lazy):
-            v = v.f()
-        self.rays[(origin, through)] = v
-        return v
 
 
 # ---- elements -----------------------------------------------------------------------------------------------------
@@ -195,9 +180,6 @@ class _Element:
     def margin_names(self) -> tuple:
         return ()
 
-    def evaluate(self, env: _Env, i: int) -> None:  # pragma: no cover - abstract
-        raise NotImplementedError
-
 
 class _Ground(_Element):
     kind = "ground"
@@ -206,9 +188,6 @@ class _Ground(_Element):
         if not isinstance(xy, (tuple, list)) or len(xy) != 2:
             raise LinkageError(f"ground {name!r}: coordinates are a pair (x, y), got {xy!r}")
         self.point, self.xy = name, (_Scalar(xy[0], f"ground {name} x"), _Scalar(xy[1], f"ground {name} y"))
-
-    def evaluate(self, env, i):
-        env.pts[self.point] = (self.xy[0](env.xp, env.p), self.xy[1](env.xp, env.p))
 
 
 class _Crank(_Element):
@@ -221,17 +200,6 @@ class _Crank(_Element):
 
     def angle_names(self):
         return (self.angle,) if self.angle else ()
-
-    def evaluate(self, env, i):
-        xp, r = env.xp, self.length(env.xp, env.p)
-        x, y = r * xp.cos(env.theta2), r * xp.sin(env.theta2)
-        o = env.pts[self.about]
-        x = x if self.pivot_zero[0] else o[0] + x
-        y = y if self.pivot_zero[1] else o[1] + y
-        env.pts[self.point] = (x, y)
-        env.rays[(self.about, self.point)] = env.theta2
-        if self.angle:
-            env.angles[self.angle] = env.theta2
 
 
 class _RRR(_Element):
@@ -255,19 +223,6 @@ class _RRR(_Element):
     def margin_names(self):
         return (self.margin,)
 
-    def evaluate(self, env, i):
-        xp, p, pts = env.xp, env.p, env.pts
-        P, Q = pts[self.p_], pts[self.q_]
-        x, ang_q, m = cl.circle_circle(xp, P, self.a(xp, p), Q, self.b(xp, p), self.sign(xp, p), self.around)
-        pts[self.point] = x
-        env.rays[(self.q_, self.point)] = ang_q
-        env.rays[(self.p_, self.point)] = _Lazy(lambda: xp.atan2(x[1] - P[1], x[0] - P[0]))
-        for name, ray in zip(self.angles, ((self.p_, self.point), (self.q_, self.point)), strict=True):
-            if name:
-                env.angles[name] = env.ray(*ray)
-        env.trans[i] = [(self.point, cl.joint_lines(P, Q, x))]
-        env.margins[i] = [(self.margin, m)]
-
 
 class _RRP(_Element):
     kind = "rrp"
@@ -290,17 +245,6 @@ class _RRP(_Element):
     def margin_names(self):
         return (self.margin,)
 
-    def evaluate(self, env, i):
-        xp, p = env.xp, env.p
-        c = env.pts[self.pin]
-        d, m = cl.rod_to_line(xp, c, self.r(xp, p), self.h(xp, p), self.sign(xp, p))
-        env.pts[self.point] = d
-        env.rays[(self.pin, self.point)] = _Lazy(lambda: xp.atan2(d[1] - c[1], d[0] - c[0]))
-        if self.angle:
-            env.angles[self.angle] = env.ray(self.pin, self.point)
-        env.trans[i] = [(self.point, cl.rod_lines(c, d))]
-        env.margins[i] = [(self.margin, m)]
-
 
 class _RPR(_Element):
     kind = "rpr"
@@ -315,13 +259,6 @@ class _RPR(_Element):
     def joints(self):
         return (self.pin,)
 
-    def evaluate(self, env, i):
-        theta = cl.pin_in_slot(env.xp, env.pts[self.pivot], env.pts[self.pin])
-        env.rays[(self.pivot, self.pin)] = theta
-        if self.angle:
-            env.angles[self.angle] = theta
-        env.trans[i] = [(self.pin, cl.RIGHT_ANGLE)]
-
 
 class _RPP(_Element):
     kind = "rpp"
@@ -331,9 +268,6 @@ class _RPP(_Element):
 
     def joints(self):
         return (self.pin,)
-
-    def evaluate(self, env, i):
-        env.trans[i] = [(self.pin, cl.RIGHT_ANGLE)]
 
 
 class _SlotLine(_Element):
@@ -352,15 +286,6 @@ class _SlotLine(_Element):
     def margin_names(self):
         return (self.margin,) if self.margin else ()
 
-    def evaluate(self, env, i):
-        o, a = env.pts[self.pivot], env.pts[self.through]
-        d, t = cl.slot_to_line(env.xp, o, a, self.h(env.xp, env.p))
-        env.pts[self.point] = d
-        env.rays[(self.pivot, self.point)] = _Lazy(lambda: env.ray(self.pivot, self.through))
-        env.trans[i] = [(self.point, cl.slot_line_lines(o, a))]
-        if self.margin:
-            env.margins[i] = [(self.margin, t)]
-
 
 class _OnBody(_Element):
     kind = "on_ray"
@@ -371,13 +296,6 @@ class _OnBody(_Element):
         self.offset = None if angle is None else _Scalar(angle, f"{name} angle")
         if self.offset is not None:
             self.kind = "coupler_point"
-
-    def evaluate(self, env, i):
-        phi = env.ray(self.origin, self.through)
-        if self.offset is not None:
-            phi = phi + self.offset(env.xp, env.p)
-        env.pts[self.point] = cl.on_ray(env.xp, env.pts[self.origin], phi, self.length(env.xp, env.p))
-        env.rays[(self.origin, self.point)] = phi
 
 
 def _pair(v, what):
@@ -537,8 +455,116 @@ class Linkage:
             if e.kind == "rrr":
                 four = e.p_ in cranks and e.q_ in grounds
                 e.margin = e.margin_given or (f"four-bar closure at {e.point}" if four else f"closure at {e.point}")
-        self._plan = (tuple(order), self._bodies(order))
+        self._plan = (tuple(order), self._bodies(order), self._compile(order))
         return self._plan
+
+    def _compile(self, order):
+        """The loop as one straight-line Python function, generated once from the plan: the closures' calls in
+        dependency order with every expression spelled out (no interpretation per evaluation)."""
+        els, lines, ns = self._elements, [], {"cl": cl, "Loop": Loop}
+        var = {e.point: f"_p{i}" for i, e in enumerate(els) if e.point}
+        rays: dict = {}  # (origin, through) -> variable name, or ("lazy", code) computed on first use
+        angles: dict = {}
+        trans: dict = {}  # element index -> [(joint, code)]
+        margins: dict = {}  # element index -> [(name, variable)]
+        tmp = iter(range(1 << 30))
+
+        def new():
+            return f"_t{next(tmp)}"
+
+        def scalar(sc):
+            if sc.code is not None:
+                return sc.code
+            name = f"_f{next(tmp)}"
+            ns[name] = sc.f
+            return f"{name}(xp, p)"
+
+        def ray(o, t):
+            v = rays.get((o, t))
+            if v is None:
+                v = new()
+                lines.append(f"{v} = cl.pin_in_slot(xp, {var[o]}, {var[t]})")
+            elif isinstance(v, tuple):
+                code = v[1]() if callable(v[1]) else v[1]
+                v = new()
+                lines.append(f"{v} = {code}")
+            rays[(o, t)] = v
+            return v
+
+        def atan2(frm, to):
+            a, b = var[frm], var[to]
+            return ("lazy", f"xp.atan2({b}[1] - {a}[1], {b}[0] - {a}[0])")
+
+        for i in order:
+            e, X = els[i], var.get(els[i].point)
+            if e.kind == "ground":
+                lines.append(f"{X} = ({scalar(e.xy[0])}, {scalar(e.xy[1])})")
+            elif e.kind == "crank":
+                r, o = new(), var[e.about]
+                lines.append(f"{r} = {scalar(e.length)}")
+                x = f"{r} * xp.cos(theta2)" if e.pivot_zero[0] else f"{o}[0] + {r} * xp.cos(theta2)"
+                y = f"{r} * xp.sin(theta2)" if e.pivot_zero[1] else f"{o}[1] + {r} * xp.sin(theta2)"
+                lines.append(f"{X} = ({x}, {y})")
+                rays[(e.about, e.point)] = "theta2"
+                if e.angle:
+                    angles[e.angle] = "theta2"
+            elif e.kind == "rrr":
+                P, Q, aq, m = var[e.p_], var[e.q_], new(), new()
+                args = f"{scalar(e.a)}, {Q}, {scalar(e.b)}, {scalar(e.sign)}, {e.around!r}"
+                lines.append(f"{X}, {aq}, {m} = cl.circle_circle(xp, {P}, {args})")
+                rays[(e.q_, e.point)] = aq
+                rays[(e.p_, e.point)] = atan2(e.p_, e.point)
+                for name, r in zip(e.angles, ((e.p_, e.point), (e.q_, e.point)), strict=True):
+                    if name:
+                        angles[name] = ray(*r)
+                trans[i] = [(e.point, f"cl.joint_lines({P}, {Q}, {X})")]
+                margins[i] = [(e.margin, m)]
+            elif e.kind == "rrp":
+                c, m = var[e.pin], new()
+                args = f"{scalar(e.r)}, {scalar(e.h)}, {scalar(e.sign)}"
+                lines.append(f"{X}, {m} = cl.rod_to_line(xp, {c}, {args})")
+                rays[(e.pin, e.point)] = atan2(e.pin, e.point)
+                if e.angle:
+                    angles[e.angle] = ray(e.pin, e.point)
+                trans[i] = [(e.point, f"cl.rod_lines({c}, {X})")]
+                margins[i] = [(e.margin, m)]
+            elif e.kind == "rpr":
+                t = new()
+                lines.append(f"{t} = cl.pin_in_slot(xp, {var[e.pivot]}, {var[e.pin]})")
+                rays[(e.pivot, e.pin)] = t
+                if e.angle:
+                    angles[e.angle] = t
+                trans[i] = [(e.pin, "cl.RIGHT_ANGLE")]
+            elif e.kind == "rpp":
+                trans[i] = [(e.pin, "cl.RIGHT_ANGLE")]
+            elif e.kind == "slot_line":
+                o, a, t = var[e.pivot], var[e.through], new()
+                lines.append(f"{X}, {t} = cl.slot_to_line(xp, {o}, {a}, {scalar(e.h)})")
+                rays[(e.pivot, e.point)] = ("lazy", lambda e=e: ray(e.pivot, e.through))
+                trans[i] = [(e.point, f"cl.slot_line_lines({o}, {a})")]
+                if e.margin:
+                    margins[i] = [(e.margin, t)]
+            else:  # on_ray, coupler_point
+                phi = ray(e.origin, e.through)
+                if e.offset is not None:
+                    v = new()
+                    lines.append(f"{v} = {phi} + {scalar(e.offset)}")
+                    phi = v
+                lines.append(f"{X} = cl.on_ray(xp, {var[e.origin]}, {phi}, {scalar(e.length)})")
+                rays[(e.origin, e.point)] = phi
+        out = self._output
+        x = f"{var[out]}[0]" if out in var else angles[out]
+        n = range(len(els))
+        points = ", ".join(f"{e.point!r}: {var[e.point]}" for e in els if e.point)
+        angs = ", ".join(f"{a!r}: {angles[a]}" for e in els for a in e.angle_names())
+        tr = ", ".join(f"{j!r}: {c}" for i in n for j, c in trans.get(i, ()))
+        mg = ", ".join(f"({k!r}, {v})" for i in n for k, v in margins.get(i, ()))
+        body = "\n    ".join([*lines, f"return Loop({{{points}}}, {{{angs}}}, {x}, {{{tr}}}, [{mg}])"])
+        src = f"def loop(xp, theta2, p):\n    {body}\n"
+        exec(compile(src, f"<linkage loop {id(self):#x}>", "exec"), ns)  # noqa: S102 - our own generated source
+        fn = ns["loop"]
+        fn.source = src
+        return fn
 
     def _bodies(self, order) -> tuple:
         els = self._elements
@@ -584,21 +610,7 @@ class Linkage:
     def loop(self, xp, theta2, p) -> Loop:
         """The closed-form loop at crank angle theta2 with parameters p in the math namespace xp (a type's
         ``loop = staticmethod(L.loop)``)."""
-        order, _ = self._build()
-        env = _Env(xp, theta2, p)
-        for i in order:
-            self._elements[i].evaluate(env, i)
-        els = range(len(self._elements))
-        angles_order = [a for e in self._elements for a in e.angle_names()]
-        out = self._output
-        x = env.pts[out][0] if out in env.pts else env.angles[out]
-        return Loop(
-            points={e.point: env.pts[e.point] for e in self._elements if e.point},
-            angles={a: env.angles[a] for a in angles_order},
-            x=x,
-            transmission={j: lines for i in els for j, lines in env.trans.get(i, ())},
-            margins=[m for i in els for m in env.margins.get(i, ())],
-        )
+        return (self._plan or self._build())[2](xp, theta2, p)
 
     def bodies(self) -> tuple[Body, ...]:
         """Every moving body (``Body``), in the order the elements that make them were declared."""

@@ -4,9 +4,12 @@ through the rod PD on the slide line y = h."""
 from __future__ import annotations
 
 from qropt.errors import GrashofError
-from qropt.kinematics.closures import joint_lines, rod_lines, rod_to_line
-from qropt.mechanisms.base import REQUIRED, Body, Loop
-from qropt.mechanisms.four_bar import SHORTEST, _FourBarBase, four_bar, grashof_rules
+from qropt.mechanisms.base import REQUIRED
+from qropt.mechanisms.four_bar import SHORTEST, _FourBarBase, four_bar_linkage, grashof_rules
+
+# the coupler point P at r5 from A, beta off A->B (the coupler a ternary plate ABP), the rod PD to the ram on y = h
+LINKAGE = four_bar_linkage().coupler_point("P", "A", "B", "r5", angle="beta")
+LINKAGE.rrp("D", ("P", "r6"), line_y="h", sign="sigma_slider").output("D")
 
 
 class CouplerSlider(_FourBarBase):
@@ -32,15 +35,8 @@ class CouplerSlider(_FourBarBase):
     # B's coupler-follower angle depends on |O4A| only, extreme with the crank along the ground line: as the four-bar
     # sliders (EXACT_TRANSMISSION), and the Grashof rules make the four-bar assemble (RULED_MARGINS), both inherited.
     ACCEL_EXTREMES = 6  # a coupler point's path adds acceleration extremes beyond the four-bar sliders' four
-    BODIES = (
-        Body("crank", ("O2", "A"), "bar"),
-        Body("coupler", ("A", "B", "P"), "plate"),  # ternary: the rigid union of bars AB and AP
-        Body("follower", ("O4", "B"), "bar"),
-        Body("rod", ("P", "D"), "bar"),
-        Body("ram", ("D",), "ram"),
-    )
-    GROUND = ("O2", "O4")
-    OUTPUT_JOINT = "D"
+    BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
+    loop = staticmethod(LINKAGE.loop)
 
     @classmethod
     def rules(cls, xp, p, grashof=None):
@@ -58,25 +54,6 @@ class CouplerSlider(_FourBarBase):
                 kind=g.kind,
                 required="crank-rocker or drag-link",
             )
-
-    @staticmethod
-    def loop(xp, theta2, p):
-        a, o4, b, theta3, theta4, m4 = four_bar(xp, theta2, p)
-        phi = theta3 + p["beta"]
-        pp = (a[0] + p["r5"] * xp.cos(phi), a[1] + p["r5"] * xp.sin(phi))
-        d, m6 = rod_to_line(xp, pp, p["r6"], p["h"], p["sigma_slider"])
-        return Loop(
-            points={"O2": (0.0, 0.0), "A": a, "B": b, "O4": o4, "P": pp, "D": d},
-            angles={
-                "theta2": theta2,
-                "theta3": theta3,
-                "theta4": theta4,
-                "theta6": xp.atan2(d[1] - pp[1], d[0] - pp[0]),
-            },
-            x=d[0],
-            transmission={"B": joint_lines(a, o4, b), "D": rod_lines(pp, d)},
-            margins=[("four-bar closure at B", m4), ("rod PD reaching the slide line", m6)],
-        )
 
 
 __all__ = ["CouplerSlider"]

@@ -3,8 +3,25 @@
 from __future__ import annotations
 
 from qropt.errors import InvalidParameter
-from qropt.kinematics.closures import RIGHT_ANGLE, on_ray, pin_in_slot, rod_lines, rod_to_line
-from qropt.mechanisms.base import REQUIRED, Body, Loop, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Mechanism, Rule
+from qropt.mechanisms.builder import Linkage
+
+
+def slotted_lever(lever: str | None) -> Linkage:
+    """Crank r2 about O2, the crank-pin block in the lever's slot about O4 = (0, -r1) (theta4), and C on the lever
+    at ``lever`` from O4 (none without ``lever``): the crank-shaper's, Whitworth's and slot-ram shaper's frame."""
+    L = Linkage()
+    L.ground("O2", (0, 0))
+    L.crank("A", about="O2", length="r2")
+    L.ground("O4", (0, "-r1"))
+    L.rpr("A", pivot="O4", angle="theta4")
+    if lever is not None:
+        L.on_ray("C", "O4", "A", lever)
+    return L
+
+
+YOKE = slotted_lever("r4").rpp("C").output("C")  # without a rod r6: the yoke-ram follows x_C
+ROD = slotted_lever("r4").rrp("D", ("C", "r6"), line_y="-r1 + h", sign="sigma_slider").output("D")  # with r6
 
 
 class CrankShaper(Mechanism):
@@ -16,15 +33,10 @@ class CrankShaper(Mechanism):
     KIND = "crank-shaper"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r4": REQUIRED, "r6": None, "h": None, "sigma_slider": 1.0}
     LENGTHS = ("r1", "r2", "r4", "r6")
-    BODIES = (  # with the yoke (no rod r6): the yoke-ram moves along x with x_C
-        Body("crank", ("O2", "A"), "bar"),
-        Body("block", ("A", "O4"), "block"),  # the crank-pin block in the lever's slot
-        Body("lever", ("O4", "A", "C"), "slot-lever"),  # length max(r4, r1 + r2)
-        Body("yoke", ("C",), "yoke"),
-    )
-    ROD_BODIES = (*BODIES[:3], Body("rod", ("C", "D"), "bar"), Body("ram", ("D",), "ram"))  # with a rod r6
-    GROUND = ("O2", "O4")
-    OUTPUT_JOINT = "C"
+    BODIES = YOKE.bodies()  # with the yoke (no rod r6): the yoke-ram moves along x with x_C
+    ROD_BODIES = ROD.bodies()  # with a rod r6
+    GROUND = YOKE.ground_joints()
+    OUTPUT_JOINT = YOKE.output_joint()
 
     def bodies(self):
         """BODIES with the yoke; ROD_BODIES with a rod r6."""
@@ -32,7 +44,7 @@ class CrankShaper(Mechanism):
 
     def output_joint(self):
         """C (the yoke-ram follows x_C) without a rod; D with a rod r6."""
-        return "D" if "r6" in self.params else "C"
+        return ROD.output_joint() if "r6" in self.params else YOKE.output_joint()
 
     @classmethod
     def completed(cls, params):
@@ -55,16 +67,5 @@ class CrankShaper(Mechanism):
 
     @staticmethod
     def loop(xp, theta2, p):
-        o4 = (0.0, -p["r1"])
-        a = (p["r2"] * xp.cos(theta2), p["r2"] * xp.sin(theta2))
-        theta4 = pin_in_slot(xp, o4, a)
-        c = on_ray(xp, o4, theta4, p["r4"])
-        points = {"O2": (0.0, 0.0), "A": a, "O4": o4, "C": c}
-        angles = {"theta2": theta2, "theta4": theta4}
-        if "r6" not in p:
-            return Loop(points, angles, c[0], {"A": RIGHT_ANGLE, "C": RIGHT_ANGLE}, [])
-        d, m = rod_to_line(xp, c, p["r6"], -p["r1"] + p["h"], p["sigma_slider"])
-        points["D"] = d
-        angles["theta6"] = xp.atan2(d[1] - c[1], d[0] - c[0])
-        trans = {"A": RIGHT_ANGLE, "D": rod_lines(c, d)}
-        return Loop(points, angles, d[0], trans, [("rod CD reaching the slide line", m)])
+        """The yoke's loop without a rod r6, the rod's with one (a choice on the keys of p, never on values)."""
+        return (ROD if "r6" in p else YOKE).loop(xp, theta2, p)

@@ -7,8 +7,9 @@ import math
 from typing import ClassVar, NamedTuple
 
 from qropt.errors import GrashofError
-from qropt.kinematics.closures import circle_circle, joint_lines, on_ray, rod_lines, rod_to_line
-from qropt.mechanisms.base import REQUIRED, Body, Loop, Mechanism, Rule
+from qropt.kinematics.closures import circle_circle
+from qropt.mechanisms.base import REQUIRED, Mechanism, Rule
+from qropt.mechanisms.builder import Linkage
 
 LINKS = ("r1", "r2", "r3", "r4")
 
@@ -46,6 +47,21 @@ def four_bar(xp, theta2, p):
     theta3 = xp.atan2(b[1] - a[1], b[0] - a[0])
     return a, o4, b, theta3, theta4, m
 
+
+def four_bar_linkage() -> Linkage:
+    """The driving four-bar as a Linkage (no output yet): B on branch sigma, O4 declared after B (O2, A, B, O4)."""
+    L = Linkage()
+    L.ground("O2", (0, 0))
+    L.crank("A", about="O2", length="r2")
+    L.rrr("B", ("A", "r3"), ("O4", "r4"), sign="sigma", around=math.pi)
+    L.ground("O4", ("r1", 0))
+    return L
+
+
+FOUR_BAR = four_bar_linkage().output("theta4")
+# C on the follower along O4->B at r5 (follower length max(r4, r5)), the rod CD to the ram D on y = h
+SLIDER = four_bar_linkage().on_ray("C", "O4", "B", "r5").rrp("D", ("C", "r6"), line_y="h", sign="sigma_slider")
+SLIDER.output("D")
 
 SHORTEST = {"drag-link": "r1", "crank-rocker": "r2"}
 
@@ -96,23 +112,8 @@ class FourBar(_FourBarBase):
     REQUIRES_FULL_TURN = False
     OUTPUT = "follower"
     TRAVEL = "swing"
-    BODIES = (
-        Body("crank", ("O2", "A"), "bar"),
-        Body("coupler", ("A", "B"), "bar"),
-        Body("follower", ("O4", "B"), "bar"),
-    )
-    GROUND = ("O2", "O4")
-
-    @staticmethod
-    def loop(xp, theta2, p):
-        a, o4, b, theta3, theta4, m = four_bar(xp, theta2, p)
-        return Loop(
-            points={"O2": (0.0, 0.0), "A": a, "B": b, "O4": o4},
-            angles={"theta2": theta2, "theta3": theta3, "theta4": theta4},
-            x=theta4,
-            transmission={"B": joint_lines(a, o4, b)},
-            margins=[("four-bar closure at B", m)],
-        )
+    BODIES, GROUND = FOUR_BAR.bodies(), FOUR_BAR.ground_joints()
+    loop = staticmethod(FOUR_BAR.loop)
 
     @classmethod
     def rules(cls, xp, p, grashof=None):
@@ -139,15 +140,7 @@ class FourBarSlider(_FourBarBase):
     }
     LENGTHS = ("r1", "r2", "r3", "r4", "r5", "r6")
     SHORTEST: ClassVar[str] = ""
-    BODIES = (
-        Body("crank", ("O2", "A"), "bar"),
-        Body("coupler", ("A", "B"), "bar"),
-        Body("follower", ("O4", "B", "C"), "bar"),  # along ray O4->B, length max(r4, r5)
-        Body("rod", ("C", "D"), "bar"),
-        Body("ram", ("D",), "ram"),
-    )
-    GROUND = ("O2", "O4")
-    OUTPUT_JOINT = "D"
+    BODIES, GROUND, OUTPUT_JOINT = SLIDER.bodies(), SLIDER.ground_joints(), SLIDER.output_joint()
     ACCEL_EXTREMES = 4  # the four-bar adds acceleration extremes of note
 
     @classmethod
@@ -167,23 +160,7 @@ class FourBarSlider(_FourBarBase):
                 required=self.CLASS,
             )
 
-    @staticmethod
-    def loop(xp, theta2, p):
-        a, o4, b, theta3, theta4, m4 = four_bar(xp, theta2, p)
-        c = on_ray(xp, o4, theta4, p["r5"])
-        d, m6 = rod_to_line(xp, c, p["r6"], p["h"], p["sigma_slider"])
-        return Loop(
-            points={"O2": (0.0, 0.0), "A": a, "B": b, "O4": o4, "C": c, "D": d},
-            angles={
-                "theta2": theta2,
-                "theta3": theta3,
-                "theta4": theta4,
-                "theta6": xp.atan2(d[1] - c[1], d[0] - c[0]),
-            },
-            x=d[0],
-            transmission={"B": joint_lines(a, o4, b), "D": rod_lines(c, d)},
-            margins=[("four-bar closure at B", m4), ("rod CD reaching the slide line", m6)],
-        )
+    loop = staticmethod(SLIDER.loop)
 
 
 __all__ = ["FourBar", "FourBarSlider", "Grashof", "grashof", "grashof_rules", "four_bar"]

@@ -2,8 +2,14 @@
 
 from __future__ import annotations
 
-from qropt.kinematics.closures import rod_lines, rod_to_line
-from qropt.mechanisms.base import REQUIRED, Body, Loop, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Mechanism, Rule
+from qropt.mechanisms.builder import Linkage
+
+LINKAGE = Linkage()
+LINKAGE.ground("O2", (0, 0))
+LINKAGE.crank("A", about="O2", length="r2")
+LINKAGE.rrp("C", ("A", "r3"), line_y="e", sign="sigma_slider")
+LINKAGE.output("C")
 
 
 class SliderCrank(Mechanism):
@@ -12,9 +18,7 @@ class SliderCrank(Mechanism):
     KIND = "slider-crank"
     PARAMS = {"r2": REQUIRED, "r3": REQUIRED, "e": 0.0, "sigma_slider": 1.0}
     LENGTHS = ("r2", "r3")
-    BODIES = (Body("crank", ("O2", "A"), "bar"), Body("rod", ("A", "C"), "bar"), Body("ram", ("C",), "ram"))
-    GROUND = ("O2",)
-    OUTPUT_JOINT = "C"
+    BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
 
     @classmethod
     def rules(cls, xp, p, grashof=None):
@@ -23,14 +27,4 @@ class SliderCrank(Mechanism):
             Rule("full rotation needs r3 >= r2 + |e|", p["r3"] - p["r2"] + p["e"]),
         ]
 
-    @staticmethod
-    def loop(xp, theta2, p):
-        a = (p["r2"] * xp.cos(theta2), p["r2"] * xp.sin(theta2))
-        c, m = rod_to_line(xp, a, p["r3"], p["e"], p["sigma_slider"])
-        return Loop(
-            points={"O2": (0.0, 0.0), "A": a, "C": c},
-            angles={"theta2": theta2, "theta3": xp.atan2(c[1] - a[1], c[0] - a[0])},
-            x=c[0],
-            transmission={"C": rod_lines(a, c)},
-            margins=[("rod AC reaching the slide line", m)],
-        )
+    loop = staticmethod(LINKAGE.loop)

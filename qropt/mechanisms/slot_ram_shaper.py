@@ -3,8 +3,12 @@ and on the slide line y = -r1 + h (no rod)."""
 
 from __future__ import annotations
 
-from qropt.kinematics.closures import RIGHT_ANGLE, pin_in_slot, slot_line_lines, slot_to_line
-from qropt.mechanisms.base import REQUIRED, Body, Loop, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Mechanism, Rule
+from qropt.mechanisms.crank_shaper import slotted_lever
+
+# D rides in the lever's slot O4->A (lever length max(r1 + r2, h r1 / sqrt(r1^2 - r2^2))) and on y = -r1 + h; it is
+# on the ray (t > 0) wherever the rules hold
+LINKAGE = slotted_lever(None).slot_line("D", ("O4", "A"), line_y="-r1 + h").output("D")
 
 
 class SlotRamShaper(Mechanism):
@@ -17,14 +21,7 @@ class SlotRamShaper(Mechanism):
     KIND = "slot-ram-shaper"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "h": REQUIRED}
     LENGTHS = ("r1", "r2")  # h is the slide line's offset (positive by a rule), as the crank-shaper's
-    BODIES = (
-        Body("crank", ("O2", "A"), "bar"),
-        Body("block", ("A", "O4"), "block"),  # the crank-pin block in the lever's slot
-        Body("lever", ("O4", "A", "D"), "slot-lever"),  # length max(r1 + r2, h r1 / sqrt(r1^2 - r2^2))
-        Body("ram", ("D",), "ram"),
-    )
-    GROUND = ("O2", "O4")
-    OUTPUT_JOINT = "D"
+    BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
 
     @classmethod
     def rules(cls, xp, p, grashof=None):
@@ -33,19 +30,7 @@ class SlotRamShaper(Mechanism):
             Rule("a slot-ram shaper needs the slide line above O4: h > 0", p["h"] - 1e-9 * p["r1"]),
         ]
 
-    @staticmethod
-    def loop(xp, theta2, p):
-        o4 = (0.0, -p["r1"])
-        a = (p["r2"] * xp.cos(theta2), p["r2"] * xp.sin(theta2))
-        theta4 = pin_in_slot(xp, o4, a)
-        d, _ = slot_to_line(xp, o4, a, -p["r1"] + p["h"])  # on the ray (t > 0) wherever the rules hold
-        return Loop(
-            points={"O2": (0.0, 0.0), "A": a, "O4": o4, "D": d},
-            angles={"theta2": theta2, "theta4": theta4},
-            x=d[0],
-            transmission={"A": RIGHT_ANGLE, "D": slot_line_lines(o4, a)},
-            margins=[],
-        )
+    loop = staticmethod(LINKAGE.loop)
 
 
 __all__ = ["SlotRamShaper"]
