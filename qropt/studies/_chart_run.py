@@ -36,8 +36,8 @@ def chart(
     scheduler: None (in-process), 'local' (a LocalCluster of ``workers`` processes, one thread each) or the
     address of a running Dask scheduler ('tcp://host:8786'); ``workers`` alone means 'local'. solver: the Solver
     (default ``qropt.synthesis.solver.DEFAULT``; workers rebuild it from its options); tile: cells per tile
-    (x, y); check: the full solve also runs where both cell indices are multiples of it. A tqdm bar on standard error when
-    ``progress`` and it is a terminal.
+    (x, y); check: the full solve also runs where both cell indices are multiples of it. A tqdm bar on standard
+    error when ``progress`` and it is a terminal.
     """
     from qropt.synthesis.solver import DEFAULT, Solver
 
