@@ -290,6 +290,18 @@ class Mechanism:
         return None
 
     @classmethod
+    def linkage(cls, params: dict):
+        """The builder ``Linkage`` this type's loop comes from at these parameters (None for a hand-written loop)."""
+        return getattr(cls.loop, "__self__", None)
+
+    def relative_motion(self, theta2: float, omega2: float = 1.0, alpha2: float = 0.0):
+        """Every vector term of the velocity and acceleration equations at one crank angle (rad), dyad by dyad
+        (``qropt.mechanisms.relative_motion``): the paper's polygons, each term's magnitude and direction."""
+        from qropt.mechanisms.relative_motion import relative_motion
+
+        return relative_motion(self, theta2, omega2, alpha2)
+
+    @classmethod
     def completed(cls, params: dict) -> dict:
         """Defaults that depend on which parameters are given (override; e.g. a rod's slide line at h = 0)."""
         return {}

@@ -337,6 +337,12 @@ class Linkage:
         self._plan = None
         return self
 
+    def elements(self) -> tuple:
+        """The declared elements in the order they are evaluated (each after the points it reads): what the
+        relative-motion analysis walks (``qropt.mechanisms.relative_motion``)."""
+        order = self._build()[0]
+        return tuple(self._elements[i] for i in order)
+
     def ground(self, name: str, xy) -> Linkage:
         """A frame pivot at (x, y): numbers, parameter names or linear expressions ('-r1 + h')."""
         return self._add(_Ground(name, xy))

@@ -65,6 +65,10 @@ class CrankShaper(Mechanism):
         if "r6" in p and "h" not in p:
             object.__setattr__(self, "params", {**p, "h": 0.0})  # frozen by Mechanism.__init__
 
+    @classmethod
+    def linkage(cls, params):
+        return ROD if "r6" in params else YOKE
+
     @staticmethod
     def loop(xp, theta2, p):
         """The yoke's loop without a rod r6, the rod's with one (a choice on the keys of p, never on values)."""
