@@ -71,3 +71,17 @@ def test_a_type_without_a_builder_linkage_has_no_polygons():
 
     with pytest.raises(qropt.InvalidParameter, match="not declared with the linkage builder"):
         Hand(r2=0.1, r3=0.4).relative_motion(0.5)
+
+
+def test_the_command_line_prints_the_terms_and_draws_the_polygons(tmp_path, capsys):
+    from qropt import cli
+
+    path = tmp_path / "polygons.png"
+    assert cli.main(["analyze", "--theta2", "60deg", "--omega2", "10", "--polygons", "--plot", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "V_B/A" in out and "solved" in out and path.stat().st_size > 10_000
+    assert cli.main(["analyze", "--theta2", "60deg", "--omega2", "10", "--polygons", "--json"]) == 0
+    import json
+
+    rows = json.loads(capsys.readouterr().out)["terms"]
+    assert next(r for r in rows if r["term"] == "V_B/A")["magnitude"] == pytest.approx(1.898, rel=5e-3)

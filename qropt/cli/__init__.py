@@ -290,6 +290,8 @@ def cmd_analyze(args):
     if args.json and args.table is not None and args.csv in (None, "-"):
         raise CliError("--json prints JSON on standard output: give the table a file with --csv FILE")
     m = build_mechanism(args)
+    if args.polygons:
+        return polygons(args, m)
     r = analysis_report(m, args.theta2, args.omega2, args.alpha2)
     if args.json:
         json.dump(r, sys.stdout, indent=2, allow_nan=False)
@@ -309,6 +311,34 @@ def cmd_analyze(args):
     for path in export(args, m, args.theta2):
         if not args.json:
             print(f"  written: {path}")
+
+
+def polygons(args, m) -> int:
+    """``analyze --polygons``: the velocity and acceleration equations term by term (the paper's Tables 1-3),
+    directions in degrees counter-clockwise from +x; with --plot, the polygons drawn to scale."""
+    rm = m.relative_motion(args.theta2, args.omega2, args.alpha2)
+    rows = rm.table()
+    if args.json:
+        out = {"theta2_deg": math.degrees(args.theta2), "omega2": args.omega2, "alpha2": args.alpha2}
+        json.dump({**out, "units": m.units, "terms": rows}, sys.stdout, indent=2, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        print(
+            f"{type(m).__name__} at theta2 = {math.degrees(args.theta2):g} deg, omega2 = {args.omega2:g} rad/s,"
+            f" alpha2 = {args.alpha2:g} rad/s^2 (lengths in {m.units})"
+        )
+        print(f"  {'joint':5s} {'quantity':12s} {'term':22s} {'kind':10s} {'magnitude':>12s} {'dir [deg]':>9s}")
+        for r in rows:
+            state = "solved" if r["solved"] else "known"
+            print(
+                f"  {r['joint']:5s} {r['quantity']:12s} {r['term']:22s} {r['kind']:10s} {r['magnitude']:12.6g}"
+                f" {r['direction_deg']:9.2f}  {state}"
+            )
+    if args.plot:
+        rm.plot(args.plot, m.units)
+        if not args.json:
+            print(f"  picture written to {args.plot}")
+    return 0
 
 
 def _export_arguments(p):
@@ -355,6 +385,7 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("--csv", help="file for the full-cycle table ('-' for standard output)")
     a.add_argument("--plot", help="PNG file: mechanism at theta2 beside x, v, a over the cycle")
     a.add_argument("--from", dest="design", help="a design file (qropt synth --save, or --json output) to analyse")
+    a.add_argument("--polygons", action="store_true", help="the equations term by term; with --plot, the polygons")
     units_argument(a, "the length unit of the parameters (a design file states its own; --units may repeat it)")
     _export_arguments(a)
     a.set_defaults(run=cmd_analyze)
