@@ -23,17 +23,10 @@ ROOT = Path(globals().get("__file__", ".")).resolve().parent.parent
 def cases():
     """(name, feasible problem, the problem without a design); only qropt's public API (any version has it)."""
     from qropt import Problem
+    from qropt.examples import paper_problem
 
     def paper(**kw):
-        base = dict(
-            mechanism="DragLinkSlider",
-            fixed={"r1": 0.1, "r2": 0.225, "r4": 0.275, "r6": 0.3},
-            free={"r3": (0.05, 1.0), "r5": (0.01, 0.5)},
-            targets={"time_ratio": 1.5, "stroke": 0.3},
-            conditions={"grashof": "drag-link"},
-            objective="max_gamma_min",
-        )
-        return Problem(**{**base, **kw})
+        return paper_problem().replace(**kw)
 
     def rocker_slider(**kw):
         base = dict(

@@ -160,9 +160,9 @@ def relative_motion(m, theta2: float, omega2: float = 1.0, alpha2: float = 0.0) 
 
     eqs = []
 
-    def rigid(x, o, t, name, known):
+    def rigid(x, o, t, known):
         """x fixed on the link o -> t (x may be t): V_x = V_o + omega x ox, A_x = A_o + normal + tangential."""
-        r0, w, a = rate(o, t)
+        _, w, a = rate(o, t)
         r = pos[x] - pos[o]
         vt = [Term(f"V_{o}", "absolute", vel[o], False)] if np.any(vel[o]) else []
         at = [Term(f"A_{o}", "absolute", acc[o], False)] if np.any(acc[o]) else []
@@ -185,7 +185,7 @@ def relative_motion(m, theta2: float, omega2: float = 1.0, alpha2: float = 0.0) 
         """x moving along the link o -> t (a block in a turning slot): V_x = V_x' + V_slide, with the Coriolis term."""
         r, w, a = rate(o, t)
         u = r / np.hypot(*r)
-        s1, s2 = float(np.dot(vel[x] - vel[o], u)), None  # the slide speed along the slot
+        s1 = float(np.dot(vel[x] - vel[o], u))  # the slide speed along the slot
         base_v = vel[o] + cross(w, pos[x] - pos[o])
         base_a = acc[o] - w * w * (pos[x] - pos[o]) + cross(a, pos[x] - pos[o])
         cor = cross(2 * w, s1 * u)
@@ -214,18 +214,18 @@ def relative_motion(m, theta2: float, omega2: float = 1.0, alpha2: float = 0.0) 
     for e in linkage.elements():
         k = e.kind
         if k == "crank":
-            rigid(e.point, e.about, e.point, e.point, known=True)
+            rigid(e.point, e.about, e.point, known=True)
         elif k == "rrr":
-            rigid(e.point, e.p_, e.point, e.point, known=False)
-            rigid(e.point, e.q_, e.point, e.point, known=False)
+            rigid(e.point, e.p_, e.point, known=False)
+            rigid(e.point, e.q_, e.point, known=False)
         elif k == "rrp":
-            rigid(e.point, e.pin, e.point, e.point, known=False)
+            rigid(e.point, e.pin, e.point, known=False)
         elif k == "rpr":
             sliding(e.pin, e.pivot, e.pin)
         elif k == "slot_line":
             sliding(e.point, e.pivot, e.through)
         elif k in ("on_ray", "coupler_point"):
-            rigid(e.point, e.origin, e.through, e.point, known=True)
+            rigid(e.point, e.origin, e.through, known=True)
     return RelativeMotion(float(theta2), float(omega2), float(alpha2), tuple(eqs))
 
 

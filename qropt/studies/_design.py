@@ -27,16 +27,16 @@ from qropt.synthesis import criteria
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import SOLUTION_PRESENT, Result, json_safe
 
-# type name -> (mechanism kind, free lengths, free offsets, fixed values[, free angles])
+# type name -> (mechanism kind, free lengths, free offsets, fixed values, free angles)
 TYPES = {
-    "slider-crank": ("slider-crank", ("r2", "r3"), ("e",), {}),
-    "crank-shaper": ("crank-shaper", ("r1", "r2", "r4"), (), {}),
-    "crank-shaper-rod": ("crank-shaper", ("r1", "r2", "r4", "r6"), ("h",), {}),
-    "whitworth": ("whitworth", ("r1", "r2", "r5", "r6"), ("h",), {}),
-    "crank-rocker-slider": ("crank-rocker-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}),
-    "drag-link-slider": ("drag-link-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}),
+    "slider-crank": ("slider-crank", ("r2", "r3"), ("e",), {}, ()),
+    "crank-shaper": ("crank-shaper", ("r1", "r2", "r4"), (), {}, ()),
+    "crank-shaper-rod": ("crank-shaper", ("r1", "r2", "r4", "r6"), ("h",), {}, ()),
+    "whitworth": ("whitworth", ("r1", "r2", "r5", "r6"), ("h",), {}, ()),
+    "crank-rocker-slider": ("crank-rocker-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}, ()),
+    "drag-link-slider": ("drag-link-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}, ()),
     "coupler-slider": ("coupler-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}, ("beta",)),
-    "slot-ram-shaper": ("slot-ram-shaper", ("r1", "r2"), ("h",), {}),
+    "slot-ram-shaper": ("slot-ram-shaper", ("r1", "r2"), ("h",), {}, ()),
 }
 
 
@@ -52,8 +52,7 @@ def type_row(t, bounds=None) -> tuple:
     ``TYPES`` by its name, or the default row of any other slider type (a Mechanism class, its KIND, class name
     or "module:Class"); ProblemError naming the types where there is none."""
     if isinstance(t, str) and t in TYPES:
-        row = TYPES[t]
-        return t, (*row, ()) if len(row) == 4 else row
+        return t, TYPES[t]
     try:
         cls = mechanism_type(t) if isinstance(t, (str, type)) else None
     except QroptError as e:

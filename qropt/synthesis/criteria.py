@@ -476,7 +476,7 @@ def better(problem, a, b) -> bool:
 def units(length: str = "length") -> dict:
     """Criterion name -> unit, with the length unit named (e.g. 'm')."""
     out = {c.name: c.unit.replace("length", length) for c in CRITERIA.values()}
-    out["torque_per_newton"] = f"{length} (N m per N)" if length != "length" else "length (N m per N)"
+    out["torque_per_newton"] = f"{length} (N m per N)"
     return out
 
 

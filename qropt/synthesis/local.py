@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import CONVERGED, Status
 from qropt.synthesis.certificate import Designs, certify, residuals
@@ -231,8 +232,6 @@ def place(slots, used, new, period, near, base):
 
 def nlp_value(problem, info) -> float:
     """A certified objective in the NLP's terms (what the backend minimises)."""
-    from qropt.synthesis import criteria
-
     return criteria.of_problem(problem).to_nlp(info["certified"], problem.omega2)
 
 
