@@ -71,6 +71,17 @@ def servo(path):
     qropt.speed_profile(m, omega_max=20, v_cut=0.5, a_max=40, alpha_max=400, v_max=2).plot(path)
 
 
+def forces(path):
+    masses, loads = qropt.Masses.steel(2e-4, ram=20.0), qropt.Loads(cutting_force=1000.0, gravity=9.81)
+    plots.save(plots.dynamics_figure(paper_mechanism(), 10.0, masses, loads, math.radians(60)), path)
+
+
+def polygons(path):
+    m = paper_mechanism()
+    m = type(m)(**{**m.params, "r3": 0.2504})  # the paper's Table 4 design, as its Tables 2-3
+    m.relative_motion(math.radians(60), 10.0).plot(path)
+
+
 PICTURES = {
     "types.png": types,
     "front.png": front,
@@ -80,6 +91,8 @@ PICTURES = {
     "family.png": family,
     "reachable.png": reachable,
     "servo.png": servo,
+    "forces.png": forces,
+    "polygons.png": polygons,
 }
 
 

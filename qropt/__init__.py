@@ -6,6 +6,7 @@ The public names only; the flow of data is kinematics -> mechanisms -> synthesis
 
 from qropt.convex.servo import SpeedProfile, speed_profile
 from qropt.convex.tolerance import Allocation, MonteCarlo, allocate, sensitivities
+from qropt.dynamics import BodyMass, Counterweight, Dynamics, Loads, Masses, Motor, Simulation, simulate
 from qropt.errors import (
     AssemblyError,
     ChartError,
@@ -69,6 +70,15 @@ __all__ = [
     "Reachable",
     "chart",
     "Chart",
+    # dynamics
+    "Masses",
+    "BodyMass",
+    "Counterweight",
+    "Loads",
+    "Dynamics",
+    "Motor",
+    "Simulation",
+    "simulate",
     # convex layer
     "speed_profile",
     "SpeedProfile",

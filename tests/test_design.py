@@ -477,3 +477,13 @@ def test_bad_command_lines_are_one_line(capsys):
         assert main(args) == code, args
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == len(cases) and all(line.startswith("qropt:") for line in err), err
+
+
+def test_the_readme_shows_the_design_table_of_today():
+    """The README's eight-row table is ``design(1.5, 0.3).markdown()`` as computed now."""
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    table = qropt.design(1.5, 0.3).markdown()
+    assert table in readme
+    assert len(table.splitlines()) == 2 + 8

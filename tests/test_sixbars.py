@@ -212,6 +212,84 @@ def test_coupler_slider_solve_is_certified_and_confirmed_by_brute_force():
     assert _rel(r.quantities["gamma_min"], gamma) < 1e-9
 
 
+# the coupler slider without closed forms: free parameters of fixed shapes, and the design row (all eight free)
+_FOURBAR = {"r1": 0.4, "r2": 0.1, "r3": 0.35, "r4": 0.3, "r6": 0.6, "h": 0.0}
+COUPLER_TASKS = {
+    "r4, r5, beta": ({k: v for k, v in _FOURBAR.items() if k != "r4"}, {"r4": (0.2, 0.45)}),
+    "r3, r4, r5, beta": (
+        {k: v for k, v in _FOURBAR.items() if k not in ("r3", "r4")},
+        {"r3": (0.2, 0.5), "r4": (0.2, 0.45)},
+    ),
+}
+
+
+@pytest.mark.parametrize("task", [*COUPLER_TASKS, "design row"])
+def test_coupler_slider_default_solve_finds_what_a_large_multistart_finds(task):
+    """The default solve (a grid screen of rule points for its starts, more starts the more parameters are free)
+    reaches the best gamma_min of a multi-start eight times as large, and its certificate says it rests on a
+    multi-start."""
+    if task == "design row":
+        from qropt.studies._design import type_problem
+
+        p = type_problem("coupler-slider", 1.5, 0.3)
+    else:
+        fixed, free = COUPLER_TASKS[task]
+        p = qropt.Problem(
+            "coupler-slider",
+            fixed=fixed,
+            free={**free, "r5": (0.05, 0.6), "beta": (-math.pi, math.pi)},
+            targets={"time_ratio": 1.5, "stroke": 0.3},
+        )
+    r = qropt.solve(p)
+    assert r.status == "optimal", r.message
+    assert "distinct local optima from" in r.certificate.global_claim
+    n = r.stats["starts"]
+    big = qropt.Solver(starts_n=8 * n, seed=5).solve(p)
+    assert big.status == "optimal", big.message
+    assert r.objective >= big.objective - 1e-7, (r.objective, big.objective)
+    q = dict(r.params)
+    _, _, _, _, tr, stroke, gamma = brute.sixbar_cycle("coupler-slider", q)
+    assert abs(tr - 1.5) < 1e-6 and abs(stroke - 0.3) < 1e-6 and _rel(r.objective, gamma) < 1e-9
+
+
+def test_no_sampled_design_that_turns_is_no_proof_of_infeasibility():
+    """At TR 2.4 the coupler slider's default solve may not reach the gamma_min optimum, but designs exist (one
+    is checked by brute force here): the solve says 'failed' and names a design, never 'infeasible'."""
+    from qropt.studies._design import type_problem
+
+    p = type_problem("coupler-slider", 2.4, 0.2)
+    r = qropt.solve(p)
+    assert r.status in ("optimal", "acceptable", "failed"), r.message
+    if r.status == "failed":
+        shown = r.message.split("(one: ")[1].split(")")[0]
+        q = {k: float(v) for k, v in (kv.split("=") for kv in shown.split(", "))}
+        _, _, _, _, tr, stroke, _ = brute.sixbar_cycle("coupler-slider", {**q, "sigma": -1.0, "sigma_slider": 1.0})
+        assert abs(tr - 2.4) < 1e-4 and abs(stroke - 0.2) < 1e-4
+
+
+@pytest.mark.parametrize("kind", ["slot-ram-shaper", "crank-shaper"])
+def test_a_continuum_of_optima_is_broken_by_the_least_size(kind):
+    """The motion depends on r2/r1, so every design of the closed-form family has the same gamma_min: the design
+    row returns the least footprint of a dense scan of the family over r1 (to 1e-6)."""
+    tr, s = 1.6, 0.3
+    row = qropt.design(tr, s, types=[kind]).rows[0].result
+    assert row.status == "optimal", row.message
+    assert "continuum along r1" in row.message
+    lo, hi = (s / 20, 5 * s)
+    k = analytic.crank_shaper_ratio(tr)
+    sizes, gammas = [], []
+    for r1 in np.geomspace(lo, hi, 4001):
+        q = {"r1": r1, "r2": k * r1}
+        q |= {"h": s * math.sqrt(1 - k * k) / (2 * k)} if kind == "slot-ram-shaper" else {"r4": s / (2 * k)}
+        if not all(lo <= v <= hi for n, v in q.items() if n != "h"):
+            continue
+        m = qropt.mechanism_type(kind)(**q)
+        sizes.append(m.size("footprint"))
+        gammas.append(m.gamma_min().value)
+    assert max(gammas) - min(gammas) < 1e-9 and abs(row.objective - gammas[0]) <= 2e-9  # the tie: 1e-9 relative
+    assert row.quantities["size"] <= min(sizes) * (1 + 1e-6), (row.quantities["size"], min(sizes))
+
+
 # a crank-rocker whose coupler point (r5 = 1.169 at beta = 1.796 rad) folds the ram's x-motion: two reversals a turn
 TWICE = {"r1": 0.996, "r2": 0.365, "r3": 0.568, "r4": 0.806, "r5": 1.169, "beta": 1.796, "r6": 5.0, "h": 0.0}
 

@@ -292,6 +292,8 @@ def cmd_analyze(args):
     m = build_mechanism(args)
     if args.polygons:
         return polygons(args, m)
+    if args.dynamics:
+        return dynamics(args, m)
     r = analysis_report(m, args.theta2, args.omega2, args.alpha2)
     if args.json:
         json.dump(r, sys.stdout, indent=2, allow_nan=False)
@@ -336,6 +338,95 @@ def polygons(args, m) -> int:
             )
     if args.plot:
         rm.plot(args.plot, m.units)
+        if not args.json:
+            print(f"  picture written to {args.plot}")
+    return 0
+
+
+def dynamics(args, m) -> int:
+    """``analyze --dynamics``: the peak and RMS crank torque, the peak force at every joint, the peak shaking
+    force and moment and the flywheel for --cs, at --omega2 (SI); --plot, --csv (the turn degree by degree) and
+    --json as for the kinematics."""
+    from qropt.dynamics.cycle import CycleDynamics
+    from qropt.dynamics.model import Loads, Masses
+
+    try:
+        masses = Masses.bars(args.density, args.ram_mass, block=args.block_mass)
+        loads = Loads(args.force, friction=args.friction, gravity=args.gravity)
+    except QroptError as e:
+        raise CliError(str(e)) from None
+    cd = CycleDynamics(m, args.omega2, args.alpha2, masses, loads)
+    ex = cd.extremes()
+    fw = cd.flywheel(args.cs) if args.alpha2 == 0 else None
+    out = {
+        "type": type(m).__name__,
+        "omega2": args.omega2,
+        "alpha2": args.alpha2,
+        "masses": masses.to_dict(),
+        "loads": loads.to_dict(),
+        "peak_torque": {"value": ex.peak_torque.value, "theta2_deg": math.degrees(ex.peak_torque.theta2)},
+        "rms_torque": ex.rms_torque,
+        "mean_torque": ex.mean_torque,
+        "peak_forces": {k: {"value": p.value, "theta2_deg": math.degrees(p.theta2)} for k, p in ex.peak_forces.items()},
+        "peak_shaking_force": ex.peak_shaking_force.value,
+        "peak_shaking_moment": ex.peak_shaking_moment.value,
+    }
+    if fw is not None:
+        out["flywheel"] = {
+            "cs": fw.cs,
+            "energy_fluctuation": fw.energy_fluctuation,
+            "inertia": fw.inertia,
+            "energy_per_turn": fw.energy_per_turn,
+            "working_energy": fw.working_energy,
+            "return_energy": fw.return_energy,
+        }
+    if args.json:
+        json.dump(out, sys.stdout, indent=2, allow_nan=False)
+        sys.stdout.write("\n")
+    else:
+        print(
+            f"{type(m).__name__} at omega2 = {args.omega2:g} rad/s, alpha2 = {args.alpha2:g} rad/s^2: links "
+            f"{args.density:g} kg/m, ram {args.ram_mass:g} kg, cutting force {args.force:g} N, friction "
+            f"{args.friction:g}, gravity {args.gravity:g} m/s^2 (SI)"
+        )
+        at = math.degrees(ex.peak_torque.theta2)
+        print(f"  peak torque     {ex.peak_torque.value:12.6g} N m at theta2 = {at:.2f} deg")
+        print(f"  RMS torque      {ex.rms_torque:12.6g} N m   mean {ex.mean_torque:.6g} N m")
+        for k, p in ex.peak_forces.items():
+            print(f"  peak force {k:6s}{p.value:12.6g} N   at theta2 = {math.degrees(p.theta2):.2f} deg")
+        print(
+            f"  shaking force   {ex.peak_shaking_force.value:12.6g} N   moment {ex.peak_shaking_moment.value:.6g} N m"
+        )
+        if fw is not None:
+            print(
+                f"  flywheel        {fw.inertia:12.6g} kg m^2 for Cs = {fw.cs:g} (energy fluctuation "
+                f"{fw.energy_fluctuation:.6g} J; {fw.energy_per_turn:.6g} J a turn, {fw.working_energy:.6g} J on the "
+                "working stroke)"
+            )
+    if args.csv:
+        th = np.radians(np.arange(0.0, 360.0, 1.0))
+        d = cd.at(th)
+        names = sorted(d.joint_forces)
+        rows = [["theta2_deg", "torque_Nm", *(f"{k}_{c}_N" for k in names for c in "xy"), "shaking_x_N", "shaking_y_N"]]
+        for i, t in enumerate(th):
+            rows.append(
+                [
+                    f"{math.degrees(t):g}",
+                    f"{d.torque[i]:.10g}",
+                    *(f"{d.joint_forces[k][i, c]:.10g}" for k in names for c in (0, 1)),
+                    *(f"{v:.10g}" for v in d.shaking_force[i]),
+                ]
+            )
+        f = sys.stdout if args.csv == "-" else open(args.csv, "w", newline="")  # noqa: SIM115
+        try:
+            csv.writer(f).writerows(rows)
+        finally:
+            if f is not sys.stdout:
+                f.close()
+    if args.plot:
+        from qropt.io import plots
+
+        plots.save(plots.dynamics_figure(m, args.omega2, masses, loads, args.theta2), args.plot)
         if not args.json:
             print(f"  picture written to {args.plot}")
     return 0
@@ -386,6 +477,14 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("--plot", help="PNG file: mechanism at theta2 beside x, v, a over the cycle")
     a.add_argument("--from", dest="design", help="a design file (qropt synth --save, or --json output) to analyse")
     a.add_argument("--polygons", action="store_true", help="the equations term by term; with --plot, the polygons")
+    a.add_argument("--dynamics", action="store_true", help="crank torque, joint forces, shaking and flywheel (SI)")
+    a.add_argument("--density", type=real, default=0.0, help="links as uniform bars of this many kg per metre")
+    a.add_argument("--ram-mass", dest="ram_mass", type=real, default=0.0, help="the ram's mass, kg")
+    a.add_argument("--block-mass", dest="block_mass", type=real, default=0.0, help="the crank-pin block's mass, kg")
+    a.add_argument("--force", type=real, default=0.0, help="cutting force on the working stroke, N")
+    a.add_argument("--friction", type=real, default=0.0, help="the slide's friction coefficient")
+    a.add_argument("--gravity", type=real, default=0.0, help="gravity along -y, m/s^2 (e.g. 9.81)")
+    a.add_argument("--cs", type=real, default=0.05, help="coefficient of speed fluctuation for the flywheel")
     units_argument(a, "the length unit of the parameters (a design file states its own; --units may repeat it)")
     _export_arguments(a)
     a.set_defaults(run=cmd_analyze)
@@ -393,7 +492,7 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("problem", nargs="?", help="a problem file (default: the paper's design task, built in)")
     s.add_argument("--objective", choices=[o for o in criteria.objectives() if o] + ["none"])
     s.add_argument("--size", choices=["sum", "longest", "footprint"], help="size measure for min_size")
-    s.add_argument("--starts", type=int, default=8, help="space-filling multi-start points (default 8)")
+    s.add_argument("--starts", type=int, help="space-filling multi-start points (default: the solver's)")
     s.add_argument("--json", action="store_true", help="print the Result as JSON")
     s.add_argument("--plot", help="PNG file: the best design over its cycle")
     _export_arguments(s)
@@ -679,7 +778,7 @@ def cmd_synth(args):
         changes["size"] = args.size
     if changes:
         problem = problem.replace(**changes)
-    if args.starts < 0:
+    if args.starts is not None and args.starts < 0:
         raise CliError(f"--starts must be >= 0, got {args.starts}")
     r = solve(problem, starts_n=args.starts)
     if args.json:

@@ -70,6 +70,9 @@ def _write(p, write) -> None:
         raise InvalidParameter(f"{p}: cannot write: {e.strerror or e}") from None
 
 
+PLATE_FILL = 9  # AutoCAD colour index of a plate's fill: light grey
+
+
 def to_dxf(m: Mechanism, path, theta2: float = 0.0) -> None:
     """The mechanism at theta2 (rad) as a DXF drawing in its own length unit, one layer per kind of entity."""
     import ezdxf
@@ -94,8 +97,8 @@ def to_dxf(m: Mechanism, path, theta2: float = 0.0) -> None:
                 msp.add_lwpolyline(args[0], dxfattribs=attribs)
             else:
                 msp.add_lwpolyline(args[0], close=True, dxfattribs=attribs)
-                if args[1]:  # a plate: filled
-                    hatch = msp.add_hatch(color=LAYERS[layer], dxfattribs=attribs)
+                if args[1]:  # a plate: filled light grey inside its outline (joints and links stay visible)
+                    hatch = msp.add_hatch(color=PLATE_FILL, dxfattribs=attribs)
                     hatch.paths.add_polyline_path(args[0], is_closed=True)
     _write(p, doc.saveas)
 

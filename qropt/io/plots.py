@@ -113,6 +113,71 @@ def cycle_figure(m: Mechanism, theta2: float = math.radians(60), omega2: float =
     return fig
 
 
+def dynamics_figure(m: Mechanism, omega2: float, masses=None, loads=None, theta2: float = math.radians(60), n=721):
+    """Figure: the mechanism at theta2 with the force each joint passes on (arrows to one scale, newtons) (left);
+    the crank torque and every joint force's magnitude over a turn (right), strokes shaded."""
+    _mechanism(m)
+    drawing.check(m)
+    fig = plt.figure(figsize=(12, 6))
+    ax0 = fig.add_subplot(1, 2, 1)
+    x0, x1, y0, y1 = draw_mechanism(ax0, m, theta2, color="0.35")
+    d = m.dynamics(np.array([theta2]), omega2, masses=masses, loads=loads)
+    pos = m.positions(np.array([theta2])).points
+    forces = {k: v[0] for k, v in d.joint_forces.items() if k in pos or k == "slide"}
+    biggest = max([float(np.hypot(*f)) for f in forces.values()] + [1e-300])
+    scale = 0.25 * max(x1 - x0, y1 - y0) / biggest  # the largest force drawn a quarter of the drawing
+    colours = plt.get_cmap("tab10")
+    tips = []
+    for i, (k, f) in enumerate(sorted(forces.items())):
+        at = pos[m.output_joint()][0] if k == "slide" else pos[k][0]
+        tips.append(at + scale * f)
+        ax0.annotate(
+            "",
+            xy=at + scale * f,
+            xytext=at,
+            arrowprops={"arrowstyle": "-|>", "color": colours(i % 10), "lw": 1.8},
+            zorder=6,
+        )
+        ax0.plot([], [], color=colours(i % 10), label=f"{k}: {np.hypot(*f):.4g} N")
+    tips = np.array(tips)
+    pad = 0.05 * max(x1 - x0, y1 - y0)
+    ax0.set_xlim(min(x0, tips[:, 0].min()) - pad, max(x1, tips[:, 0].max()) + pad)
+    ax0.set_ylim(min(y0, tips[:, 1].min()) - pad, max(y1, tips[:, 1].max()) + pad)
+    ax0.legend(fontsize=7, loc="best", ncol=2, framealpha=0.9)
+    ax0.set_title(
+        f"{type(m).__name__} at theta2 = {math.degrees(theta2):.1f} deg, torque {d.torque[0]:.4g} N m\n"
+        "joint forces on the driven body, to one scale",
+        fontsize=10,
+    )
+    ax0.set_xlabel(f"x [{m.units}]")
+    ax0.set_ylabel(f"y [{m.units}]")
+    th = np.linspace(0, 2 * math.pi, n)
+    dc = m.dynamics(th, omega2, masses=masses, loads=loads)
+    dead = m.dead_centres()
+    a, b = m.stroke_angles()
+    deg = np.degrees(th)
+    ax1 = fig.add_subplot(2, 2, 2)
+    ax1.plot(deg, dc.torque, color="k")
+    ax1.axhline(float(np.mean(dc.torque[:-1])), color="k", ls=":", lw=1, label="mean")
+    ax1.set_ylabel("crank torque [N m]")
+    _shade(ax1, dead.theta_max, dead.theta_min, a, b, omega2)
+    ax1.legend(loc="lower left", bbox_to_anchor=(0.0, 1.02), ncol=3, fontsize=8, frameon=False)
+    ax1.grid(alpha=0.3)
+    ax2 = fig.add_subplot(2, 2, 4)
+    lines = [
+        ax2.plot(deg, v, color=colours(i % 10), label=k)[0]
+        for i, (k, v) in enumerate(sorted(dc.force_magnitudes().items()))
+    ]
+    ax2.set_ylabel("joint force [N]")
+    ax2.set_xlabel(f"theta2 [deg] (omega2 = {omega2:g} rad/s)")
+    _shade(ax2, dead.theta_max, dead.theta_min, a, b, omega2)
+    ax2.legend(handles=lines, fontsize=7, ncol=4, loc="upper right", framealpha=0.9)
+    ax2.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.subplots_adjust(left=0.08)  # the drawing's y label clear of the edge
+    return fig
+
+
 def _shade(ax, t_max, t_min, a, b, omega2):
     # the crank arc t_max -> t_min (counter-clockwise) has length a and the other b; at constant |omega2| the
     # longer arc takes longer whichever way the crank turns, so it is the working stroke for either sign of omega2

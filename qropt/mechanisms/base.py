@@ -255,6 +255,9 @@ class Mechanism:
     EXACT_TRANSMISSION: ClassVar[dict[str, tuple[float, ...]]] = {}  # joint -> crank angles of its extremes
     RULED_MARGINS: ClassVar[tuple[str, ...]] = ()  # closures that assemble wherever the type's rules hold
     ACCEL_EXTREMES: ClassVar[int] = 2  # acceleration extremes the NLP lifts for the peak acceleration
+    # parameters along which, at given targets, the motion and so every kinematic criterion stay the same (the
+    # others following): such optima form a continuum, and a solve breaks the tie by the least size
+    TIES: ClassVar[tuple[str, ...]] = ()
     BODIES: ClassVar[tuple[Body, ...]] = ()  # every moving body (see Body): pictures and the mass model read them
     GROUND: ClassVar[tuple[str, ...]] = ()  # the joints fixed to the frame (ground pivots)
     OUTPUT_JOINT: ClassVar[str | None] = None  # the joint whose x is a slider output; None for a follower angle
@@ -293,6 +296,34 @@ class Mechanism:
     def linkage(cls, params: dict):
         """The builder ``Linkage`` this type's loop comes from at these parameters (None for a hand-written loop)."""
         return getattr(cls.loop, "__self__", None)
+
+    def dynamics(self, theta2, omega2: float = 1.0, alpha2: float = 0.0, *, masses=None, loads=None):
+        """Exact inverse dynamics at crank angles theta2 (rad), SI: the crank torque, every joint force, the
+        shaking force and moment (``qropt.dynamics.Dynamics``); masses: ``qropt.Masses`` (default massless),
+        loads: ``qropt.Loads`` (default none)."""
+        from qropt.dynamics.inverse import inverse_dynamics
+
+        return inverse_dynamics(self, theta2, omega2, alpha2, masses=masses, loads=loads)
+
+    def dynamic_extremes(self, omega2: float = 1.0, alpha2: float = 0.0, *, masses=None, loads=None):
+        """Peak and RMS torque, the peak force at every joint and the peak shaking force and moment over the
+        turn, exact (``qropt.dynamics.cycle.DynamicExtremes``)."""
+        from qropt.dynamics.cycle import CycleDynamics
+
+        return CycleDynamics(self, omega2, alpha2, masses, loads).extremes()
+
+    def flywheel(self, omega2: float, cs: float, *, masses=None, loads=None):
+        """The flywheel inertia (kg m^2) that keeps the speed fluctuation (omega_max - omega_min) / omega2 at cs,
+        from the constant-speed torque (``qropt.dynamics.cycle.Flywheel``)."""
+        from qropt.dynamics.cycle import CycleDynamics
+
+        return CycleDynamics(self, omega2, 0.0, masses, loads).flywheel(cs)
+
+    def body_masses(self, masses) -> dict:
+        """Every moving body's mass, centre of mass (body frame, m) and inertia (kg m^2) under ``masses``."""
+        from qropt.dynamics.inverse import body_masses
+
+        return body_masses(self, masses)
 
     def relative_motion(self, theta2: float, omega2: float = 1.0, alpha2: float = 0.0):
         """Every vector term of the velocity and acceleration equations at one crank angle (rad), dyad by dyad

@@ -81,12 +81,23 @@ keys of p); the RRR's transmission rule assumes its second centre is a ground pi
 from __future__ import annotations
 
 import re
+from typing import NamedTuple
 
 from qropt.errors import InvalidParameter
 from qropt.kinematics import closures as cl
 from qropt.mechanisms.base import Body, Loop
 
-__all__ = ["Linkage", "LinkageError"]
+__all__ = ["Linkage", "LinkageError", "Connection"]
+
+
+class Connection(NamedTuple):
+    """One joint between two bodies (see ``Linkage.connections``)."""
+
+    joint: str
+    giver: str
+    receiver: str
+    kind: str  # 'pin', 'slot' or 'guide'
+    line: tuple | None = None  # a slot's line (two joints); None: the yoke's slot, normal to the slide line
 
 
 class LinkageError(InvalidParameter):
@@ -621,6 +632,68 @@ class Linkage:
     def bodies(self) -> tuple[Body, ...]:
         """Every moving body (``Body``), in the order the elements that make them were declared."""
         return self._build()[1]
+
+    def connections(self) -> tuple[Connection, ...]:
+        """How the bodies hold each other (what the force analysis reads), in declaration order: a 'pin' (a
+        revolute joint: a force of any direction), a 'slot' (a pin or block sliding in a slot: a force normal to
+        the slot, the line ``line`` = (a, b) of joints, or normal to the slide line's normal for a yoke, where
+        ``line`` is None) and a 'guide' (the ram on its slide line: a force normal to the line, and a moment for
+        a yoke-ram). ``giver`` is the body the motion comes from ('ground' for the frame), ``receiver`` the one it
+        drives."""
+        order, bodies = self._build()[:2]
+        grounds = set(self.ground_joints())
+        made: list = []  # bodies made so far, in declaration order
+
+        def carrier(j):
+            if j in grounds:
+                return "ground"
+            for b in made:
+                if j in b.joints and b.kind not in ("ram", "yoke", "block"):
+                    return b.name
+            raise LinkageError(f"no body carries joint {j!r}")
+
+        by_name = {b.name: b for b in bodies}
+        out = []
+        for i in order:
+            e = self._elements[i]
+            if e.kind == "crank":
+                out.append(Connection(e.about, carrier(e.about), e.body, "pin"))
+                made.append(by_name[e.body])
+            elif e.kind == "rrr":
+                coupler, follower = e.bodies
+                out += [
+                    Connection(e.p_, carrier(e.p_), coupler, "pin"),
+                    Connection(e.q_, carrier(e.q_), follower, "pin"),
+                    Connection(e.point, coupler, follower, "pin"),
+                ]
+                made += [by_name[coupler], by_name[follower]]
+            elif e.kind == "rrp":
+                rod, ram = e.bodies
+                out += [
+                    Connection(e.pin, carrier(e.pin), rod, "pin"),
+                    Connection(e.point, rod, ram, "pin"),
+                    Connection(e.point, "ground", ram, "guide"),
+                ]
+                made += [by_name[rod], by_name[ram]]
+            elif e.kind == "rpr":
+                block, lever = e.bodies
+                out += [
+                    Connection(e.pin, carrier(e.pin), block, "pin"),
+                    Connection(e.pivot, carrier(e.pivot), lever, "pin"),
+                    Connection(e.pin, block, lever, "slot", (e.pivot, e.pin)),
+                ]
+                made += [by_name[block], by_name[lever]]
+            elif e.kind == "rpp":
+                out += [Connection(e.pin, carrier(e.pin), e.body, "slot"), Connection(e.pin, "ground", e.body, "guide")]
+                made.append(by_name[e.body])
+            elif e.kind == "slot_line":
+                lever = next(b.name for b in made if b.kind != "block" and {e.pivot, e.through} <= set(b.joints))
+                out += [
+                    Connection(e.point, lever, e.body, "slot", (e.pivot, e.through)),
+                    Connection(e.point, "ground", e.body, "guide"),
+                ]
+                made.append(by_name[e.body])
+        return tuple(out)
 
     def ground_joints(self) -> tuple[str, ...]:
         """The frame pivots, in declaration order (a type's GROUND)."""

@@ -92,8 +92,8 @@ class RelativeMotion:
 
 
 def polygon_figure(rm: RelativeMotion, units: str = "m"):
-    """The velocity and acceleration polygons drawn to scale: each equation's terms head to tail from the pole o,
-    the joint's exact vector dashed from o."""
+    """The velocity and acceleration polygons drawn to scale: each equation's terms head to tail from the pole o
+    (a vector already drawn is not drawn again), the joint's exact vector dashed from o."""
     from qropt.io import plots
 
     fig, axes = plots.plt.subplots(1, 2, figsize=(12, 5.6))
@@ -107,16 +107,23 @@ def polygon_figure(rm: RelativeMotion, units: str = "m"):
     }
     for ax, quantity, unit in ((axes[0], "velocity", f"{units}/s"), (axes[1], "acceleration", f"{units}/s^2")):
         drawn = set()
-        for e in (e for e in rm.equations if e.quantity == quantity):
+        eqs = [e for e in rm.equations if e.quantity == quantity]
+        gap = 0.025 * max([float(np.hypot(*t.vector)) for e in eqs for t in e.terms] + [1e-300])
+        segments: set = set()
+        for e in eqs:
             head = np.zeros(2)
             for t in e.terms:
                 tip = head + t.vector
-                if t.magnitude > 0:
+                seg = tuple(np.round(np.r_[head, tip] / gap, 3))  # a vector drawn already (a known absolute term)
+                if t.magnitude > 0 and seg not in segments:
+                    segments.add(seg)
                     style = {"arrowstyle": "->", "color": colours[t.kind], "lw": 1.4}
                     ax.annotate("", xy=tip, xytext=head, arrowprops=style)
                     ax.plot([head[0], tip[0]], [head[1], tip[1]], alpha=0.0)  # (arrows do not set the limits)
-                    mid = head + 0.5 * t.vector
-                    ax.text(*mid, t.name, fontsize=7, color=colours[t.kind], ha="center", va="bottom")
+                    normal = np.array([-t.vector[1], t.vector[0]]) / t.magnitude  # labels on the left of a term
+                    mid = head + 0.5 * t.vector + gap * normal
+                    ha = "right" if normal[0] < -0.3 else "left" if normal[0] > 0.3 else "center"
+                    ax.text(*mid, t.name, fontsize=7, color=colours[t.kind], ha=ha, va="center")
                 head = tip
             if e.joint not in drawn:  # the joint's exact vector from the pole, once
                 ax.plot([0, e.exact[0]], [0, e.exact[1]], ls="--", color="0.5", lw=0.8)

@@ -157,6 +157,28 @@ class Comparison:
                 lines.append(f"  {r.type:20s} no design: {r.reason}")
         return "\n".join(lines)
 
+    def markdown(self) -> str:
+        """The comparison as a Markdown table, best first: gamma_min in degrees, each criterion in its unit to four
+        significant digits, the chosen parameters (lengths in the unit, angles in degrees)."""
+        u = criteria.units(self.units)
+        head = ["row", "gamma_min [deg]", f"footprint [{u['footprint']}]", f"peak accel [{u['peak_accel']}]"]
+        head += [f"peak velocity [{u['peak_velocity']}]", "parameters"]
+        lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        for r in self.rows:
+            if not r.success:
+                lines.append(f"| {r.type} | no design: {r.reason} |" + " |" * (len(head) - 2))
+                continue
+            c, kinds = r.criteria, r.result.mechanism.kinds()
+            params = {k: 0.0 if abs(v) < 1e-12 * self.stroke else v for k, v in r.result.params.items()}  # no noise
+            shown = [
+                f"{k} = {math.degrees(v):.4g} deg" if kinds[k] == "angle" else f"{k} = {v:.4g}"
+                for k, v in params.items()
+                if kinds[k] != "branch"
+            ]
+            cells = [r.type, f"{math.degrees(c['gamma_min']):.2f}", f"{c['footprint']:.4g}", f"{c['peak_accel']:.4g}"]
+            lines.append("| " + " | ".join([*cells, f"{c['peak_velocity']:.4g}", ", ".join(shown)]) + " |")
+        return "\n".join(lines)
+
     def table(self) -> list[dict]:
         """One dict per row (Row.record, with the length unit under "units"), best first."""
         return [r.record() | {"units": self.units} for r in self.rows]

@@ -65,6 +65,7 @@ class Criterion:
     maximise: ClassVar[bool] = False
     slider_only: ClassVar[bool] = False  # needs a slider output (not FourBar's follower angle)
     size: ClassVar[str | None] = None  # a size measure: the objective is min_size with problem.size = this
+    kinematic: ClassVar[bool] = True  # depends on the motion alone (not on the size or on masses)
 
     # ---- names -------------------------------------------------------------------------------------
     @property

@@ -9,9 +9,9 @@ In order, each step only where the ones before said nothing:
 3. a feasibility solve (no objective): a design meeting every target and condition found there starts one
    refinement of the objective, and otherwise makes the answer 'failed' (the optimum was not reached), never
    'infeasible';
-4. where the closed forms gave the starts, one space-filling search (they may have missed).
-Every solve here runs without diagnosis and with at most ``starts_n`` space-filling starts, so a diagnosis
-costs at most (bounds + 3) solves and 2 * RANGE_SOLVES local solves per target.
+4. where the closed forms gave the starts, one space-filling search of ``starts_n`` starts (they may have missed).
+Every other solve here runs without diagnosis and with at most DIAGNOSIS_STARTS space-filling starts, so a
+diagnosis costs at most (bounds + 3) solves and 2 * RANGE_SOLVES local solves per target.
 """
 
 from __future__ import annotations
@@ -60,7 +60,11 @@ class Diagnosis:
             problem, targets, list(targets), starts_n=n, seed=seed, solves=RANGE_SOLVES, toward=True
         )
         msgs = [range_message(problem, k, targets[k], lo, hi) for k, (lo, hi) in reach.items()]
-        outside = [m for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True) if not inside(targets[k], lo, hi)]
+        outside = [  # a target beyond the designs found; none found proves nothing
+            m
+            for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True)
+            if math.isfinite(lo) and not inside(targets[k], lo, hi)
+        ]
         if proved:
             why = f"no design: the closed form that gives every design ({plan.how}) gives none for these targets"
             return done("infeasible", "; ".join([why, *msgs]), reachable=reach)
@@ -89,7 +93,7 @@ class Diagnosis:
             # space-filling starts, each in its own TR orientation only (a second chance, not a second multi-start)
             none = starts_.plan(problem, use_analytic=False)
             more, how, _ = self.solver.multistart.candidates(
-                problem, none, [], targets, n, seed, self.solver.max_rounds, Designs(), retry=False
+                problem, none, [], targets, starts_n, seed, self.solver.max_rounds, Designs(), retry=False
             )
             if any(c.ok for c in more):
                 return self.solver.best(problem, more, how, none, t0)
@@ -171,7 +175,7 @@ def inside(v, lo, hi) -> bool:
 def range_message(problem, k, v, lo, hi):
     bounds = ", ".join(f"{n} in [{a:g}, {b:g}]" for n, (a, b) in problem.free.items())
     if not math.isfinite(lo):
-        return f"no design turns fully and meets the conditions for {bounds}"
+        return f"no sampled design turns fully and meets the conditions for {bounds}"
     where = "inside" if inside(v, lo, hi) else "below" if v < lo else "above"
     return f"{k} {v:g} is {where} the reachable {lo:.6g}..{hi:.6g} for {bounds}"
 

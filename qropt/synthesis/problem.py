@@ -19,6 +19,7 @@ from types import MappingProxyType
 from typing import Any
 
 from qropt import units as units_
+from qropt.dynamics.model import Loads, Masses
 from qropt.errors import ProblemError, QroptError
 from qropt.mechanisms import Mechanism, mechanism_type, type_reference
 from qropt.mechanisms.base import MAGNITUDE, REQUIRED
@@ -46,7 +47,8 @@ class Problem:
     denominator, lower, upper)]; objective: 'max_gamma_min', 'min_size' (with ``size``), 'min_peak_accel'
     (at ``omega2``, over the 'cycle' or the 'working' stroke), 'min_peak_velocity' (at ``omega2``, over the
     working stroke) or None (see ``qropt.criteria``); branches: name -> allowed signs; units: the length unit
-    of every length above and of the answer (one of ``qropt.units.LENGTH_UNITS``; default metres).
+    of every length above and of the answer (one of ``qropt.units.LENGTH_UNITS``; default metres); masses,
+    loads: the mass model and loads of its dynamics (``qropt.Masses``, ``qropt.Loads``, or their dicts), SI.
     """
 
     mechanism: Any
@@ -61,6 +63,8 @@ class Problem:
     branches: Any = field(default_factory=dict)
     name: str = ""
     units: str = units_.DEFAULT
+    masses: Any = None
+    loads: Any = None
 
     def __post_init__(self):
         try:
@@ -75,6 +79,12 @@ class Problem:
             units_.length_unit(self.units)
         except QroptError as e:
             raise self._err(str(e)) from None
+        for k, kind in (("masses", Masses), ("loads", Loads)):  # data: a dict (a file's table) or the object
+            v = getattr(self, k)
+            try:
+                set_(self, k, v if v is None or isinstance(v, kind) else kind.from_dict(v))
+            except QroptError as e:
+                raise self._err(f"{k}: {e}") from None
         for k in ("fixed", "free", "targets", "conditions", "branches"):
             v = getattr(self, k)
             if v is not None and not isinstance(v, Mapping):
@@ -295,6 +305,8 @@ class Problem:
             "branches": {k: list(v) for k, v in self.branches.items()},
             "name": self.name,
             "units": self.units,
+            **({} if self.masses is None else {"masses": self.masses.to_dict()}),
+            **({} if self.loads is None else {"loads": self.loads.to_dict()}),
         }
 
     @classmethod

@@ -28,6 +28,7 @@ from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import Result
 
 TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
+TIE_TOL = 1e-9  # relative: designs this close to an optimum tie with it (see Solver.least_size)
 RANGE_SAMPLES = 64  # designs spread over the bounds whose exact target values start a reachable range
 RANGE_SOLVES = 4  # local solves that push a reachable range's ends out from the samples
 RANGE_FREE = (RowKind.DEAD_CENTRE, RowKind.ORIENTATION, RowKind.TARGET)  # rows a range's designs need not meet
@@ -39,7 +40,8 @@ class Solver:
     tolerances: {'feasibility': largest accepted violation, 'gap': certified minus NLP epigraph value that
     ends the exchange loop}; ipopt_options: merged into IPOPT's (names as CasADi takes them, 'ipopt.tol');
     samples: uniform epigraph sample angles per formulation (the exchange loop adds up to ``extra`` more);
-    starts_n, seed: the Sobol multi-start used where no closed form enumerates the solutions; backend: an NLP
+    starts_n, seed: the Sobol multi-start used where no closed form enumerates the solutions (without closed
+    forms, starts_n per two free parameters unless a solve names its own); backend: an NLP
     backend (``qropt.synthesis.backends``; default IPOPT). Results do not depend on what the Solver solved
     before: formulations take every value as a parameter.
     """
@@ -133,6 +135,7 @@ class Solver:
         'infeasible' where a closed form that gives every design gives none that is valid.
         """
         t0 = time.perf_counter()
+        asked = starts_n
         problem, targets, extra, starts_n, seed, max_rounds = self._check(
             problem, targets, extra_starts, starts_n, seed, max_rounds
         )
@@ -154,6 +157,8 @@ class Solver:
                 )
             return r
         plan = starts_.plan(problem, use_analytic)
+        if asked is None:
+            starts_n = starts_.grown(starts_n, problem, plan)
         designs = Designs()  # every mechanism this solve builds, built once
         cands, claim, retry = self.multistart.candidates(
             problem, plan, extra, targets, starts_n, seed, max_rounds, designs, retry=not diagnose
@@ -172,7 +177,8 @@ class Solver:
             kw = {"starts_n": starts_n, "seed": seed, "targets": targets, "max_rounds": max_rounds}
             return self.solve(problem, use_analytic=False, diagnose=False, **kw)
         if good:
-            return self.best(problem, cands, claim, plan, t0)
+            r = self.best(problem, cands, claim, plan, t0)
+            return self.least_size(problem, r, targets, seed, max_rounds)
         if not diagnose:
             stats = self._stats(problem, cands, plan)
             stats["t_total"] = time.perf_counter() - t0
@@ -216,6 +222,41 @@ class Solver:
             ]
             return self._result(problem, best_first[0], None, claim, stats, local)
         raise AssertionError("best() of candidates without a certified one")
+
+    def least_size(self, problem, r: Result, targets, seed, max_rounds) -> Result:
+        """Where the type's optima form a continuum (``Mechanism.TIES`` free) and the objective is kinematic, the
+        design of least size (the problem's size measure) among those within TIE_TOL of the optimum: min_size
+        under a bound at the optimum, and alone (where the targets fix the criterion, the bound is redundant and
+        degenerate, and the design stays within TIE_TOL anyway); local solves from the optimum first, then along
+        the closed forms' family. ``r`` where none is optimal and within TIE_TOL."""
+        c = criteria.of_problem(problem)
+        ties = [k for k in problem.mechanism.TIES if k in problem.free]
+        if not ties or c is None or c.size or not c.kinematic or r.status != "optimal":
+            return r
+        tol = TIE_TOL * max(1.0, abs(r.objective))
+        bound = r.objective - tol if c.maximise else r.objective + tol
+        old = problem.conditions.get(c.bound)
+        if old is not None and c.better(old, bound):
+            bound = old
+        start = [{k: r.params[k] for k in problem.free}]
+        kw = {"targets": targets, "seed": seed, "max_rounds": max_rounds, "diagnose": False}
+        bounded = problem.replace(objective="min_size", conditions={**problem.conditions, c.bound: bound})
+        alone = problem.replace(objective="min_size")
+        local = {"use_analytic": False, "extra_starts": start}
+        tries = [(bounded, local), (alone, local), (bounded, {}), (alone, {})]  # from the optimum first
+        for sub, how in tries:
+            s = self.solve(sub, starts_n=0, **how, **kw)
+            if s.status == "optimal" and not c.better(bound, s.quantities[c.name]):
+                size = s.quantities["size"]
+                best = dataclasses.replace(
+                    s,
+                    objective=objective_value(problem, s.quantities),
+                    message=f"{r.message}; optima form a continuum along {', '.join(ties)}: the least "
+                    f"{problem.size} ({size:.6g}) within {tol:.1e} of it ({s.certificate.global_claim})",
+                    local_optima=(),
+                )
+                return dataclasses.replace(best, local_optima=(best, *r.local_optima[1:]))
+        return r
 
     def _check(self, problem, targets, extra_starts, starts_n, seed, max_rounds):
         if not isinstance(problem, Problem):
@@ -321,6 +362,13 @@ class Solver:
                     m = problem.build(v, br)
                     if m.dead_centres().reversals == 1:
                         seen.append((m, v, br))
+        if pts and not seen:  # none of the samples turns: a grid screen of many more finds some that do
+            for v in starts_.turning_points(problem, max(RANGE_SAMPLES, starts_n), seed):
+                for br in starts_.branches(problem):
+                    with contextlib.suppress(QroptError):
+                        m = problem.build(v, br)
+                        if m.dead_centres().reversals == 1:
+                            seen.append((m, v, br))
         out = dict(exact)
         for target in names:
             if not seen:

@@ -7,6 +7,7 @@ that walks a family holding every solution is scanned and only its best points a
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -56,25 +57,37 @@ def plan(problem, use_analytic: bool = True) -> Plan:
 POOL = 64  # Sobol points drawn per start wanted: the type's rules (one vectorised check) thin them first
 
 
-def rule_points(problem, n: int, seed: int) -> list[dict]:
+RULE_DRAWS = 2**17  # Sobol points a rule_points call draws at most
+
+
+def rule_points(problem, n: int, seed: int, least: int = 1) -> list[dict]:
     """Scrambled-Sobol points over the free bounds (log-spaced for lengths), a power of two of them at least n,
     with the points that break the type's rules (Grashof class, crank shorter than the centres and the like)
-    dropped in one vectorised check; none is built."""
+    dropped in one vectorised check; none is built. While fewer than ``least`` pass, four times as many more are
+    drawn (RULE_DRAWS in all at most). If none passes, the first n points as they are."""
     from scipy.stats import qmc  # imported here: scipy.stats takes a second to import
 
     names = list(problem.free)
-    u = qmc.Sobol(len(names), scramble=True, seed=seed).random_base2(max(0, n - 1).bit_length())
-    cols = {}
-    for j, k in enumerate(names):
-        lo, hi = problem.free[k]
-        cols[k] = lo * (hi / lo) ** u[:, j] if k in problem.mechanism.LENGTHS and lo > 0 else lo + (hi - lo) * u[:, j]
-    p = {**problem.fixed, **cols, **branches(problem)[0]}
-    ok = np.ones(u.shape[0], bool)
-    for rule in problem.mechanism.rules(NUMPY, p, problem.conditions.get("grashof")):
-        ok &= np.broadcast_to(np.asarray(rule.value) >= 0, ok.shape)
-    return [{k: float(cols[k][i]) for k in names} for i in np.flatnonzero(ok).tolist()] or [
-        {k: float(cols[k][i]) for k in names} for i in range(min(n, u.shape[0]))
-    ]
+    sampler = qmc.Sobol(len(names), scramble=True, seed=seed)
+    kept: list[dict] = []
+    first: list[dict] = []
+    draw, drawn = 1 << max(0, n - 1).bit_length(), 0
+    while drawn < RULE_DRAWS and (not drawn or len(kept) < least):
+        u = sampler.random(draw)
+        drawn += draw
+        cols = {}
+        for j, k in enumerate(names):
+            lo, hi = problem.free[k]
+            log = k in problem.mechanism.LENGTHS and lo > 0
+            cols[k] = lo * (hi / lo) ** u[:, j] if log else lo + (hi - lo) * u[:, j]
+        p = {**problem.fixed, **cols, **branches(problem)[0]}
+        ok = np.ones(u.shape[0], bool)
+        for rule in problem.mechanism.rules(NUMPY, p, problem.conditions.get("grashof")):
+            ok &= np.broadcast_to(np.asarray(rule.value) >= 0, ok.shape)
+        kept += [{k: float(cols[k][i]) for k in names} for i in np.flatnonzero(ok).tolist()]
+        first = first or [{k: float(cols[k][i]) for k in names} for i in range(min(n, u.shape[0]))]
+        draw = min(4 * draw, RULE_DRAWS - drawn)
+    return kept or first
 
 
 MAX_CORNERS = 64  # the corners of the free bounds tried as designs (every one up to six free parameters)
@@ -92,13 +105,18 @@ def corners(problem) -> list[dict]:
 
 
 def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
-    """Up to n of the ``rule_points`` (POOL * n drawn) whose mechanism turns fully on the first branch; if none
-    does, the first n points as they are. Where every length and offset is free, each point is scaled to meet
+    """Up to n of the ``rule_points`` whose mechanism turns fully on the first branch; if none does, the first n
+    points as they are. With a time-ratio target and no closed forms, ``screen`` chooses them (POOL * n points
+    and at least SCREEN, evaluated at once). Where every length and offset is free, each point is scaled to meet
     the stroke target (TR and angles do not change with scale) when the scaled point stays inside the bounds."""
     if n <= 0:
         return []
     branch = branches(problem)[0]
     build = build or _build
+    if "time_ratio" in problem.targets and plan(problem).kind == "none":  # no closed form helps: screen
+        chosen = screen(problem, n, seed, build)
+        if chosen:
+            return chosen
     pts = rule_points(problem, POOL * n, seed)
     kept = []
     for v in pts:
@@ -109,15 +127,122 @@ def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
     return kept or pts[:n]
 
 
-def _to_stroke(problem, values, branch, build) -> dict:
-    """The design scaled so that its stroke meets the target, if scaling is free and stays in bounds."""
-    stroke = problem.targets.get("stroke")
+def grown(n: int, problem, plan: Plan) -> int:
+    """The default number of space-filling starts: n, and without closed forms n per two free parameters."""
+    return n * max(1, len(problem.free) // 2) if plan.kind == "none" else n
+
+
+SCREEN = 4096  # rule points a screen draws at least
+SCREEN_GRID = 180  # crank angles of a screen's grid
+SCREEN_KEEP = 4  # designs per start wanted evaluated exactly, nearest the TR target first
+SCREEN_CHUNK = 512  # designs per vectorised pass (memory: chunk * grid numbers per intermediate)
+
+
+def screen(problem, n: int, seed: int, build) -> list[dict]:
+    """n starts near the targets: rule points evaluated on a crank-angle grid in vectorised passes (no
+    mechanism built), those that close everywhere with one output reversal a turn scaled to the stroke target
+    where scaling is free, the SCREEN_KEEP * n nearest the TR target built and evaluated exactly, and of those
+    in turn the nearest and the best by the objective among the ones within TR_NEAR of the target. [] if none
+    turns fully."""
+    branch = branches(problem)[0]
+    pts = rule_points(problem, max(SCREEN, POOL * n), seed, least=SCREEN // 8)
+    try:
+        tr, stroke = grid_cycle(problem, pts)
+    except (TypeError, ValueError, IndexError):  # a user type's loop that takes one design at a time
+        return []
+    good = np.flatnonzero(np.isfinite(tr))
+    if good.size == 0:
+        return []
+    target = problem.targets.get("stroke")
     scalable = [k for k, kind in problem.mechanism.kinds().items() if kind in ("length", "offset")]
-    if stroke is None or any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable):
+    if target is not None and not any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable):
+        k = target / stroke[good]  # designs that fit the bounds once scaled to the stroke go first
+        fits = np.ones(good.size, bool)
+        for name, (lo, hi) in problem.free.items():
+            x = np.array([pts[i][name] for i in good.tolist()]) * (k if name in scalable else 1.0)
+            fits &= (x >= lo) & (x <= hi)
+        good = good[fits] if fits.any() else good
+    near = good[np.argsort(np.abs(np.log(tr[good] / problem.targets["time_ratio"])))][: SCREEN_KEEP * n]
+    from qropt.synthesis import criteria  # here: criteria imports the formulation this module imports
+
+    scored = []
+    for i in near.tolist():
+        v = _to_stroke(problem, pts[i], branch, build, stroke=float(stroke[i]))
+        try:
+            m = build(problem, v, branch)
+            miss = abs(math.log(m.time_ratio() / problem.targets["time_ratio"]))
+            f = criteria.objective_of(problem, m) if problem.objective else 0.0
+        except QroptError:
+            continue
+        scored.append((miss, f, v))
+    maximise = bool(problem.objective) and criteria.maximises(problem.objective)
+    best = sorted((s for s in scored if s[0] <= TR_NEAR), key=lambda s: -s[1] if maximise else s[1])
+    nearest = sorted(scored, key=lambda s: s[0])
+    chosen: list[dict] = []
+    for pair in itertools.zip_longest(nearest, best):  # the nearest and the best in turn
+        for s in pair:
+            if s is not None and len(chosen) < n and not any(s[2] is c for c in chosen):
+                chosen.append(s[2])
+    return chosen
+
+
+def grid_cycle(problem, pts: list[dict]) -> tuple[np.ndarray, np.ndarray]:
+    """(TR, stroke) of designs (free-parameter dicts, first branch) on a SCREEN_GRID crank-angle grid, in
+    vectorised passes with no mechanism built; nan where a design does not close everywhere or its output does
+    not reverse exactly once a turn. Grid values: starts and samples, not results."""
+    cls, branch, names = problem.mechanism, branches(problem)[0], list(problem.free)
+    tr, stroke = np.full(len(pts), np.nan), np.full(len(pts), np.nan)
+    if not pts:
+        return tr, stroke
+    cols = {k: np.array([v[k] for v in pts], float) for k in names}
+    given = {**problem.fixed, **branch, **{k: 1.0 for k in names}}
+    base = {k: v for k, v in cls.PARAMS.items() if k not in given and isinstance(v, (int, float))}
+    base.update(cls.completed(given))
+    theta = np.linspace(0.0, 2 * np.pi, SCREEN_GRID, endpoint=False)
+    with np.errstate(all="ignore"):
+        for i in range(0, len(pts), SCREEN_CHUNK):
+            part = {k: c[i : i + SCREEN_CHUNK, None] for k, c in cols.items()}
+            rows = min(SCREEN_CHUNK, len(pts) - i)
+            loop = cls.loop(NUMPY, theta[None, :], {**base, **problem.fixed, **branch, **part})
+            x = np.broadcast_to(loop.x, (rows, theta.size))
+            ok = np.all(np.isfinite(x), axis=1)
+            for _, margin in loop.margins:
+                ok &= np.all(np.broadcast_to(margin, x.shape) >= 0, axis=1)
+            dx = np.diff(x, axis=1, append=x[:, :1])
+            ok &= np.count_nonzero(np.sign(dx) != np.sign(np.roll(dx, 1, axis=1)), axis=1) == 2
+            a = (theta[np.argmin(x, axis=1)] - theta[np.argmax(x, axis=1)]) % (2 * np.pi)
+            a = np.minimum(a, 2 * np.pi - a)
+            ok &= a > 0
+            tr[i : i + rows] = np.where(ok, (2 * np.pi - a) / np.where(ok, a, 1.0), np.nan)
+            stroke[i : i + rows] = np.where(ok, np.ptp(x, axis=1), np.nan)
+    return tr, stroke
+
+
+def turning_points(problem, n: int, seed: int) -> list[dict]:
+    """Up to n rule points (SCREEN drawn at least) that turn fully with one output reversal on the grid."""
+    pts = rule_points(problem, max(SCREEN, n), seed, least=n)
+    try:
+        tr, _ = grid_cycle(problem, pts)
+    except (TypeError, ValueError, IndexError):  # a user type's loop that takes one design at a time
+        return pts[:n]
+    return [pts[i] for i in np.flatnonzero(np.isfinite(tr))[:n].tolist()]
+
+
+TR_NEAR = 0.05  # a screened design within 5 % of the TR target (in log) competes on its objective
+
+
+def _to_stroke(problem, values, branch, build, stroke: float | None = None) -> dict:
+    """The design scaled so that its stroke (given, or evaluated) meets the target, if scaling is free and stays
+    in bounds."""
+    target = problem.targets.get("stroke")
+    scalable = [k for k, kind in problem.mechanism.kinds().items() if kind in ("length", "offset")]
+    if target is None or any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable):
         return values
     try:
-        k = stroke / build(problem, values, branch).stroke()
+        k = target / (stroke if stroke else build(problem, values, branch).stroke())
     except QroptError:
+        return values
+    if not math.isfinite(k) or k <= 0:
         return values
     scaled = {name: x * k if name in scalable else x for name, x in values.items()}
     inside = all(lo <= scaled[name] <= hi for name, (lo, hi) in problem.free.items())
@@ -163,4 +288,16 @@ def local_best(scores: list, maximise: bool, keep: int = 3) -> list[int]:
     return sorted(idx, key=lambda i: -s[i])[:keep]
 
 
-__all__ = ["Plan", "branches", "plan", "sobol", "orientation", "dead_centre_start", "local_best"]
+__all__ = [
+    "Plan",
+    "branches",
+    "plan",
+    "sobol",
+    "grown",
+    "screen",
+    "grid_cycle",
+    "turning_points",
+    "orientation",
+    "dead_centre_start",
+    "local_best",
+]

@@ -1,0 +1,21 @@
+"""Dynamics: the mass model and loads (``model``), exact inverse dynamics (``inverse``), cycle quantities and the
+flywheel (``cycle``), and the crank's motion under a motor (``forward``)."""
+
+from qropt.dynamics.forward import Motor, Simulation, TurnSpeeds, simulate, steady_mean_torque
+from qropt.dynamics.inverse import Dynamics, body_masses, inverse_dynamics
+from qropt.dynamics.model import BodyMass, Counterweight, Loads, Masses
+
+__all__ = [
+    "BodyMass",
+    "Counterweight",
+    "Loads",
+    "Masses",
+    "Dynamics",
+    "body_masses",
+    "inverse_dynamics",
+    "Motor",
+    "Simulation",
+    "TurnSpeeds",
+    "simulate",
+    "steady_mean_torque",
+]

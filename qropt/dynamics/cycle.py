@@ -1,0 +1,177 @@
+"""Cycle quantities of the inverse dynamics: exact extremes (peak torque, peak force at each joint, peak shaking
+force), quadratures over the turn (RMS torque, the energy per stroke) and the flywheel.
+
+Extremes: a grid of the turn, then a bounded scalar search around each grid maximum (to 1e-12 rad). Quadratures:
+Gauss-Legendre on each stroke separately (the cutting force switches at the dead centres, so the integrand is
+smooth only within a stroke). SI units.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
+from qropt.dynamics.inverse import _solve, _System
+from qropt.dynamics.model import Loads, Masses
+
+GRID = 720  # crank angles of the search grid
+GAUSS = 48  # Gauss-Legendre nodes per piece of a stroke
+TWO_PI = 2 * math.pi
+
+
+@dataclass(frozen=True)
+class Peak:
+    """The largest value of a cycle quantity over the turn and the crank angle (rad) where it occurs."""
+
+    value: float
+    theta2: float
+
+
+@dataclass(frozen=True)
+class DynamicExtremes:
+    """Peak |torque| (N m), RMS torque (N m, over the turn), mean torque (N m), the peak force magnitude at each
+    joint (N), the peak shaking force (N) and shaking moment (N m); each Peak with its crank angle."""
+
+    peak_torque: Peak
+    rms_torque: float
+    mean_torque: float
+    peak_forces: dict
+    peak_shaking_force: Peak
+    peak_shaking_moment: Peak
+
+
+@dataclass(frozen=True)
+class Flywheel:
+    """The flywheel for a coefficient of speed fluctuation ``cs`` at mean speed omega2 (rad/s): the energy
+    fluctuation (J: the largest minus the smallest of integral (T - T_mean) dtheta2 over a turn), the added
+    inertia (kg m^2) ``energy_fluctuation / (cs omega2^2)``, the mean torque (N m), the energy per turn (J) and
+    the energy the motor delivers on the working and on the return stroke (J)."""
+
+    cs: float
+    omega2: float
+    energy_fluctuation: float
+    inertia: float
+    mean_torque: float
+    energy_per_turn: float
+    working_energy: float
+    return_energy: float
+
+
+class CycleDynamics:
+    """The dynamics of one mechanism, masses and loads at omega2 and alpha2, evaluated at any crank angles."""
+
+    def __init__(self, m, omega2: float, alpha2: float = 0.0, masses=None, loads=None):
+        from qropt.dynamics.inverse import _has_load
+        from qropt.errors import InvalidParameter
+        from qropt.mechanisms.base import _finite
+
+        self.m = m
+        self.omega2, self.alpha2 = _finite("omega2", omega2), _finite("alpha2", alpha2)
+        self.loads = Loads() if loads is None else loads
+        if not isinstance(self.loads, Loads):
+            raise InvalidParameter(f"loads is a qropt.Loads, got {type(self.loads).__name__}")
+        if self.omega2 == 0.0 and _has_load(self.loads):
+            raise InvalidParameter("omega2 must be nonzero with a cutting force or friction: they resist the motion")
+        self.system = _System(m, Masses() if masses is None else masses)
+        d = m.dead_centres()
+        a, _ = m.stroke_angles()
+        self.pieces = [(d.theta_max, d.theta_max + a), (d.theta_max + a, d.theta_max + TWO_PI)]
+
+    def at(self, theta2):
+        return _solve(
+            self.m, self.system, np.atleast_1d(np.asarray(theta2, float)), self.omega2, self.alpha2, self.loads
+        )
+
+    def quadrature(self, f, pieces=None):
+        """integral of f(Dynamics) over the pieces (default: the two strokes, i.e. a turn), Gauss-Legendre."""
+        x, w = np.polynomial.legendre.leggauss(GAUSS)
+        total = 0.0
+        for lo, hi in pieces or self.pieces:
+            t = 0.5 * (hi - lo) * x + 0.5 * (hi + lo)
+            total += 0.5 * (hi - lo) * float(np.dot(w, f(self.at(t % TWO_PI))))
+        return total
+
+    def peak(self, f) -> Peak:
+        """The largest f(Dynamics) over the turn: the grid's best, then a bounded search around it."""
+        t = np.linspace(0.0, TWO_PI, GRID, endpoint=False)
+        v = f(self.at(t))
+        i = int(np.argmax(v))
+        h = TWO_PI / GRID
+        r = minimize_scalar(
+            lambda th: -float(f(self.at(th % TWO_PI))[0]),
+            bounds=(t[i] - h, t[i] + h),
+            method="bounded",
+            options={"xatol": 1e-12},
+        )
+        best = -float(r.fun)
+        if best >= v[i]:
+            return Peak(best, float(r.x % TWO_PI))
+        return Peak(float(v[i]), float(t[i]))
+
+    def extremes(self) -> DynamicExtremes:
+        t = np.linspace(0.0, TWO_PI, GRID, endpoint=False)
+        joints = list(self.at(t[:1]).joint_forces)
+        mean = self.quadrature(lambda d: d.torque) / TWO_PI
+        rms = math.sqrt(self.quadrature(lambda d: d.torque**2) / TWO_PI)
+        return DynamicExtremes(
+            peak_torque=self.peak(lambda d: np.abs(d.torque)),
+            rms_torque=rms,
+            mean_torque=mean,
+            peak_forces={j: self.peak(lambda d, j=j: np.hypot(*d.joint_forces[j].T)) for j in joints},
+            peak_shaking_force=self.peak(lambda d: np.hypot(*d.shaking_force.T)),
+            peak_shaking_moment=self.peak(lambda d: np.abs(d.shaking_moment)),
+        )
+
+    def flywheel(self, cs: float) -> Flywheel:
+        """See ``Flywheel``: the energy's extremes where T = T_mean, each root refined by brentq."""
+        from qropt.errors import InvalidParameter
+
+        if isinstance(cs, bool) or not isinstance(cs, (int, float)) or not 0 < cs < 2:
+            raise InvalidParameter(f"cs, the coefficient of speed fluctuation, is a number in (0, 2), got {cs!r}")
+        if self.omega2 == 0 or self.alpha2 != 0:
+            raise InvalidParameter("the flywheel is sized at a constant, nonzero omega2 (alpha2 = 0)")
+        mean = self.quadrature(lambda d: d.torque) / TWO_PI
+        t0 = self.pieces[0][0]
+        t = t0 + np.linspace(0.0, TWO_PI, GRID + 1)
+
+        def excess(th):
+            return float(self.at(th % TWO_PI).torque[0]) - mean
+
+        v = self.at(t % TWO_PI).torque - mean
+        roots = [t0]
+        for i in range(GRID):
+            if v[i] == 0.0:
+                roots.append(float(t[i]))
+            elif v[i] * v[i + 1] < 0:
+                roots.append(brentq(excess, t[i], t[i + 1], xtol=1e-13))
+        roots.append(t0 + TWO_PI)
+        cuts = sorted({*roots, self.pieces[0][1]})  # the dead centre splits the integrand's smooth pieces
+        energy, e = [0.0], 0.0
+        for lo, hi in zip(cuts, cuts[1:], strict=False):
+            if hi - lo > 0:
+                e += self.quadrature(lambda d: d.torque - mean, [(lo, hi)])
+                energy.append(e)
+        delta = max(energy) - min(energy)
+        work = self.quadrature(lambda d: d.torque, [self.pieces[0]])
+        back = self.quadrature(lambda d: d.torque, [self.pieces[1]])
+        working_first = self.m.working_direction(self.omega2) is not None and _first_is_working(self.m, self.omega2)
+        w, r = (work, back) if working_first else (back, work)
+        sense = math.copysign(1.0, self.omega2)  # energy delivered: the integral of T omega2 dt = sign * T dtheta2
+        w, r = sense * w, sense * r
+        inertia = delta / (cs * self.omega2**2)
+        return Flywheel(cs, self.omega2, delta, inertia, mean, sense * TWO_PI * mean, w, r)
+
+
+def _first_is_working(m, omega2) -> bool:
+    """Whether the crank interval theta_max -> theta_min (counter-clockwise) is the working stroke."""
+    from qropt.dynamics.inverse import _working
+
+    d = m.dead_centres()
+    a, _ = m.stroke_angles()
+    return bool(_working(m, np.array([(d.theta_max + a / 2) % TWO_PI]), omega2)[0])
+
+
+__all__ = ["CycleDynamics", "DynamicExtremes", "Flywheel", "Peak"]

@@ -1,0 +1,462 @@
+"""Exact inverse dynamics of a linkage declared with the builder: the input torque, every joint force, the shaking
+force and moment, at given crank angles, omega2 and alpha2.
+
+The jets of the loop (the same code as the kinematics) give each body's centre-of-mass acceleration and angular
+acceleration exactly; Newton-Euler's equations of every moving body (three for a rigid body, two for the point
+ram) are then one linear system per crank angle, solved at all angles at once. Unknowns: the crank torque T, a
+force vector at every pin, a force along the contact normal at every slot (a block or pin in a slot, the yoke),
+the guide's normal force under the ram (and the moment a yoke-ram's guide carries), and the couple between a
+massive crank-pin block and its slot. A massless block (the default) passes its force straight from the crank to
+the lever along the slot's normal. Friction on the slide (mu |N| against the ram's velocity) makes the system
+depend on N: it is solved by fixed-point iteration. SI units throughout.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from qropt import units as units_
+from qropt.dynamics.model import BodyMass, Loads, Masses
+from qropt.errors import DegenerateMechanism, InvalidParameter
+from qropt.kinematics.ops import JET, Jet
+
+FRICTION_ITERATIONS = 200  # fixed-point steps at most for the slide's friction
+FRICTION_TOL = 1e-13  # relative change of the guide force that ends them
+LENGTH_GRID = 720  # crank angles where a lever's reach is sampled before its exact maximum is refined
+
+
+@dataclass(frozen=True)
+class Dynamics:
+    """Inverse dynamics over crank angles ``theta2`` (rad) at omega2 (rad/s), alpha2 (rad/s^2), SI units.
+
+    torque: (n,) N m, the motor's torque on the crank (``torque * omega2`` the power it delivers);
+    joint_forces: joint -> (n, 2) N, what the driven body receives across the joint ('O2' the crank's ground
+    bearing; 'slide' the guide's force on the ram: its normal force and, with friction, the friction along x);
+    shaking_force: (n, 2) N, ``-sum(m a_G)``; shaking_moment: (n,) N m about O2, ``-sum(r_G x m a_G + I alpha)``;
+    guide_moment: (n,) N m the yoke-ram's guide carries (None without a yoke)."""
+
+    theta2: np.ndarray
+    omega2: float
+    alpha2: float
+    torque: np.ndarray
+    joint_forces: dict
+    shaking_force: np.ndarray
+    shaking_moment: np.ndarray
+    guide_moment: np.ndarray | None = None
+
+    @property
+    def power(self) -> np.ndarray:
+        """W, the power the motor delivers (``torque * omega2``)."""
+        return self.torque * self.omega2
+
+    def force_magnitudes(self) -> dict:
+        """joint -> (n,) N, the magnitude of each joint force."""
+        return {k: np.hypot(v[:, 0], v[:, 1]) for k, v in self.joint_forces.items()}
+
+
+def _parts(j, shape) -> np.ndarray:
+    """(3, n): value, first and second time derivative of a jet or a constant."""
+    if isinstance(j, Jet):
+        return np.broadcast_to(j.c, (3, *shape)).astype(float)
+    out = np.zeros((3, *shape))
+    out[0] = float(j)
+    return out
+
+
+def linkage_of(m):
+    """The builder linkage of a mechanism (InvalidParameter for a hand-written loop)."""
+    link = type(m).linkage(m.params)
+    if link is None:
+        raise InvalidParameter(
+            f"{type(m).__name__}: dynamics needs the joints and bodies of a linkage declared with the builder "
+            "(qropt.mechanisms.builder.Linkage); this type's loop is hand-written"
+        )
+    return link
+
+
+def _frame(body, pts, kind_angle):
+    """(origin (x, y) jets, angle jet) of a body's frame: origin at its first joint, x along the body."""
+    first = pts[body.joints[0]]
+    if body.kind in ("ram",):
+        return first, 0.0
+    if body.kind == "yoke":
+        return (first[0], 0.0), 0.0
+    if body.kind == "block":  # at the pin, turning with the slot's line pivot->pin
+        pin, pivot = pts[body.joints[0]], pts[body.joints[1]]
+        return pin, JET.atan2(pin[1] - pivot[1], pin[0] - pivot[0])
+    second = pts[body.joints[1]]
+    return first, JET.atan2(second[1] - first[1], second[0] - first[0])
+
+
+def body_masses(m, masses: Masses) -> dict[str, BodyMass]:
+    """Every moving body's mass model in SI (body frames as in ``Dynamics``): the defaults of ``masses`` (uniform
+    slender bars, a point ram, a point block, the counterweight on the crank) with its overrides."""
+    if not isinstance(masses, Masses):
+        raise InvalidParameter(f"masses is a qropt.Masses, got {type(masses).__name__}")
+    k = units_.to_metres(m.units)
+    bodies = linkage_of(m).bodies()
+    unknown = sorted(set(masses.bodies) - {b.name for b in bodies})
+    if unknown:
+        raise InvalidParameter(f"{type(m).__name__} has no bodies {unknown}; its bodies: {[b.name for b in bodies]}")
+    t = np.linspace(0.0, 2 * math.pi, LENGTH_GRID, endpoint=False)
+    reach = None
+    out = {}
+    for b in bodies:
+        if b.name in masses.bodies:
+            bm = masses.bodies[b.name]
+        elif b.kind in ("ram", "yoke"):
+            bm = BodyMass(masses.ram)
+        elif b.kind == "block":
+            bm = BodyMass(masses.block)
+        else:
+            if reach is None:
+                reach = _reaches(m, t)
+            bars = [k * reach(b.joints[0], j) for j in b.joints[1:]]
+            if b.kind != "plate":
+                bars = [max(bars)]
+            bm = _bars(b, bars, m, k, masses.density)
+        if b.name == "crank" and masses.counterweight is not None and masses.counterweight.mass > 0:
+            cw = masses.counterweight
+            bm = _combined(bm, BodyMass(cw.mass, (cw.radius * math.cos(cw.angle), cw.radius * math.sin(cw.angle))))
+        out[b.name] = bm
+    return out
+
+
+def _reaches(m, t):
+    """reach(a, b): the largest distance (mechanism units) between joints a and b over a turn: exact for joints
+    fixed on one body (constant), refined by Newton on the jets' derivative where b slides along a lever."""
+    pos = m.positions(t).points
+
+    def reach(a, b):
+        d = np.hypot(*(pos[b] - pos[a]).T)
+        if np.ptp(d) <= 1e-12 * max(1.0, d.max()):
+            return float(d.max())
+        th = float(t[int(np.argmax(d))])
+        for _ in range(8):  # Newton on d(|r|^2)/dtheta = 0 from the grid's best
+            lp = m.evaluate(JET, Jet.seed(np.array([th])))
+            (ax, ay), (bx, by) = lp.points[a], lp.points[b]
+            dx, dy = _parts(bx, (1,)) - _parts(ax, (1,)), _parts(by, (1,)) - _parts(ay, (1,))
+            g1 = dx[0] * dx[1] + dy[0] * dy[1]
+            g2 = dx[1] ** 2 + dx[0] * dx[2] + dy[1] ** 2 + dy[0] * dy[2]
+            if not g2[0] < 0:
+                break
+            step = float(g1[0] / g2[0])
+            th -= step
+            if abs(step) < 1e-14:
+                break
+        lp = m.evaluate(JET, Jet.seed(np.array([th])))
+        (ax, ay), (bx, by) = lp.points[a], lp.points[b]
+        exact = float(np.hypot(_parts(bx, (1,))[0] - _parts(ax, (1,))[0], _parts(by, (1,))[0] - _parts(ay, (1,))[0])[0])
+        return max(exact, float(d.max()))
+
+    return reach
+
+
+def _bars(body, lengths, m, k, density) -> BodyMass:
+    """Uniform slender bars from the body's first joint along each other joint's direction (the body frame's
+    x-axis for the first; a plate's other bars at their angle in the frame)."""
+    if body.kind != "plate":
+        L = lengths[0]
+        mass = density * L
+        return BodyMass(mass, (L / 2, 0.0), mass * L * L / 12)
+    pos = m.positions(np.array([0.0])).points
+    o = pos[body.joints[0]][0]
+    x_dir = pos[body.joints[1]][0] - o
+    phi = math.atan2(x_dir[1], x_dir[0])
+    parts = []
+    for j, L in zip(body.joints[1:], lengths, strict=True):
+        d = pos[j][0] - o
+        a = math.atan2(d[1], d[0]) - phi
+        mass = density * L
+        parts.append(BodyMass(mass, (L / 2 * math.cos(a), L / 2 * math.sin(a)), mass * L * L / 12))
+    out = parts[0]
+    for p in parts[1:]:
+        out = _combined(out, p)
+    return out
+
+
+def _combined(a: BodyMass, b: BodyMass) -> BodyMass:
+    """Two rigid parts in one frame as one body (parallel axes)."""
+    mass = a.mass + b.mass
+    if mass == 0:
+        return BodyMass(0.0)
+    com = tuple((a.mass * ca + b.mass * cb) / mass for ca, cb in zip(a.com, b.com, strict=True))
+    inertia = a.inertia + b.inertia
+    inertia += a.mass * ((a.com[0] - com[0]) ** 2 + (a.com[1] - com[1]) ** 2)
+    inertia += b.mass * ((b.com[0] - com[0]) ** 2 + (b.com[1] - com[1]) ** 2)
+    return BodyMass(mass, com, inertia)
+
+
+class _System:
+    """The Newton-Euler system of one mechanism: bodies, unknowns and the rows they enter."""
+
+    def __init__(self, m, masses: Masses):
+        link = linkage_of(m)
+        self.props = body_masses(m, masses)
+        bodies = list(link.bodies())
+        conns = list(link.connections())
+        block = next((b for b in bodies if b.kind == "block"), None)
+        self.block_massive = block is not None and self.props[block.name].mass > 0
+        if block is not None and not self.block_massive:  # crank -> lever straight along the slot's normal
+            bodies = [b for b in bodies if b is not block]
+            pin = next(c for c in conns if c.receiver == block.name and c.kind == "pin")
+            conns = [
+                c._replace(giver=pin.giver) if c.giver == block.name else c
+                for c in conns
+                if not (c.receiver == block.name and c.kind == "pin")
+            ]
+        self.bodies = bodies
+        self.conns = conns
+        self.ground = set(link.ground_joints())
+        rows, n = {}, 0
+        for b in bodies:
+            rows[b.name] = n
+            n += 2 if b.kind == "ram" else 3
+        self.rows, self.n_rows = rows, n
+        cols, n = [], 1  # column 0: the crank torque
+        for c in conns:
+            width = 2 if c.kind == "pin" else 1
+            cols.append((c, n, width))
+            n += width
+        self.cols = cols
+        self.yoke = next((b.name for b in bodies if b.kind == "yoke"), None)
+        if self.yoke is not None:
+            self.guide_moment_col = n
+            n += 1
+        if self.block_massive:
+            self.couple_col = n
+            n += 1
+        if n != self.n_rows:
+            raise InvalidParameter(
+                f"{type(m).__name__}: {self.n_rows} equations of motion against {n} unknown forces; the force "
+                "analysis needs a linkage whose every body is held by pins, slots and the ram's guide"
+            )
+        self.n = n
+
+
+def inverse_dynamics(m, theta2, omega2: float = 1.0, alpha2: float = 0.0, *, masses=None, loads=None) -> Dynamics:
+    """Inverse dynamics of ``m`` at crank angles theta2 (rad); see ``Dynamics``."""
+    from qropt.mechanisms.base import _finite
+
+    masses = Masses() if masses is None else masses
+    loads = Loads() if loads is None else loads
+    if not isinstance(loads, Loads):
+        raise InvalidParameter(f"loads is a qropt.Loads, got {type(loads).__name__}")
+    omega2, alpha2 = _finite("omega2", omega2), _finite("alpha2", alpha2)
+    if omega2 == 0.0 and (_has_load(loads)):
+        raise InvalidParameter("omega2 must be nonzero with a cutting force or friction: they resist the motion")
+    t = m._angles(theta2)
+    sys_ = _System(m, masses)
+    return _solve(m, sys_, t, omega2, alpha2, loads)
+
+
+def _has_load(loads: Loads) -> bool:
+    f = loads.cutting_force
+    return bool(
+        loads.friction or loads.follower_torque or (np.any(np.array(f)[:, 1] > 0) if isinstance(f, tuple) else f)
+    )
+
+
+def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
+    k = units_.to_metres(m.units)
+    shape = t.shape
+    n = t.size
+    lp = m.evaluate(JET, Jet.seed(t, omega2, alpha2))
+    pts = {j: (xy[0], xy[1]) for j, xy in lp.points.items()}
+    P = {j: np.stack([_parts(x, shape)[0], _parts(y, shape)[0]], axis=-1) * k for j, (x, y) in pts.items()}
+    g = loads.gravity
+    A = np.zeros((n, s.n, s.n))
+    rhs = np.zeros((n, s.n))
+    kin = {}
+    for b in s.bodies:
+        bm = s.props[b.name]
+        origin, phi = _frame(b, pts, None)
+        ph = _parts(phi, shape)
+        ox, oy = (_parts(c, shape) * k for c in origin)
+        c, sn = np.cos(ph[0]), np.sin(ph[0])
+        cx, cy = bm.com
+        gx = ox[0] + c * cx - sn * cy
+        gy = oy[0] + sn * cx + c * cy
+        # r_G = o + R(phi) c: velocity o' + phi' J R c, acceleration o'' + phi'' J R c - phi'^2 R c
+        rx, ry = c * cx - sn * cy, sn * cx + c * cy
+        vx, vy = ox[1] - ph[1] * ry, oy[1] + ph[1] * rx
+        ax = ox[2] - ph[2] * ry - ph[1] ** 2 * rx
+        ay = oy[2] + ph[2] * rx - ph[1] ** 2 * ry
+        kin[b.name] = (np.stack([gx, gy], -1), np.stack([vx, vy], -1), np.stack([ax, ay], -1), ph[1], ph[2], bm)
+        r = s.rows[b.name]
+        rhs[:, r] = bm.mass * ax
+        rhs[:, r + 1] = bm.mass * ay + bm.mass * g
+        if b.kind != "ram":
+            rhs[:, r + 2] = bm.inertia * ph[2]
+    crank = s.rows["crank"]
+    A[:, crank + 2, 0] = 1.0  # the motor's torque on the crank
+
+    def put(body, col, fx, fy, at):
+        """A unit unknown in column col gives the force (fx, fy) on ``body`` at point ``at``."""
+        if body == "ground":
+            return
+        r = s.rows[body]
+        G = kin[body][0]
+        A[:, r, col] += fx
+        A[:, r + 1, col] += fy
+        if _kind(s, body) != "ram":
+            A[:, r + 2, col] += (at[:, 0] - G[:, 0]) * fy - (at[:, 1] - G[:, 1]) * fx
+
+    guide_col = None
+    for c, col, _ in s.cols:
+        at = P[c.joint]
+        if c.kind == "pin":
+            for i, (fx, fy) in enumerate(((1.0, 0.0), (0.0, 1.0))):
+                put(c.receiver, col + i, fx, fy, at)
+                put(c.giver, col + i, -fx, -fy, at)
+        elif c.kind == "slot":
+            nx, ny = _normal(c, P, n)
+            put(c.receiver, col, nx, ny, at)
+            put(c.giver, col, -nx, -ny, at)
+        else:  # the guide under the ram: a force normal to the slide line, at the ram's joint
+            guide_col = col
+            put(c.receiver, col, 0.0, 1.0, at if _kind(s, c.receiver) != "yoke" else kin[c.receiver][0])
+    if s.yoke is not None:
+        A[:, s.rows[s.yoke] + 2, s.guide_moment_col] = 1.0
+    if s.block_massive:
+        block = next(b.name for b in s.bodies if b.kind == "block")
+        lever = next(c.receiver for c in s.conns if c.giver == block and c.kind == "slot")
+        A[:, s.rows[block] + 2, s.couple_col] = 1.0
+        A[:, s.rows[lever] + 2, s.couple_col] = -1.0
+
+    out_body = next((b for b in s.bodies if b.kind in ("ram", "yoke")), None)
+    external = np.zeros((n, s.n))  # known applied forces moved to the right-hand side: cutting force, torque
+    working = _working(m, t, omega2)
+    if out_body is not None:
+        v_out = kin[out_body.name][1][:, 0]
+        x_out = P[m.output_joint()][:, 0] / k if m.output_joint() else kin[out_body.name][0][:, 0] / k
+        f_cut = np.where(working, loads.force_at(x_out), 0.0) * -np.sign(v_out)
+        r = s.rows[out_body.name]
+        external[:, r] += f_cut  # along x, through the ram's point (no moment about a yoke's centre on its line)
+    elif loads.follower_torque and m.OUTPUT == "follower":
+        fol = next(b for b in s.bodies if b.name == "follower")
+        w4 = kin[fol.name][3]
+        external[:, s.rows[fol.name] + 2] += np.where(working, -loads.follower_torque * np.sign(w4), 0.0)
+    friction = np.zeros(n)
+    v_sign = -np.sign(kin[out_body.name][1][:, 0]) if out_body is not None else 0.0
+    try:
+        x = np.linalg.solve(A, (rhs - external)[..., None])[..., 0]
+        if loads.friction and guide_col is not None:
+            r = s.rows[out_body.name]
+            for _ in range(FRICTION_ITERATIONS):
+                new = loads.friction * np.abs(x[:, guide_col]) * v_sign
+                ext = external.copy()
+                ext[:, r] += new
+                x_new = np.linalg.solve(A, (rhs - ext)[..., None])[..., 0]
+                done = np.max(np.abs(x_new[:, guide_col] - x[:, guide_col])) <= FRICTION_TOL * max(
+                    1.0, float(np.max(np.abs(x_new[:, guide_col])))
+                )
+                x, friction = x_new, new
+                if done:
+                    break
+    except np.linalg.LinAlgError:
+        raise DegenerateMechanism(
+            f"{m!r}: the force analysis is singular at some crank angle (a transmission angle of zero: no force "
+            "can drive the output there)"
+        ) from None
+    forces = {}
+    for c, col, _ in s.cols:
+        if c.kind == "pin":
+            key = f"{c.joint}/block" if s.block_massive and _kind(s, c.receiver) == "block" else c.joint
+            forces[key] = x[:, col : col + 2].copy()
+        elif c.kind == "slot":
+            nx, ny = _normal(c, P, n)
+            forces[c.joint] = np.stack([x[:, col] * nx, x[:, col] * ny], -1) * np.ones((n, 1))
+        else:
+            forces["slide"] = np.stack([friction * np.ones(n), x[:, col]], -1)
+    sf = np.zeros((n, 2))
+    sm = np.zeros(n)
+    for G, _, a, _, alpha, bm in kin.values():
+        ma = bm.mass * a
+        sf -= ma
+        sm -= G[:, 0] * ma[:, 1] - G[:, 1] * ma[:, 0] + bm.inertia * alpha
+    gm = x[:, s.guide_moment_col] if s.yoke is not None else None
+    return Dynamics(t, omega2, alpha2, x[:, 0].copy(), forces, sf, sm, gm)
+
+
+@dataclass(frozen=True)
+class Generalised:
+    """The crank's equation of motion ``T = M theta2'' + M' theta2'^2 / 2 + Q`` at crank angles theta2 (rad), SI:
+    M (kg m^2) = sum(m |dr_G/dtheta2|^2 + I (dphi/dtheta2)^2), M' = dM/dtheta2, and Q (N m) the torque the loads
+    and gravity need at the crank, for a crank turning in the sense of ``sense`` (the cutting force resists the
+    working stroke, which depends on it; friction, which depends on the speed, is not in Q)."""
+
+    theta2: np.ndarray
+    M: np.ndarray
+    dM: np.ndarray
+    Q: np.ndarray
+
+
+def generalised(m, theta2, *, masses=None, loads=None, sense: float = 1.0) -> Generalised:
+    """See ``Generalised``; from the jets (seeded with omega2 = 1, alpha2 = 0) and the loads' virtual work."""
+    masses = Masses() if masses is None else masses
+    loads = Loads() if loads is None else loads
+    if loads.friction:
+        raise InvalidParameter("friction depends on the speed: it has no place in the generalised load Q")
+    t = m._angles(theta2)
+    s = _System(m, masses)
+    k = units_.to_metres(m.units)
+    lp = m.evaluate(JET, Jet.seed(t, 1.0, 0.0))
+    pts = {j: (xy[0], xy[1]) for j, xy in lp.points.items()}
+    M = np.zeros(t.shape)
+    dM = np.zeros(t.shape)
+    Q = np.zeros(t.shape)
+    for b in s.bodies:
+        bm = s.props[b.name]
+        origin, phi = _frame(b, pts, None)
+        ph = _parts(phi, t.shape)
+        ox, oy = (_parts(c, t.shape) * k for c in origin)
+        c, sn = np.cos(ph[0]), np.sin(ph[0])
+        rx, ry = c * bm.com[0] - sn * bm.com[1], sn * bm.com[0] + c * bm.com[1]
+        vx, vy = ox[1] - ph[1] * ry, oy[1] + ph[1] * rx  # dr_G/dtheta2
+        ax = ox[2] - ph[2] * ry - ph[1] ** 2 * rx
+        ay = oy[2] + ph[2] * rx - ph[1] ** 2 * ry
+        M += bm.mass * (vx * vx + vy * vy) + bm.inertia * ph[1] ** 2
+        dM += 2 * (bm.mass * (vx * ax + vy * ay) + bm.inertia * ph[1] * ph[2])
+        Q += bm.mass * loads.gravity * vy
+    if m.output_joint() is not None or m.OUTPUT == "follower":
+        x = _parts(lp.x, t.shape)
+        working = _working(m, t, sense)
+        if m.OUTPUT == "slider":
+            Q += np.where(working, loads.force_at(x[0]) * np.abs(x[1]) * k, 0.0) * math.copysign(1.0, sense)
+        else:
+            Q += np.where(working, loads.follower_torque * np.abs(x[1]), 0.0) * math.copysign(1.0, sense)
+    return Generalised(t, M, dM, Q)
+
+
+def _kind(s: _System, body: str) -> str:
+    return next(b.kind for b in s.bodies if b.name == body)
+
+
+def _normal(c, P, n):
+    """The unit normal of a slot's line (rotated +90 degrees from a->b); the yoke's: +x."""
+    if c.line is None:
+        return np.ones(n), np.zeros(n)
+    a, b = P[c.line[0]], P[c.line[1]]
+    d = b - a
+    L = np.hypot(d[:, 0], d[:, 1])
+    return -d[:, 1] / L, d[:, 0] / L
+
+
+def _working(m, t, omega2) -> np.ndarray:
+    """Where the output moves on its working (slow) stroke at these crank angles."""
+    a, _ = m.stroke_angles()
+    d = m.dead_centres()
+    s = (t - d.theta_max) % (2 * math.pi)
+    down = s < a  # from theta_max to theta_min counter-clockwise: the output decreases for omega2 > 0
+    way = m.working_direction(omega2 if omega2 else 1.0)
+    if way is None:
+        return np.zeros(t.shape, bool)
+    decreasing = down if omega2 > 0 else ~down
+    return decreasing if way == "-x" else ~decreasing
+
+
+__all__ = ["Dynamics", "Generalised", "inverse_dynamics", "generalised", "body_masses", "linkage_of"]

@@ -1,0 +1,80 @@
+"""The dynamics on the command line and in the report: the same numbers as the library, one-line errors."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+
+import qropt
+from qropt import cli
+from qropt.examples import paper_mechanism
+
+ARGS = ["analyze", "--omega2", "10", "--dynamics", "--density", "1.57", "--ram-mass", "20", "--force", "1000"]
+
+
+def _library():
+    m = paper_mechanism()
+    masses, loads = qropt.Masses.bars(1.57, 20.0), qropt.Loads(1000.0)
+    return m, masses, loads, m.dynamic_extremes(10.0, masses=masses, loads=loads)
+
+
+def test_the_json_carries_the_librarys_peaks_and_flywheel(capsys):
+    assert cli.main([*ARGS, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    m, masses, loads, ex = _library()
+    assert out["peak_torque"]["value"] == pytest.approx(ex.peak_torque.value, rel=1e-12)
+    assert out["rms_torque"] == pytest.approx(ex.rms_torque, rel=1e-12)
+    assert {k: v["value"] for k, v in out["peak_forces"].items()} == pytest.approx(
+        {k: p.value for k, p in ex.peak_forces.items()}, rel=1e-12
+    )
+    fw = m.flywheel(10.0, 0.05, masses=masses, loads=loads)
+    assert out["flywheel"]["inertia"] == pytest.approx(fw.inertia, rel=1e-12)
+    assert out["flywheel"]["energy_per_turn"] == pytest.approx(300.0, rel=1e-9)  # 1000 N over the 0.3 m stroke
+
+
+def test_text_plot_and_csv(tmp_path, capsys):
+    png, table = tmp_path / "forces.png", tmp_path / "forces.csv"
+    assert cli.main([*ARGS, "--plot", str(png), "--csv", str(table)]) == 0
+    text = capsys.readouterr().out
+    assert "peak torque" in text and "flywheel" in text and "peak force O4" in text
+    assert png.stat().st_size > 20_000
+    rows = list(csv.DictReader(table.open()))
+    assert len(rows) == 360
+    m, masses, loads, _ = _library()
+    d = m.dynamics(np.radians([float(r["theta2_deg"]) for r in rows]), 10.0, masses=masses, loads=loads)
+    assert [float(r["torque_Nm"]) for r in rows] == pytest.approx(d.torque, rel=1e-9, abs=1e-9)
+    assert [float(r["O4_x_N"]) for r in rows] == pytest.approx(d.joint_forces["O4"][:, 0], rel=1e-9, abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        (["--density", "-1"], "density"),
+        (["--force", "-5"], "cutting_force"),
+        (["--cs", "3"], "cs"),
+        (["--omega2", "0"], "omega2"),
+    ],
+)
+def test_bad_dynamics_input_is_one_line(extra, words, capsys):
+    assert cli.main([*ARGS, *extra]) != 0
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and words in err and "Traceback" not in err
+
+
+def test_the_report_states_its_assumptions_and_the_librarys_numbers():
+    from qropt.io.report import FORCES, _forces
+
+    m = paper_mechanism()
+    text = _forces(m)
+    ex = m.dynamic_extremes(
+        FORCES["omega2"],
+        masses=qropt.Masses.steel(FORCES["area"], FORCES["ram"]),
+        loads=qropt.Loads(FORCES["force"], gravity=FORCES["gravity"]),
+    )
+    assert "20 mm x 10 mm" in text and "20 kg ram" in text and "1000 N" in text
+    assert f"<td>{ex.peak_torque.value:.6g}</td>" in text
+    assert f"<td>{math.degrees(ex.peak_torque.theta2):.6g}</td>" in text
