@@ -80,10 +80,12 @@ def type_problem(
     omega2: float = 1.0,
     size: str = "footprint",
     units: str = units_.DEFAULT,
+    masses=None,
+    loads=None,
 ) -> Problem:
     """The task as a Problem of one type (a name of ``TYPES``, or a slider type of one's own: see ``type_row``):
     default bounds scaled by the stroke, ``bounds`` (name -> (lo, hi)) overriding those the type has,
-    ``conditions`` added to the type's own; lengths in ``units``."""
+    ``conditions`` added to the type's own; lengths in ``units``; ``masses`` and ``loads`` for its dynamics."""
     kind, (mech, lengths, offsets, fixed, angles) = type_row(kind, bounds)
     s = stroke
     free = {k: bounds_of("length", s) for k in lengths} | {k: bounds_of("offset", s) for k in offsets}
@@ -102,6 +104,8 @@ def type_problem(
         size=size,
         name=f"{kind} TR {time_ratio:g} stroke {stroke:g} {units}",
         units=units,
+        masses=masses,
+        loads=loads,
     )
 
 
@@ -237,14 +241,18 @@ def design(
     solver=None,
     progress=None,
     units: str = units_.DEFAULT,
+    masses=None,
+    loads=None,
 ) -> Comparison:
     """Solve the task (TR, stroke) for every type (or ``types``) and compare; see the module docstring.
 
     objective: as Problem.objective; conditions: bound conditions for every type (e.g. {'gamma_min': 0.7});
     pareto: two objectives whose front is computed for every type (``n`` points each; a type without one gets
     the reason in ``Comparison.fronts``); progress: a callable called once per finished type; units: the length
-    unit of the stroke, the bounds and every length of the answer (one of ``qropt.units.LENGTH_UNITS``).
-    Every argument is checked (every type's problem built, the front's objectives and ``n``) before any solve.
+    unit of the stroke, the bounds and every length of the answer (one of ``qropt.units.LENGTH_UNITS``); masses,
+    loads: every type's mass model and loads (``qropt.Masses``, ``qropt.Loads``; the bars follow each design's
+    links), for the dynamic objectives and bounds. Every argument is checked (every type's problem built, the
+    front's objectives and ``n``) before any solve.
     """
     from qropt.synthesis.solver import DEFAULT, Solver
 
@@ -288,6 +296,8 @@ def design(
             omega2=omega2,
             size=size,
             units=units,
+            masses=masses,
+            loads=loads,
         )
         for kind in types
     }

@@ -108,8 +108,10 @@ def quantities(problem, m) -> dict:
     q["grashof"] = m.grashof().kind if m.FOUR_BAR else None
     q["size"] = m.size(problem.size)
     q["working_direction"] = m.working_direction(problem.omega2)
+    dynamic = problem.masses is not None or problem.loads is not None
     for name, c in criteria.CRITERIA.items():
-        if name not in criteria.BUILT_IN and c.applies(type(m)):
+        wanted = dynamic if c.needs_masses else name not in criteria.BUILT_IN  # the others are computed above
+        if wanted and c.applies(type(m)):
             q[name] = c.value(problem, m)
     return q
 

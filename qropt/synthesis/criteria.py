@@ -66,6 +66,7 @@ class Criterion:
     slider_only: ClassVar[bool] = False  # needs a slider output (not FourBar's follower angle)
     size: ClassVar[str | None] = None  # a size measure: the objective is min_size with problem.size = this
     kinematic: ClassVar[bool] = True  # depends on the motion alone (not on the size or on masses)
+    needs_masses: ClassVar[bool] = False  # a dynamic criterion: the problem's masses and loads, at its omega2
 
     # ---- names -------------------------------------------------------------------------------------
     @property
@@ -112,6 +113,10 @@ class Criterion:
     def from_nlp(self, y: float, omega2: float) -> float:
         """The inverse of ``to_nlp``."""
         return -y if self.maximise else y
+
+    def check(self, problem) -> str | None:
+        """Why a problem cannot use this criterion (None: it can)."""
+        return None
 
     def violation(self, problem, m, bound: float) -> float:
         """How far m is past the bound (>= 0)."""
@@ -410,6 +415,8 @@ def unregister(name: str) -> None:
 
 for _c in (GammaMin(), SizeSum(), SizeLongest(), Footprint(), PeakAcceleration(), PeakVelocity()):
     register(_c)
+from qropt.synthesis import dynamic  # noqa: E402,F401 - registers the dynamic criteria (it imports this module)
+
 BUILT_IN = tuple(CRITERIA)
 
 

@@ -78,6 +78,7 @@ class Kin(NamedTuple):
     margins: object
     coords: object
     dcoords: object
+    ddcoords: object  # second derivatives of the coordinates where a criterion needs them (dynamics), else 0
 
 
 class Blocks:
@@ -158,6 +159,12 @@ class Formulation:
         self.bound_keys = [k for k in criteria.bounds() if k in problem.conditions]
         used = ([self.objective] if self.objective else []) + [criteria.bounds()[k] for k in self.bound_keys]
         self.box = any(isinstance(c, criteria.Footprint) for c in used)
+        self.dynamic = any(
+            c.needs_masses for c in used
+        )  # the body accelerations: masses, loads and omega2 are baked in
+        if self.dynamic:
+            self.masses, self.loads, self.omega2 = problem.masses, problem.loads, problem.omega2
+            self.units = problem.units
         self.rows: list[Row] = []
 
         X, TH = casadi.SX.sym("x", len(self.free)), casadi.SX.sym("th", 2)
@@ -171,7 +178,7 @@ class Formulation:
         self.exact = [self.at(a) for a in sorted({a for v in cls.EXACT_TRANSMISSION.values() for a in v})]
         self._start = TH[0] if orientation > 0 else TH[1]
         self._length = (TH[1] - TH[0]) if orientation > 0 else TWO_PI - (TH[1] - TH[0])
-        self._W, self._working = W, None
+        self._W, self._working, self._strokes = W, None, None
         travel, span = self._core_rows(TH, PT)
         self._condition_rows(problem)
 
@@ -237,7 +244,7 @@ class Formulation:
         self.lbg = np.array([r.lb for r in self.rows], float)
         self.ubg = np.array([r.ub for r in self.rows], float)
         self.nx, self.nz, self.n_lift, self.n_box = len(self.free), len(self.z_names), len(self.lifts), n_box
-        del self.params, self.dead, self.sampled, self.exact, self._working  # symbols of the build only
+        del self.params, self.dead, self.sampled, self.exact, self._working, self._strokes  # the build's symbols
 
     # ---- the build -----------------------------------------------------------------------------------
     def _kinematics(self, X, PF):
@@ -256,6 +263,8 @@ class Formulation:
             *[transmission_cos(CASADI, lp.transmission[j]) for j in self.exact_joints + self.sampled_joints], 0
         )
         coords = casadi.vertcat(*[c for pt in lp.points.values() for c in pt])
+        self.joint_index = {j: 2 * i for i, j in enumerate(lp.points)}  # joint -> its x row in coords (y next)
+        dcoords = casadi.jacobian(coords, t)
         outs = [
             lp.x,
             v,
@@ -265,7 +274,8 @@ class Formulation:
             casadi.jacobian(cos, t),
             casadi.vertcat(*margins, 0),
             coords,
-            casadi.jacobian(coords, t),
+            dcoords,
+            casadi.jacobian(dcoords, t) if self.dynamic else casadi.SX(0),
         ]
         kin = casadi.Function("kin", [t, X, PF], outs, ["theta2", "free", "fixed"], list(Kin._fields))
         self.n_coords = coords.shape[0]
@@ -285,6 +295,17 @@ class Formulation:
         if self._working is None:
             self._working = [self.at(self._start + self._W[k] * self._length) for k in range(self.n_samples)]
         return self._working
+
+    def strokes(self, nodes) -> list[tuple[Kin, float, float]]:
+        """(outputs, weight, arc) at Gauss-Legendre ``nodes`` (on [-1, 1]) of the working arc, then of the return
+        arc: the crank angles move with the dead centres, so a quadrature over each stroke is the certifier's own;
+        weight * arc / 2 is a node's share of its stroke."""
+        if self._strokes is None:
+            out = []
+            for lo, arc in ((self._start, self._length), (self._start + self._length, TWO_PI - self._length)):
+                out += [(self.at(lo + 0.5 * arc * (1 + x)), w, arc) for x, w in zip(*nodes, strict=True)]
+            self._strokes = out
+        return self._strokes
 
     def in_working(self, phi):
         """A lifted angle's place in the working stroke (0..1 inside it)."""

@@ -47,6 +47,14 @@ class Candidate:
         return bool(self.ends) and self.ends[-1] in CONVERGED
 
 
+def _dynamic_key(problem) -> tuple:
+    """What a dynamic criterion bakes into its NLP: the masses, the loads and omega2 (nothing otherwise)."""
+    used = [criteria.of_problem(problem)] + [c for k, c in criteria.bounds().items() if k in problem.conditions]
+    if not any(c is not None and c.needs_masses for c in used):
+        return ()
+    return (repr(problem.masses), repr(problem.loads), problem.omega2)
+
+
 class Formulations:
     """The NLPs of a Solver, one per problem structure, built on first use (immutable; numbers are passed)."""
 
@@ -73,6 +81,7 @@ class Formulations:
             orientation,
             range_target,
             sense,
+            *_dynamic_key(problem),
         )
         f = self._built.get(key)
         if f is None:

@@ -282,6 +282,12 @@ class Problem:
             raise self._err(f"omega2 = {self.omega2:g} rad/s is out of range (|omega2| <= {MAX_OMEGA2:g} rad/s)")
         if self.objective and not criteria.of(self.objective, self.size).applies(self.mechanism):
             raise self._err(f"{self.mechanism.__name__} has no slider: {self.objective} does not apply")
+        used = [criteria.of(self.objective, self.size)] if self.objective else []
+        used += [c for k, c in criteria.bounds().items() if k in self.conditions]
+        for c in used:
+            why = c.check(self)
+            if why:
+                raise self._err(why)
 
     # ---- equality and serialisation (angles in radians, lengths in the problem's unit) -------------
     def to_dict(self) -> dict:

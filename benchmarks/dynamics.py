@@ -1,0 +1,76 @@
+"""Dynamics, timed against the kinematics in the same run: full-cycle inverse dynamics (torque, every joint force,
+shaking) at 3,600 crank angles against the 3,600-angle motion (x, v, a) of the same mechanism, for random
+mechanisms of every type; and a ``min_peak_torque`` solve against a ``min_peak_accel`` solve of the same problem.
+
+Medians of repeats; writes ``results/dynamics.json``. Run: ``python -m benchmarks.dynamics`` (repository root).
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+
+import numpy as np
+
+import qropt
+from benchmarks.report import save
+from qropt.mechanisms import TYPES
+from qropt.studies._design import type_problem
+from tests.randmech import random_mechanisms
+
+SAMPLES = 3600
+MASSES = qropt.Masses.bars(2.0, 5.0)
+LOADS = qropt.Loads(1000.0, gravity=9.81)
+
+
+def median_ms(f, repeat=7):
+    f()
+    out = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        f()
+        out.append(time.perf_counter() - t)
+    return 1e3 * statistics.median(out)
+
+
+def main() -> int:
+    th = 2 * np.pi * np.arange(SAMPLES) / SAMPLES
+    rows = {}
+    print(f"{'type':20s} {'motion ms':>10s} {'dynamics ms':>12s} {'ratio':>6s}   ({SAMPLES} crank angles)")
+    for cls in TYPES:
+        ratios, tm, td = [], [], []
+        for _, m in random_mechanisms(cls.KIND, 3, seed=21):
+            a = median_ms(lambda m=m: m.motion(th, 10.0))
+            b = median_ms(lambda m=m: m.dynamics(th, 10.0, masses=MASSES, loads=LOADS))
+            tm.append(a)
+            td.append(b)
+            ratios.append(b / a)
+        a, b, r = statistics.median(tm), statistics.median(td), statistics.median(ratios)
+        rows[cls.KIND] = {"motion_ms": a, "dynamics_ms": b, "ratio": ratios}
+        print(f"{cls.KIND:20s} {a:10.3f} {b:12.3f} {r:6.1f}")
+    solves = {}
+    for kind in ("crank-shaper", "whitworth", "slider-crank"):
+        p = type_problem(kind, 1.5, 0.3, objective="min_peak_accel", masses=MASSES, loads=LOADS, omega2=10.0)
+        times = {}
+        for objective in ("min_peak_accel", "min_peak_torque"):
+            q = p.replace(objective=objective)
+            solver = qropt.Solver()
+            solver.solve(q)  # warm: the NLPs built
+            out = []
+            for _ in range(3):
+                t = time.perf_counter()
+                r = solver.solve(q)
+                out.append(time.perf_counter() - t)
+            times[objective] = (statistics.median(out), r.status)
+        ratio = times["min_peak_torque"][0] / times["min_peak_accel"][0]
+        solves[kind] = {k: {"s": v[0], "status": v[1]} for k, v in times.items()} | {"ratio": ratio}
+        print(
+            f"{kind:20s} min_peak_accel {times['min_peak_accel'][0]:.3f} s ({times['min_peak_accel'][1]}), "
+            f"min_peak_torque {times['min_peak_torque'][0]:.3f} s ({times['min_peak_torque'][1]}): {ratio:.1f}x"
+        )
+    save("dynamics.json", {"samples": SAMPLES, "analysis": rows, "solves": solves})
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

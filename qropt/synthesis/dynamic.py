@@ -1,0 +1,303 @@
+"""Dynamic criteria: the peak and RMS crank torque and the peak shaking force, at the problem's omega2 (constant
+speed) with its masses and loads (``Problem.masses``, ``Problem.loads``), SI.
+
+Exact values come from ``qropt.dynamics`` (Newton-Euler over the turn). In the NLP the torque at a crank angle is
+the power balance ``T = omega2^2 sum(m v_G . a_G + I phi' phi'') + g sum(m v_Gy) + F max(0, w x' omega2) / omega2``
+(derivatives in theta2; w the working direction), written from the joints' coordinates and their first and second
+derivatives, with the mass model following the design: each bar as long as its joints reach (a lever's sliding
+crank pin at most |pivot - O2| + r2 from the pivot, a sliding output at most as far as at a dead centre). The RMS
+torque is a Gauss-Legendre quadrature over each stroke on nodes that move with the dead centres, the same rule as
+the exact one, so the NLP's value is the certified one.
+"""
+
+from __future__ import annotations
+
+import math
+
+import casadi
+import numpy as np
+
+from qropt import units as units_
+from qropt.synthesis.criteria import Criterion, Exchange, register
+
+TWO_PI = 2 * math.pi
+
+
+def _problem_check(c, problem) -> str | None:
+    loads = problem.loads
+    if problem.masses is None and loads is None:
+        return f"{c.objective} needs masses or loads (Problem(..., masses=qropt.Masses..., loads=qropt.Loads(...)))"
+    if loads is not None and loads.friction:
+        return f"{c.name}: friction on the slide is in the exact analysis, not in the NLP; give friction=0"
+    if loads is not None and isinstance(loads.cutting_force, tuple):
+        return f"{c.name}: a cutting-force table is in the exact analysis, not in the NLP; give a constant force"
+    return None
+
+
+def _cycle(problem, m):
+    from qropt.dynamics.cycle import CycleDynamics
+
+    return CycleDynamics(m, problem.omega2, 0.0, problem.masses, problem.loads)
+
+
+class _Symbolic:
+    """The formulation's bodies with their mass model as CasADi expressions of the design."""
+
+    def __init__(self, f):
+        link = f.mechanism.linkage(f.params)
+        self.f, self.k = f, units_.to_metres(f.units)
+        self.bodies = link.bodies()
+        conns = link.connections()
+        self.crank = next(b for b in self.bodies if b.name == "crank")
+        self.sliding = {
+            b.name: {c.joint for c in conns if c.kind == "slot" and b.name in (c.giver, c.receiver)}
+            for b in self.bodies
+        }
+
+    def point(self, out, j, order=0):
+        i = self.f.joint_index[j]
+        c = (out.coords, out.dcoords, out.ddcoords)[order]
+        return c[i] * self.k, c[i + 1] * self.k
+
+    def _dist(self, out, a, b):
+        (ax, ay), (bx, by) = self.point(out, a), self.point(out, b)
+        return casadi.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
+
+    def mass_model(self, out):
+        """body -> (mass, (cx, cy), inertia): the problem's overrides, else uniform bars of the density (a plate
+        the union of bars from its first joint), the ram and block as points, the counterweight on the crank."""
+        masses = self.f.masses
+        out_models = {}
+        if masses is None:
+            return out_models
+        for b in self.bodies:
+            if b.name in masses.bodies:
+                bm = masses.bodies[b.name]
+                model = (bm.mass, bm.com, bm.inertia)
+            elif b.kind in ("ram", "yoke"):
+                model = (masses.ram, (0.0, 0.0), 0.0)
+            elif b.kind == "block":
+                model = (masses.block, (0.0, 0.0), 0.0)
+            else:
+                model = self._bars(out, b, masses.density)
+            if b.name == "crank" and masses.counterweight is not None and masses.counterweight.mass > 0:
+                cw = masses.counterweight
+                point = (cw.mass, (cw.radius * math.cos(cw.angle), cw.radius * math.sin(cw.angle)), 0.0)
+                model = _union(model, point)
+            out_models[b.name] = model
+        return out_models
+
+    def _reach(self, out, b, j):
+        first = b.joints[0]
+        if j not in self.sliding[b.name]:
+            return self._dist(out, first, j)
+        if j == self.crank.joints[1]:  # the crank pin in the lever's slot: at most |pivot - O2| + r2 away
+            return self._dist(out, first, self.crank.joints[0]) + self._dist(out, self.crank.joints[0], j)
+        return casadi.fmax(*(self._dist(d, first, j) for d in self.f.dead))  # a sliding output: at a dead centre
+
+    def _bars(self, out, b, density):
+        reaches = [self._reach(out, b, j) for j in b.joints[1:]]
+        if b.kind != "plate":
+            L = reaches[0]
+            for r in reaches[1:]:
+                L = casadi.fmax(L, r)
+            m = density * L
+            return (m, (L / 2, 0.0), m * L * L / 12)
+        (ox, oy), (sx, sy) = self.point(out, b.joints[0]), self.point(out, b.joints[1])
+        phi = casadi.atan2(sy - oy, sx - ox)
+        model = None
+        for j, L in zip(b.joints[1:], reaches, strict=True):
+            jx, jy = self.point(out, j)
+            a = casadi.atan2(jy - oy, jx - ox) - phi
+            m = density * L
+            part = (m, (L / 2 * casadi.cos(a), L / 2 * casadi.sin(a)), m * L * L / 12)
+            model = part if model is None else _union(model, part)
+        return model
+
+    def kinematics(self, out, b, com):
+        """(v_G, a_G, phi', phi'') of body b per unit theta2 (SI)."""
+        first = b.joints[0]
+        o = [self.point(out, first, k) for k in range(3)]
+        if b.kind in ("ram", "yoke"):
+            if b.kind == "yoke":
+                o = [(p[0], 0.0) for p in o]
+            return o[1], o[2], 0.0, 0.0
+        if b.kind == "block":  # turns with the slot's line pivot -> pin
+            pin, pivot = b.joints[0], b.joints[1]
+            a = [self.point(out, pivot, k) for k in range(3)]
+            s = [self.point(out, pin, k) for k in range(3)]
+        else:
+            a, s = o, [self.point(out, b.joints[1], k) for k in range(3)]
+        dx, dy = s[0][0] - a[0][0], s[0][1] - a[0][1]
+        d1x, d1y = s[1][0] - a[1][0], s[1][1] - a[1][1]
+        d2x, d2y = s[2][0] - a[2][0], s[2][1] - a[2][1]
+        r2 = dx * dx + dy * dy
+        w = (dx * d1y - dy * d1x) / r2
+        al = (dx * d2y - dy * d2x) / r2 - 2 * w * (dx * d1x + dy * d1y) / r2
+        c, sn = dx / casadi.sqrt(r2), dy / casadi.sqrt(r2)
+        rx, ry = c * com[0] - sn * com[1], sn * com[0] + c * com[1]
+        v = (o[1][0] - w * ry, o[1][1] + w * rx)
+        acc = (o[2][0] - al * ry - w * w * rx, o[2][1] + al * rx - w * w * ry)
+        return v, acc, w, al
+
+    def torque(self, out):
+        """The crank torque (N m) at constant omega2 at one crank angle."""
+        f = self.f
+        w2 = f.omega2**2
+        g = f.loads.gravity if f.loads is not None else 0.0
+        T = 0
+        for name, (m, com, inertia) in self.mass_model(out).items():
+            b = next(x for x in self.bodies if x.name == name)
+            v, a, w, al = self.kinematics(out, b, com)
+            T += w2 * (m * (v[0] * a[0] + v[1] * a[1]) + inertia * w * al) + g * m * v[1]
+        return T + self.load(out)
+
+    def load(self, out):
+        f, loads = self.f, self.f.loads
+        if loads is None:
+            return 0
+        force = loads.cutting_force if f.mechanism.OUTPUT == "slider" else loads.follower_torque
+        if not force:
+            return 0
+        scale = self.k if f.mechanism.OUTPUT == "slider" else 1.0
+        way = (-1.0 if f.orientation > 0 else 1.0) * math.copysign(1.0, f.omega2)  # the working direction
+        return force * casadi.fmax(0, way * out.v * scale * f.omega2) / f.omega2
+
+    def shaking_squared(self, out):
+        """|sum(m a_G)|^2 at constant omega2 (N^2)."""
+        w2 = self.f.omega2**2
+        sx = sy = 0
+        for name, (m, com, _) in self.mass_model(out).items():
+            b = next(x for x in self.bodies if x.name == name)
+            _, a, _, _ = self.kinematics(out, b, com)
+            sx, sy = sx + m * a[0] * w2, sy + m * a[1] * w2
+        return sx * sx + sy * sy
+
+
+def _union(a, b):
+    (ma, ca, ia), (mb, cb, ib) = a, b
+    m = ma + mb
+    cx = (ma * ca[0] + mb * cb[0]) / m
+    cy = (ma * ca[1] + mb * cb[1]) / m
+    inertia = ia + ib + ma * ((ca[0] - cx) ** 2 + (ca[1] - cy) ** 2) + mb * ((cb[0] - cx) ** 2 + (cb[1] - cy) ** 2)
+    return (m, (cx, cy), inertia)
+
+
+def _symbolic(f) -> _Symbolic:
+    s = getattr(f, "_dynamic_symbolic", None)
+    if s is None:
+        s = f._dynamic_symbolic = _Symbolic(f)
+    return s
+
+
+class _Dynamic(Criterion):
+    """Shared by the dynamic criteria: a relative gap (they are in newtons), the problem's check."""
+
+    needs_masses, kinematic = True, False
+
+    def applies(self, cls) -> bool:  # a type declared with the builder (its bodies and joints are known)
+        return cls.linkage(dict(cls.PARAMS)) is not None
+
+    def check(self, problem) -> str | None:
+        return _problem_check(self, problem)
+
+    def to_nlp(self, v, omega2):
+        return v
+
+    def from_nlp(self, y, omega2):
+        return y
+
+
+class PeakTorque(_Dynamic):
+    """The largest |crank torque| over the turn at constant omega2 (N m)."""
+
+    name, unit, label = "peak_torque", "N m", "peak crank torque"
+
+    def value(self, problem, m):
+        return _cycle(problem, m).peak(lambda d: np.abs(d.torque)).value
+
+    def epigraph(self, f):
+        s = _symbolic(f)
+        return [("peak |crank torque|", [sign * s.torque(out) for out in f.sampled for sign in (1, -1)])]
+
+    def exchange(self, f, problem, m, z, value_nlp, gap_tol):
+        p = _cycle(problem, m).peak(lambda d: np.abs(d.torque))
+        gap = (p.value - z[0]) / max(1.0, p.value)
+        return Exchange(z[0], p.value, gap, [p.theta2] if gap > gap_tol else [], [])
+
+    def exceeded(self, problem, m):
+        return [_cycle(problem, m).peak(lambda d: np.abs(d.torque)).theta2], []
+
+
+GAUSS_NODES = None  # the cycle module's Gauss-Legendre rule, read once
+
+
+def _nodes():
+    global GAUSS_NODES
+    if GAUSS_NODES is None:
+        from qropt.dynamics.cycle import GAUSS
+
+        GAUSS_NODES = np.polynomial.legendre.leggauss(GAUSS)
+    return GAUSS_NODES
+
+
+class RmsTorque(_Dynamic):
+    """The root mean square of the crank torque over the turn at constant omega2 (N m): a quadrature, the same
+    Gauss-Legendre rule on each stroke in the NLP as in the exact value."""
+
+    name, unit, label = "rms_torque", "N m", "RMS crank torque"
+
+    def value(self, problem, m):
+        return math.sqrt(_cycle(problem, m).quadrature(lambda d: d.torque**2) / TWO_PI)
+
+    def to_nlp(self, v, omega2):  # the NLP states the mean square (smooth where the RMS's root is not)
+        return v * v
+
+    def from_nlp(self, y, omega2):
+        return math.sqrt(max(y, 0.0))
+
+    def expression(self, f):
+        s = _symbolic(f)
+        total = 0
+        for out, w, arc in f.strokes(_nodes()):
+            total += 0.5 * arc * w * s.torque(out) ** 2
+        return total / TWO_PI
+
+    def exchange(self, f, problem, m, z, value_nlp, gap_tol):
+        exact = self.value(problem, m)
+        nlp = None if value_nlp is None else self.from_nlp(float(value_nlp), 1.0)
+        gap = 0.0 if nlp is None else abs(exact**2 - float(value_nlp)) / max(1.0, exact**2)
+        return Exchange(nlp, exact, gap, [], [])
+
+
+class ShakingForce(_Dynamic):
+    """The largest shaking force |sum(m a_G)| over the turn at constant omega2 (N); the NLP bounds its square."""
+
+    name, unit, label = "shaking_force", "N", "peak shaking force"
+
+    def value(self, problem, m):
+        return _cycle(problem, m).peak(lambda d: np.hypot(*d.shaking_force.T)).value
+
+    def to_nlp(self, v, omega2):
+        return v * v
+
+    def from_nlp(self, y, omega2):
+        return math.sqrt(max(y, 0.0))
+
+    def epigraph(self, f):
+        s = _symbolic(f)
+        return [("peak |shaking force|^2", [s.shaking_squared(out) for out in f.sampled])]
+
+    def exchange(self, f, problem, m, z, value_nlp, gap_tol):
+        p = _cycle(problem, m).peak(lambda d: np.hypot(*d.shaking_force.T))
+        gap = (p.value**2 - z[0]) / max(1.0, p.value**2)
+        return Exchange(self.from_nlp(z[0], 1.0), p.value, gap, [p.theta2] if gap > gap_tol else [], [])
+
+    def exceeded(self, problem, m):
+        return [_cycle(problem, m).peak(lambda d: np.hypot(*d.shaking_force.T)).theta2], []
+
+
+for _c in (PeakTorque(), RmsTorque(), ShakingForce()):
+    register(_c)
+
+__all__ = ["PeakTorque", "RmsTorque", "ShakingForce"]
