@@ -13,6 +13,7 @@ import time
 import numpy as np
 
 import qropt
+from benchmarks import analysis
 from benchmarks.report import save
 from qropt.mechanisms import TYPES
 from qropt.studies._design import type_problem
@@ -24,13 +25,8 @@ LOADS = qropt.Loads(1000.0, gravity=9.81)
 
 
 def median_ms(f, repeat=7):
-    f()
-    out = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        f()
-        out.append(time.perf_counter() - t)
-    return 1e3 * statistics.median(out)
+    f()  # warm
+    return analysis.median_ms(f, repeat)
 
 
 def main() -> int:

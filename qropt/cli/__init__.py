@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import dataclasses
 import importlib
 import json
 import math
@@ -371,15 +372,8 @@ def dynamics(args, m) -> int:
         "peak_shaking_force": ex.peak_shaking_force.value,
         "peak_shaking_moment": ex.peak_shaking_moment.value,
     }
-    if fw is not None:
-        out["flywheel"] = {
-            "cs": fw.cs,
-            "energy_fluctuation": fw.energy_fluctuation,
-            "inertia": fw.inertia,
-            "energy_per_turn": fw.energy_per_turn,
-            "working_energy": fw.working_energy,
-            "return_energy": fw.return_energy,
-        }
+    if fw is not None:  # every field of the Flywheel but the speed, given above
+        out["flywheel"] = {k: v for k, v in dataclasses.asdict(fw).items() if k != "omega2"}
     if args.json:
         json.dump(out, sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")

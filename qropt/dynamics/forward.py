@@ -30,7 +30,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from qropt.dynamics.inverse import body_masses, generalised
-from qropt.dynamics.model import Loads, Masses
+from qropt.dynamics.model import Loads, Masses, _real
 from qropt.errors import InvalidParameter, NoDeadCentres
 
 TWO_PI = 2 * math.pi
@@ -39,23 +39,6 @@ ATOL = 1e-10  # its absolute tolerance on theta2 (rad) and on omega2 / |omega0|
 STALL_FRACTION = 1e-9  # the crank has stalled when its speed in the sense of omega0 falls to this times |omega0|
 MAX_SAMPLES = 2_000_000  # turns * points_per_turn at most
 INERTIA_GRID = 720  # crank angles where M + I_fw is checked to be positive before integrating
-LIMIT = 1e12  # largest |value| of a torque, a speed or an inertia
-
-
-def _number(what: str, v, *, positive=False, nonneg=False, nonzero=False, allow_inf=False) -> float:
-    ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
-    if ok:
-        v = float(v)
-        ok = (allow_inf and v == math.inf) or (math.isfinite(v) and abs(v) <= LIMIT)
-    if not ok:
-        raise InvalidParameter(f"{what} must be a finite number (|value| <= 1e12), got {v!r}")
-    if positive and v <= 0:
-        raise InvalidParameter(f"{what} must be positive, got {v:g}")
-    if nonneg and v < 0:
-        raise InvalidParameter(f"{what} must be zero or positive, got {v:g}")
-    if nonzero and v == 0:
-        raise InvalidParameter(f"{what} must be nonzero (its sign is the sense of rotation), got 0")
-    return v
 
 
 def _count(what: str, v, lo: int, hi: int) -> int:
@@ -74,8 +57,8 @@ class Motor:
     free_speed: float = math.inf
 
     def __post_init__(self):
-        object.__setattr__(self, "stall", _number("the motor's torque (N m)", self.stall))
-        fs = _number("the motor's free speed (rad/s)", self.free_speed, positive=True, allow_inf=True)
+        object.__setattr__(self, "stall", _real("the motor's torque (N m)", self.stall))
+        fs = _real("the motor's free speed (rad/s)", self.free_speed, positive=True, allow_inf=True)
         object.__setattr__(self, "free_speed", fs)
 
     @classmethod
@@ -164,7 +147,7 @@ def steady_mean_torque(m, omega2: float, masses=None, loads=None) -> float:
     torque of a constant-torque motor that keeps the mean speed (``m.flywheel(...).mean_torque``)."""
     from qropt.dynamics.cycle import CycleDynamics
 
-    omega2 = _number("omega2 (rad/s)", omega2, nonzero=True)
+    omega2 = _real("omega2 (rad/s)", omega2, nonzero=True)
     return CycleDynamics(m, omega2, 0.0, masses, loads).quadrature(lambda d: d.torque) / TWO_PI
 
 
@@ -203,8 +186,8 @@ def simulate(
         raise InvalidParameter(
             "simulate does not model the slide's friction (it depends on the guide's force): give Loads(friction=0)"
         )
-    fw = _number("flywheel (kg m^2)", flywheel, nonneg=True)
-    omega0 = _number("omega0 (rad/s)", omega0, nonzero=True)
+    fw = _real("flywheel (kg m^2)", flywheel, nonneg=True)
+    omega0 = _real("omega0 (rad/s)", omega0, nonzero=True)
     turns = _count("turns", turns, 1, 1000)
     ppt = _count("points_per_turn", points_per_turn, 16, 10_000)
     if turns * ppt > MAX_SAMPLES:

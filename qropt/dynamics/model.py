@@ -14,18 +14,23 @@ import numpy as np
 
 from qropt.errors import InvalidParameter
 
+LIMIT = 1e12  # largest |value| of a mass, force, torque, speed or inertia the dynamics takes
 
-def _real(what, v, *, positive=False, nonneg=False) -> float:
+
+def _real(what, v, *, positive=False, nonneg=False, nonzero=False, allow_inf=False) -> float:
+    """A finite number (|value| <= LIMIT; +inf too if ``allow_inf``), or InvalidParameter naming ``what``."""
     ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
     if ok:
         v = float(v)
-        ok = math.isfinite(v) and abs(v) <= 1e12
+        ok = (allow_inf and v == math.inf) or (math.isfinite(v) and abs(v) <= LIMIT)
     if not ok:
         raise InvalidParameter(f"{what} must be a finite number (|value| <= 1e12), got {v!r}")
     if positive and v <= 0:
         raise InvalidParameter(f"{what} must be positive, got {v:g}")
     if nonneg and v < 0:
         raise InvalidParameter(f"{what} must be zero or positive, got {v:g}")
+    if nonzero and v == 0:
+        raise InvalidParameter(f"{what} must be nonzero (its sign is the sense of rotation), got 0")
     return v
 
 
