@@ -287,3 +287,40 @@ def test_readme_examples():
     assert tuple(q.constant_speed()) == pytest.approx((0.483322, 1.5, 162.091), abs=1e-3)
     r = speed_profile(INLINE, omega_max=2, v_cut=0.5)
     assert r.binding == ("omega_max", "v_cut") and "78.3% off v_cut" in r.message
+
+
+# ---- the full inertia (masses and loads) -----------------------------------------------------------------------
+def test_a_profile_with_every_links_inertia_is_checked_by_the_inverse_dynamics():
+    """With a mass model the torque is M alpha2 + M' omega2^2 / 2 + Q, linear in omega2^2: the profile's torque at
+    its samples equals the Newton-Euler inverse dynamics run at the same crank angle, speed and acceleration, and a
+    binding torque limit holds to the profile's O(h^2) discretisation."""
+    m = qropt.SliderCrank(r2=0.1, r3=0.4, e=0.05)  # TR 1.04: the servo's working arc is the slow stroke
+    masses, loads = qropt.Masses.bars(2.0, 5.0), qropt.Loads(100.0, gravity=9.81)
+    free = qropt.speed_profile(m, omega_max=20, v_cut=0.5, a_max=40, alpha_max=400, v_max=2, masses=masses, loads=loads)
+    sp = qropt.speed_profile(
+        m, omega_max=20, v_cut=0.5, a_max=40, alpha_max=400, v_max=2, masses=masses, loads=loads, torque_max=12.0
+    )
+    assert sp.status == "optimal" and free.peak_torque > 12.5 and sp.cycle_time > free.cycle_time
+    s = sp.motion()
+    k = slice(None, None, 7)
+    inverse = [
+        m.dynamics(np.array([t]), w, a, masses=masses, loads=loads).torque[0]
+        for t, w, a in zip(s.theta[k], s.omega[k], s.alpha[k], strict=True)
+    ]
+    assert np.abs(np.array(inverse) - s.torque[k]).max() <= 1e-9 * np.abs(s.torque).max()
+    assert abs(sp.check()["torque_max"]) < 1e-4  # binding, and held to the O(h^2) of the cells
+
+
+def test_the_shorthands_are_the_massless_case_and_never_count_twice():
+    m = qropt.SliderCrank(r2=0.1, r3=0.4, e=0.05)
+    kw = dict(omega_max=20, v_cut=0.5, alpha_max=400, torque_max=10.1)
+    short = qropt.speed_profile(m, force=100.0, **kw)
+    full = qropt.speed_profile(m, loads=qropt.Loads(100.0), **kw)
+    assert short.status == full.status == "optimal" and full.peak_torque == pytest.approx(short.peak_torque, rel=1e-9)
+    assert full.cycle_time == pytest.approx(short.cycle_time, rel=1e-7)
+    with pytest.raises(qropt.InvalidParameter, match="once"):
+        qropt.speed_profile(m, force=200.0, loads=qropt.Loads(200.0), **kw)
+    with pytest.raises(qropt.InvalidParameter, match="once"):
+        qropt.speed_profile(m, inertia=0.1, masses=qropt.Masses.bars(2.0), **kw)
+    with pytest.raises(qropt.InvalidParameter, match="friction"):
+        qropt.speed_profile(m, loads=qropt.Loads(200.0, friction=0.1), **kw)

@@ -11,8 +11,9 @@ its node values by at most h^2/8 max|q''| on the cell (linear interpolation erro
 1e-5..1e-4 relative at n = 720 in the examples; ``SpeedProfile.check`` measures it by exact sampling.
 
 Units: SI (a mechanism's lengths are taken in metres): theta2 rad, omega2 rad/s, alpha2 rad/s^2, time s, slider
-v m/s, a m/s^2, force N, inertia kg m^2 (constant, reduced to the crank), torque N m; the torque is quasi-static:
-inertia alpha2 + force |dx/dtheta2| on the working stroke.
+v m/s, a m/s^2, force N, inertia kg m^2 (constant, reduced to the crank), torque N m; the torque is
+inertia alpha2 + force |dx/dtheta2| on the working stroke, or with a mass model and loads (``masses``, ``loads``)
+the crank's full equation of motion M(theta2) alpha2 + M'(theta2) omega2^2 / 2 + Q(theta2), still linear in b.
 """
 
 from __future__ import annotations
@@ -85,6 +86,8 @@ class SpeedProfile:
     force: float = 0.0
     inertia: float = 0.0
     binding: tuple = field(default_factory=tuple)
+    masses: object = None  # qropt.Masses: every link's inertia in the torque (with loads: their Q)
+    loads: object = None
 
     def __repr__(self):
         if self.time is None:
@@ -121,7 +124,7 @@ class SpeedProfile:
     @property
     def peak_torque(self) -> float | None:
         """Largest |motor torque| over the turn (from ``motion()``), None without force or inertia."""
-        if self.time is None or (self.force == 0.0 and self.inertia == 0.0):
+        if self.time is None or (self.force == 0.0 and self.inertia == 0.0 and not self._dynamic):
             return None
         return float(np.abs(self.motion().torque).max())
 
@@ -140,6 +143,10 @@ class SpeedProfile:
     @cached_property
     def _cache(self) -> dict:
         return {}
+
+    @property
+    def _dynamic(self) -> bool:
+        return self.masses is not None or self.loads is not None
 
     def _motion(self, refine: int) -> ServoMotion:
         if self.time is None:
@@ -161,6 +168,12 @@ class SpeedProfile:
         xp, xpp = mo.v.reshape(theta.shape), mo.a.reshape(theta.shape)
         working = (np.arange(h.size) < self.working_cells)[:, None]
         torque = self.inertia * alpha + self.force * np.abs(xp) * working
+        if self._dynamic:  # the full inertia: M alpha2 + M' omega2^2 / 2 + Q
+            gen = _generalised(
+                self.mechanism, theta.ravel(), self.masses, self.loads, working.repeat(refine + 1, 1).ravel()
+            )
+            shape = theta.shape
+            torque = torque + gen.M.reshape(shape) * alpha + 0.5 * gen.dM.reshape(shape) * bu + gen.Q.reshape(shape)
         out = ServoMotion(
             *(
                 np.ascontiguousarray(q).ravel()
@@ -299,8 +312,24 @@ def _grid(m: Mechanism, n: int, cut_fraction: float | None) -> _Grid:
     return _Grid(theta, int(idx[-2]), cut, mo.v, mo.a)
 
 
-def _groups(g: _Grid, lim: dict, force: float, inertia: float):
-    """Every limit as rows |G beta + c| <= 1 in beta = b / omega_max^2, and v_cut as rows G beta = 1."""
+def _generalised(m, theta, masses, loads, working):
+    """M, M', Q of the crank's equation of motion at theta (crank turning counter-clockwise), SI, with the
+    cutting force on the profile's working stroke (``working``: where theta is on it)."""
+    import dataclasses
+
+    from qropt.dynamics.inverse import generalised
+
+    gravity = None if loads is None else dataclasses.replace(loads, cutting_force=0.0)
+    gen = generalised(m, theta, masses=masses, loads=gravity, sense=1.0)
+    if loads is not None:
+        mo = m.motion(theta, 1.0, 0.0)
+        gen = dataclasses.replace(gen, Q=gen.Q + loads.force_at(mo.x) * np.abs(mo.v) * working)
+    return gen
+
+
+def _groups(g: _Grid, lim: dict, force: float, inertia: float, gen=None):
+    """Every limit as rows |G beta + c| <= 1 in beta = b / omega_max^2, and v_cut as rows G beta = 1; ``gen``
+    (M, M', Q at the nodes) adds every link's inertia and the loads to the torque."""
     n = g.xp.size
     w2 = lim["omega_max"] ** 2
     h = np.diff(g.theta)
@@ -321,8 +350,13 @@ def _groups(g: _Grid, lim: dict, force: float, inertia: float):
     if lim.get("torque_max") is not None:
         work = np.arange(n) <= g.working_cells
         c = force * np.abs(g.xp) * work / lim["torque_max"]
+        own = sp.csr_matrix((n, n))
+        if gen is not None:  # M alpha2 + M' b / 2 + Q, linear in b
+            c = c + gen.Q / lim["torque_max"]
+            own = sp.diags(0.5 * gen.dM * w2)
         for side in (dalpha, prev @ dalpha):
-            groups.append(("torque_max", inertia * side / lim["torque_max"], c))
+            mass = sp.diags(inertia + (gen.M if gen is not None else 0.0) * np.ones(n))
+            groups.append(("torque_max", (mass @ side + own) / lim["torque_max"], c))
     equal = None
     if g.cut_cells is not None:
         k = np.arange(g.cut_cells[0], g.cut_cells[1] + 1)
@@ -396,6 +430,8 @@ def speed_profile(
     torque_max: float | None = None,
     objective: str = "min_cycle_time",
     n: int = 720,
+    masses=None,
+    loads=None,
 ) -> SpeedProfile:
     """The fastest periodic crank-speed profile (crank turning counter-clockwise) within the limits.
 
@@ -404,7 +440,12 @@ def speed_profile(
     the working stroke's travel (the working stroke is ``mechanism.working_arc()``); torque_max bounds
     |inertia alpha2 + force |dx/dtheta2||, the force acting on the working stroke only. objective:
     'min_cycle_time', or 'min_return_time' (then the shortest cycle among the fastest returns).
-    Invalid input raises InvalidParameter; an infeasible set of limits returns status 'infeasible'.
+    masses, loads (``qropt.Masses``, ``qropt.Loads``): the torque with every link's inertia,
+    ``M(theta2) alpha2 + M'(theta2) omega2^2 / 2 + Q(theta2)`` (still linear in b = omega2^2); force= and
+    inertia= are shorthands for a constant cutting force and a constant inertia on the crank, refused beside a
+    cutting force in loads or a mass model (never counted twice); friction, which makes the load depend on b,
+    stays out of the convex problem. Invalid input raises InvalidParameter; an infeasible set of limits
+    returns status 'infeasible'.
     """
     import cvxpy as cp  # imported on use: it takes a fraction of a second to import
 
@@ -430,8 +471,11 @@ def speed_profile(
         "torque_max": _limit("torque_max", torque_max),
     }
     force, inertia = _limit("force", force, zero_ok=True) or 0.0, _limit("inertia", inertia, zero_ok=True) or 0.0
-    if lim["torque_max"] is not None and force == 0.0 and inertia == 0.0:
-        raise InvalidParameter("torque_max needs a force or an inertia (the torque is inertia alpha2 + force x')")
+    gen = _check_dynamics(mechanism, masses, loads, force, inertia)
+    if lim["torque_max"] is not None and force == 0.0 and inertia == 0.0 and gen is None:
+        raise InvalidParameter(
+            "torque_max needs a force or an inertia, or masses and loads (the torque is inertia alpha2 + force x')"
+        )
     if lim["v_cut"] is not None and lim["v_max"] is not None and lim["v_cut"] > lim["v_max"]:
         raise InvalidParameter(f"v_cut = {lim['v_cut']:g} is above v_max = {lim['v_max']:g}")
     fraction = None
@@ -442,8 +486,12 @@ def speed_profile(
                 f"cut_fraction must be in (0, 1) (the slider stops at the dead centres), got {fraction:g}"
             )
     g = _grid(mechanism, int(n), fraction)
-    groups, equal = _groups(g, lim, force, inertia)
-    base = dict(mechanism=mechanism, limits=lim, objective=objective, force=force, inertia=inertia)
+    on_working = np.arange(g.xp.size) <= g.working_cells  # as the force= shorthand: the nodes of the working stroke
+    gen = None if gen is None else _generalised(mechanism, g.theta[:-1], masses, loads, on_working)
+    groups, equal = _groups(g, lim, force, inertia, gen)
+    base = dict(
+        mechanism=mechanism, limits=lim, objective=objective, force=force, inertia=inertia, masses=masses, loads=loads
+    )
 
     nc = g.xp.size
     h = np.diff(g.theta)
@@ -477,6 +525,25 @@ def speed_profile(
     word = "optimal" if status == cp.OPTIMAL else "acceptable"
     message = f"{objective} solved by CLARABEL with {nc} cells" + ("" if word == "optimal" else " (reduced accuracy)")
     return _profile(word, message, np.maximum(beta.value, 0.0), g, lim, base)
+
+
+def _check_dynamics(m, masses, loads, force, inertia):
+    """True where masses or loads are given (after checking them), None otherwise."""
+    from qropt.dynamics.model import Loads, Masses
+
+    if masses is None and loads is None:
+        return None
+    if masses is not None and not isinstance(masses, Masses):
+        raise InvalidParameter(f"masses is a qropt.Masses, got {type(masses).__name__}")
+    if loads is not None and not isinstance(loads, Loads):
+        raise InvalidParameter(f"loads is a qropt.Loads, got {type(loads).__name__}")
+    if loads is not None and loads.friction:
+        raise InvalidParameter("friction makes the load depend on omega2^2: it stays out of the convex problem")
+    if force and loads is not None and (isinstance(loads.cutting_force, tuple) or loads.cutting_force):
+        raise InvalidParameter("give the cutting force once: force= or loads=Loads(cutting_force=...), not both")
+    if inertia and masses is not None:
+        raise InvalidParameter("give the inertia once: inertia= (reduced to the crank) or masses=, not both")
+    return True
 
 
 def _profile(word, message, beta, g: _Grid, lim, base) -> SpeedProfile:
