@@ -38,6 +38,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     bound_flags(parser)
     parser.add_argument("--omega2", type=real, default=1.0, help="crank speed [rad/s] (default 1)")
+    parser.add_argument("--density", type=real, help="links as uniform bars of this many kg per metre (dynamics)")
+    parser.add_argument("--ram-mass", dest="ram_mass", type=real, help="the ram's mass, kg (dynamics)")
+    parser.add_argument("--force", type=real, help="cutting force on the working stroke, N (dynamics)")
+    parser.add_argument("--gravity", type=real, help="gravity along -y, m/s^2 (dynamics)")
     parser.add_argument("--pareto", nargs=2, metavar=("A", "B"), help="also each type's front between two objectives")
     parser.add_argument("--n", type=int, default=12, help="front points per type with --pareto (default 12)")
     parser.add_argument("--csv", metavar="FILE", help="write the comparison table as CSV")
@@ -65,6 +69,18 @@ def conditions_of(args) -> dict:
     return {k: getattr(args, k) for k in criteria.bounds() if getattr(args, k, None) is not None}
 
 
+def dynamics_of(args) -> tuple:
+    """(masses, loads) from the dynamics flags, each None where none of its flags is given."""
+    from qropt.dynamics.model import Loads, Masses
+
+    masses = loads = None
+    if args.density is not None or args.ram_mass is not None:
+        masses = Masses.bars(args.density or 0.0, args.ram_mass or 0.0)
+    if args.force is not None or args.gravity is not None:
+        loads = Loads(args.force or 0.0, gravity=args.gravity or 0.0)
+    return masses, loads
+
+
 def run(args) -> int:
     from qropt.cli import cli_type, picture_path, progress_bar
     from qropt.studies._design import TYPES, design
@@ -72,6 +88,7 @@ def run(args) -> int:
     plot = picture_path(args.plot) if args.plot else None
     types = None if args.types is None else [cli_type(t) if ":" in t else t for t in args.types]
     n_types = len(args.types or TYPES)
+    masses, loads = dynamics_of(args)
     with progress_bar("types", total=n_types, unit="type") as bar:
         cmp = design(
             args.tr,
@@ -85,6 +102,8 @@ def run(args) -> int:
             n=args.n,
             progress=bar.update,
             units=args.units,
+            masses=masses,
+            loads=loads,
         )
     if args.csv:
         cmp.to_csv(args.csv)
@@ -113,6 +132,15 @@ def run(args) -> int:
             f"  {r.type:20s} {math.degrees(c['gamma_min']):10.3f} {c['footprint']:11.4g} {c['sum']:8.4g} "
             f"{c['peak_accel']:11.4g} {c['peak_velocity']:9.4g} {c['torque_per_newton']:8.4g}"
         )
+    dynamic = [r for r in cmp.rows if r.success and r.criteria.get("peak_torque") is not None]
+    if dynamic:
+        print("  dynamics at omega2 (N m; N):")
+        for r in dynamic:
+            c = r.criteria
+            print(
+                f"  {r.type:20s} peak torque {c['peak_torque']:10.4g}  RMS torque {c['rms_torque']:10.4g}  "
+                f"peak shaking force {c['shaking_force']:10.4g}"
+            )
     print(f"  (T/F: peak crank torque per newton of cutting force, N {u} per N)")
     if args.csv:
         print(f"table written to {args.csv}")

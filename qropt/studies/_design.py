@@ -332,8 +332,11 @@ def design(
 def _row(kind, problem, r: Result) -> Row:
     if r.status not in SOLUTION_PRESENT:
         return Row(kind, r, {}, r.message)
+    dynamic = problem.masses is not None or problem.loads is not None  # the dynamic criteria need them
     values = {
-        name: c.value(problem, r.mechanism) for name, c in criteria.CRITERIA.items() if c.applies(problem.mechanism)
+        name: c.value(problem, r.mechanism)
+        for name, c in criteria.CRITERIA.items()
+        if c.applies(problem.mechanism) and (dynamic or not c.needs_masses)
     }
     values["torque_per_newton"] = r.quantities["torque_per_newton"]
     return Row(kind, r, {k: values.get(k) for k in columns()}, "")
