@@ -83,12 +83,11 @@ def test_the_report_states_its_assumptions_and_the_librarys_numbers():
 def test_design_by_min_peak_torque_on_the_command_line(capsys):
     """The rows' peak torque is the library's exact value of the design each row returns."""
     argv = ["design", "--tr", "1.5", "--stroke", "0.3", "--types", "crank-shaper", "--objective", "min_peak_torque"]
-    assert (
-        cli.main([*argv, "--density", "1.57", "--ram-mass", "20", "--force", "1000", "--omega2", "10", "--json"]) == 0
-    )
+    dyn = ["--density", "2", "--ram-mass", "5", "--force", "1000", "--gravity", "9.81", "--omega2", "10", "--json"]
+    assert cli.main([*argv, *dyn]) == 0
     row = json.loads(capsys.readouterr().out)["rows"][0]
     m = qropt.CrankShaper(**{k: v for k, v in row["params"].items()})
-    masses, loads = qropt.Masses.bars(1.57, 20.0), qropt.Loads(1000.0)
+    masses, loads = qropt.Masses.bars(2.0, 5.0), qropt.Loads(1000.0, gravity=9.81)
     assert row["peak_torque"] == pytest.approx(m.dynamic_extremes(10.0, masses=masses, loads=loads).peak_torque.value)
     assert cli.main(argv) != 0  # no masses and no loads: a one-line reason
     assert "needs masses or loads" in capsys.readouterr().err

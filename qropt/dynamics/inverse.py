@@ -268,8 +268,8 @@ def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
     pts = {j: (xy[0], xy[1]) for j, xy in lp.points.items()}
     P = {j: np.stack([_parts(x, shape)[0], _parts(y, shape)[0]], axis=-1) * k for j, (x, y) in pts.items()}
     g = loads.gravity
-    A = np.zeros((n, s.n, s.n))
-    rhs = np.zeros((n, s.n))
+    A = np.zeros((s.n, s.n, n))  # entry-major: each (row, column) a contiguous vector over the angles
+    rhs = np.zeros((s.n, n))
     kin = {}
     for b in s.bodies:
         bm = s.props[b.name]
@@ -287,12 +287,15 @@ def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
         ay = oy[2] + ph[2] * rx - ph[1] ** 2 * ry
         kin[b.name] = (np.stack([gx, gy], -1), np.stack([vx, vy], -1), np.stack([ax, ay], -1), ph[1], ph[2], bm)
         r = s.rows[b.name]
-        rhs[:, r] = bm.mass * ax
-        rhs[:, r + 1] = bm.mass * ay + bm.mass * g
+        rhs[r] = bm.mass * ax
+        rhs[r + 1] = bm.mass * ay + bm.mass * g
         if b.kind != "ram":
-            rhs[:, r + 2] = bm.inertia * ph[2]
+            rhs[r + 2] = bm.inertia * ph[2]
     crank = s.rows["crank"]
-    A[:, crank + 2, 0] = 1.0  # the motor's torque on the crank
+    A[crank + 2, 0] = 1.0  # the motor's torque on the crank
+    pattern_torque = (crank + 2, 0)
+
+    pattern = np.zeros((s.n, s.n), bool)  # the entries the assembly sets (the rest are zero at every angle)
 
     def put(body, col, fx, fy, at):
         """A unit unknown in column col gives the force (fx, fy) on ``body`` at point ``at``."""
@@ -300,10 +303,12 @@ def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
             return
         r = s.rows[body]
         G = kin[body][0]
-        A[:, r, col] += fx
-        A[:, r + 1, col] += fy
+        A[r, col] += fx
+        A[r + 1, col] += fy
+        pattern[r : r + 2, col] = True
         if _kind(s, body) != "ram":
-            A[:, r + 2, col] += (at[:, 0] - G[:, 0]) * fy - (at[:, 1] - G[:, 1]) * fx
+            A[r + 2, col] += (at[:, 0] - G[:, 0]) * fy - (at[:, 1] - G[:, 1]) * fx
+            pattern[r + 2, col] = True
 
     guide_col = None
     for c, col, _ in s.cols:
@@ -319,38 +324,41 @@ def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
         else:  # the guide under the ram: a force normal to the slide line, at the ram's joint
             guide_col = col
             put(c.receiver, col, 0.0, 1.0, at if _kind(s, c.receiver) != "yoke" else kin[c.receiver][0])
+    pattern[pattern_torque] = True
     if s.yoke is not None:
-        A[:, s.rows[s.yoke] + 2, s.guide_moment_col] = 1.0
+        A[s.rows[s.yoke] + 2, s.guide_moment_col] = 1.0
+        pattern[s.rows[s.yoke] + 2, s.guide_moment_col] = True
     if s.block_massive:
         block = next(b.name for b in s.bodies if b.kind == "block")
         lever = next(c.receiver for c in s.conns if c.giver == block and c.kind == "slot")
-        A[:, s.rows[block] + 2, s.couple_col] = 1.0
-        A[:, s.rows[lever] + 2, s.couple_col] = -1.0
+        A[s.rows[block] + 2, s.couple_col] = 1.0
+        A[s.rows[lever] + 2, s.couple_col] = -1.0
+        pattern[[s.rows[block] + 2, s.rows[lever] + 2], s.couple_col] = True
 
     out_body = next((b for b in s.bodies if b.kind in ("ram", "yoke")), None)
-    external = np.zeros((n, s.n))  # known applied forces moved to the right-hand side: cutting force, torque
+    external = np.zeros((s.n, n))  # known applied forces moved to the right-hand side: cutting force, torque
     working = _working(m, t, omega2)
     if out_body is not None:
         v_out = kin[out_body.name][1][:, 0]
         x_out = P[m.output_joint()][:, 0] / k if m.output_joint() else kin[out_body.name][0][:, 0] / k
         f_cut = np.where(working, loads.force_at(x_out), 0.0) * -np.sign(v_out)
         r = s.rows[out_body.name]
-        external[:, r] += f_cut  # along x, through the ram's point (no moment about a yoke's centre on its line)
+        external[r] += f_cut  # along x, through the ram's point (no moment about a yoke's centre on its line)
     elif loads.follower_torque and m.OUTPUT == "follower":
         fol = next(b for b in s.bodies if b.name == "follower")
         w4 = kin[fol.name][3]
-        external[:, s.rows[fol.name] + 2] += np.where(working, -loads.follower_torque * np.sign(w4), 0.0)
+        external[s.rows[fol.name] + 2] += np.where(working, -loads.follower_torque * np.sign(w4), 0.0)
     friction = np.zeros(n)
     v_sign = -np.sign(kin[out_body.name][1][:, 0]) if out_body is not None else 0.0
     try:
-        x = np.linalg.solve(A, (rhs - external)[..., None])[..., 0]
+        x = batched_solve(A, rhs - external, pattern)
         if loads.friction and guide_col is not None:
             r = s.rows[out_body.name]
             for _ in range(FRICTION_ITERATIONS):
                 new = loads.friction * np.abs(x[:, guide_col]) * v_sign
                 ext = external.copy()
-                ext[:, r] += new
-                x_new = np.linalg.solve(A, (rhs - ext)[..., None])[..., 0]
+                ext[r] += new
+                x_new = batched_solve(A, rhs - ext, pattern)
                 done = np.max(np.abs(x_new[:, guide_col] - x[:, guide_col])) <= FRICTION_TOL * max(
                     1.0, float(np.max(np.abs(x_new[:, guide_col])))
                 )
@@ -430,6 +438,59 @@ def generalised(m, theta2, *, masses=None, loads=None, sense: float = 1.0) -> Ge
         else:
             Q += np.where(working, loads.follower_torque * np.abs(x[1]), 0.0) * math.copysign(1.0, sense)
     return Generalised(t, M, dM, Q)
+
+
+PIVOT_TOL = 1e-10  # a pivot below this times its column's largest entry: that angle is solved with pivoting
+
+
+def batched_solve(A: np.ndarray, b: np.ndarray, pattern: np.ndarray | None = None) -> np.ndarray:
+    """x (n, K) with A[:, :, i] x[i] = b[:, i] for n small sparse systems stored entry-major, A (K, K, n) and
+    b (K, n): Gaussian elimination over the structural nonzeros (``pattern``, default where A is nonzero at some
+    angle) in one row order for every angle (partial pivoting at one of them), vectorised across the
+    angles; an angle where a pivot is small for its column is solved again by LAPACK with pivoting
+    (np.linalg.solve, which raises LinAlgError where the system is singular)."""
+    K, _, n = A.shape
+    pattern = np.any(A != 0, axis=2) if pattern is None else pattern
+    at = n // 3  # one angle's pivoting fixes the order; an angle where it does not suit is solved again below
+    order, left = [], list(range(K))
+    Mk = A[:, :, at].copy()
+    for j in range(K):  # the row order of partial pivoting at that angle
+        i = max(left, key=lambda r: abs(Mk[r, j]))
+        order.append(i)
+        left.remove(i)
+        if Mk[i, j] != 0:
+            for r in left:
+                Mk[r] -= Mk[r, j] / Mk[i, j] * Mk[i]
+    M = [[A[order[i], j] if pattern[order[i], j] else None for j in range(K)] for i in range(K)]
+    r = [b[order[i]] for i in range(K)]
+    bad = np.zeros(n, bool)
+    for j in range(K):
+        piv = M[j][j]
+        if piv is None:
+            return np.linalg.solve(np.moveaxis(A, 2, 0), b.T[..., None])[..., 0]
+        col = [np.abs(M[i][j]) for i in range(j, K) if M[i][j] is not None]
+        bad |= np.abs(piv) <= PIVOT_TOL * np.maximum.reduce(col)
+        inv_p = 1.0 / np.where(piv == 0, 1.0, piv)
+        for i in range(j + 1, K):
+            if M[i][j] is None:
+                continue
+            f = M[i][j] * inv_p
+            for c in range(j + 1, K):
+                if M[j][c] is not None:
+                    M[i][c] = -f * M[j][c] if M[i][c] is None else M[i][c] - f * M[j][c]
+            r[i] = r[i] - f * r[j]
+            M[i][j] = None
+    x = [None] * K
+    for j in range(K - 1, -1, -1):
+        acc = r[j]
+        for c in range(j + 1, K):
+            if M[j][c] is not None:
+                acc = acc - M[j][c] * x[c]
+        x[j] = acc / np.where(M[j][j] == 0, 1.0, M[j][j])
+    x = np.stack(x, axis=1)
+    if bad.any():
+        x[bad] = np.linalg.solve(np.moveaxis(A[:, :, bad], 2, 0), b[:, bad].T[..., None])[..., 0]
+    return x
 
 
 def _kind(s: _System, body: str) -> str:
