@@ -70,23 +70,24 @@ def test_the_nlp_states_the_exact_dynamics_at_any_design(kind, objective):
             assert e[:n] == pytest.approx(s2, rel=1e-9, abs=1e-9 * s2.max())
 
 
-def test_min_peak_torque_is_the_best_of_a_dense_scan_of_the_crank_shaper_family():
+@pytest.mark.parametrize("objective", ["min_peak_torque", "min_shaking_force"])
+def test_the_optimum_is_the_best_of_a_dense_scan_of_the_crank_shaper_family(objective):
     """The crank-shaper's designs for a TR and stroke are one family (r2 = k r1, r4 = s / 2k) along r1; its masses
-    follow r1 (the lever reaches max(r4, r1 + r2)). The certified optimum is at least as good as 2,000 designs
+    follow r1 (the lever reaches max(r4, r1 + r2)). The certified optimum is at least as good as 1,000 designs
     along the family, evaluated exactly, and within 1e-6 of their best."""
-    p = type_problem("crank-shaper", 1.5, 0.3, objective="min_peak_torque", masses=MASSES, loads=LOADS, omega2=10.0)
+    p = type_problem("crank-shaper", 1.5, 0.3, objective=objective, masses=MASSES, loads=LOADS, omega2=10.0)
     r = qropt.solve(p)
     assert r.status in ("optimal", "acceptable"), r.message  # acceptable: IPOPT's looser tolerance, certified
     k = analytic.crank_shaper_ratio(1.5)
-    c = criteria.of("min_peak_torque")
+    c = criteria.of(objective)
     scan = []
-    for r1 in np.geomspace(*p.free["r1"], 2000):
+    for r1 in np.geomspace(*p.free["r1"], 1000):
         q = {"r1": r1, "r2": k * r1, "r4": 0.3 / (2 * k)}
         if all(p.free[n][0] <= v <= p.free[n][1] for n, v in q.items()):
             scan.append(c.value(p, qropt.CrankShaper(**q)))
     assert r.objective <= min(scan) * (1 + 1e-9)
     assert r.objective == pytest.approx(min(scan), rel=1e-6)
-    assert r.objective == pytest.approx(c.value(p, r.mechanism), rel=1e-12)
+    assert r.objective == pytest.approx(c.value(p, r.mechanism), rel=1e-9)
 
 
 def test_massless_min_peak_torque_is_the_force_times_the_least_peak_velocity():

@@ -21,6 +21,7 @@ from qropt import units as units_
 from qropt.synthesis.criteria import Criterion, Exchange, register
 
 TWO_PI = 2 * math.pi
+LIFTS = 1  # torque extremes the NLP lifts for the peak torque
 
 
 def _problem_check(c, problem) -> str | None:
@@ -220,6 +221,20 @@ class PeakTorque(_Dynamic):
         s = _symbolic(f)
         return [("peak |crank torque|", [sign * s.torque(out) for out in f.sampled for sign in (1, -1)])]
 
+    def lifts(self, f, role):  # the largest torque extremes, lifted like the peak acceleration's (dT/dtheta2 = 0)
+        return LIFTS
+
+    def lift_terms(self, f, k, phi, out):
+        T = _symbolic(f).torque(out)
+        f.row("lifted torque extreme: stationary", casadi.jacobian(T, phi), 0.0, 0.0, kind="lift")
+        return [T, -T]
+
+    def lift_start(self, f, problem, m, n):
+        t = np.linspace(0.0, TWO_PI, 360, endpoint=False)
+        v = np.abs(_cycle(problem, m).at(t).torque)
+        peaks = [i for i in range(t.size) if v[i] >= v[i - 1] and v[i] >= v[(i + 1) % t.size]]
+        return [float(t[i]) for i in sorted(peaks, key=lambda i: -v[i])][:n]
+
     def exchange(self, f, problem, m, z, value_nlp, gap_tol):
         p = _cycle(problem, m).peak(lambda d: np.abs(d.torque))
         gap = (p.value - z[0]) / max(1.0, p.value)
@@ -287,6 +302,20 @@ class ShakingForce(_Dynamic):
     def epigraph(self, f):
         s = _symbolic(f)
         return [("peak |shaking force|^2", [s.shaking_squared(out) for out in f.sampled])]
+
+    def lifts(self, f, role):  # its largest extreme, lifted (d|S|^2/dtheta2 = 0)
+        return LIFTS
+
+    def lift_terms(self, f, k, phi, out):
+        s2 = _symbolic(f).shaking_squared(out)
+        f.row("lifted shaking extreme: stationary", casadi.jacobian(s2, phi), 0.0, 0.0, kind="lift")
+        return [s2]
+
+    def lift_start(self, f, problem, m, n):
+        t = np.linspace(0.0, TWO_PI, 360, endpoint=False)
+        v = np.hypot(*_cycle(problem, m).at(t).shaking_force.T)
+        peaks = [i for i in range(t.size) if v[i] >= v[i - 1] and v[i] >= v[(i + 1) % t.size]]
+        return [float(t[i]) for i in sorted(peaks, key=lambda i: -v[i])][:n]
 
     def exchange(self, f, problem, m, z, value_nlp, gap_tol):
         p = _cycle(problem, m).peak(lambda d: np.hypot(*d.shaking_force.T))
