@@ -76,6 +76,18 @@ def forces(path):
     plots.save(plots.dynamics_figure(paper_mechanism(), 10.0, masses, loads, math.radians(60)), path)
 
 
+def torque_front(path):
+    sc = qropt.Problem(
+        "slider-crank",
+        free={"r2": (0.015, 1.5), "r3": (0.015, 1.5), "e": (-1.5, 1.5)},
+        targets={"time_ratio": 1.5, "stroke": 0.3},
+        masses=qropt.Masses.bars(2.0, 5.0),
+        loads=qropt.Loads(cutting_force=1000.0, gravity=9.81),
+        omega2=10.0,
+    )
+    qropt.pareto(sc, ("max_gamma_min", "min_peak_torque"), n=20).plot(path)
+
+
 def polygons(path):
     m = paper_mechanism()
     m = type(m)(**{**m.params, "r3": 0.2504})  # the paper's Table 4 design, as its Tables 2-3
@@ -93,6 +105,7 @@ PICTURES = {
     "servo.png": servo,
     "forces.png": forces,
     "polygons.png": polygons,
+    "torque_front.png": torque_front,
 }
 
 
