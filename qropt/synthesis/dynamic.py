@@ -64,9 +64,10 @@ class _Symbolic:
         (ax, ay), (bx, by) = self.point(out, a), self.point(out, b)
         return casadi.sqrt((bx - ax) ** 2 + (by - ay) ** 2)
 
-    def mass_model(self, out):
+    def mass_model(self, out, lengths=None):
         """body -> (mass, (cx, cy), inertia): the problem's overrides, else uniform bars of the density (a plate
-        the union of bars from its first joint), the ram and block as points, the counterweight on the crank."""
+        the union of bars from its first joint), the ram and block as points, the counterweight on the crank;
+        ``lengths``: body -> a bar's length given (an NLP variable bounding its joints' reaches)."""
         masses = self.f.masses
         out_models = {}
         if masses is None:
@@ -80,7 +81,7 @@ class _Symbolic:
             elif b.kind == "block":
                 model = (masses.block, (0.0, 0.0), 0.0)
             else:
-                model = self._bars(out, b, masses.density)
+                model = self._bars(out, b, masses.density, (lengths or {}).get(b.name))
             if b.name == "crank" and masses.counterweight is not None and masses.counterweight.mass > 0:
                 cw = masses.counterweight
                 point = (cw.mass, (cw.radius * math.cos(cw.angle), cw.radius * math.sin(cw.angle)), 0.0)
@@ -96,12 +97,28 @@ class _Symbolic:
             return self._dist(out, first, self.crank.joints[0]) + self._dist(out, self.crank.joints[0], j)
         return casadi.fmax(*(self._dist(d, first, j) for d in self.f.dead))  # a sliding output: at a dead centre
 
-    def _bars(self, out, b, density):
+    def kinked(self):
+        """The bars whose length is the largest of several reaches (a kink of the mass model where they cross)."""
+        masses = self.f.masses
+        if masses is None:
+            return []
+        return [
+            b.name
+            for b in self.bodies
+            if b.name not in masses.bodies and b.kind in ("bar", "slot-lever") and len(b.joints) > 2
+        ]
+
+    def reaches(self, out, name):
+        b = next(x for x in self.bodies if x.name == name)
+        return [self._reach(out, b, j) for j in b.joints[1:]]
+
+    def _bars(self, out, b, density, length=None):
         reaches = [self._reach(out, b, j) for j in b.joints[1:]]
         if b.kind != "plate":
             L = reaches[0]
             for r in reaches[1:]:
                 L = casadi.fmax(L, r)
+            L = L if length is None else length
             m = density * L
             return (m, (L / 2, 0.0), m * L * L / 12)
         (ox, oy), (sx, sy) = self.point(out, b.joints[0]), self.point(out, b.joints[1])
@@ -141,13 +158,13 @@ class _Symbolic:
         acc = (o[2][0] - al * ry - w * w * rx, o[2][1] + al * rx - w * w * ry)
         return v, acc, w, al
 
-    def torque(self, out):
-        """The crank torque (N m) at constant omega2 at one crank angle."""
+    def torque(self, out, lengths=None):
+        """The crank torque (N m) at constant omega2 at one crank angle (``lengths`` as ``mass_model``)."""
         f = self.f
         w2 = f.omega2**2
         g = f.loads.gravity if f.loads is not None else 0.0
         T = 0
-        for name, (m, com, inertia) in self.mass_model(out).items():
+        for name, (m, com, inertia) in self.mass_model(out, lengths).items():
             b = next(x for x in self.bodies if x.name == name)
             v, a, w, al = self.kinematics(out, b, com)
             T += w2 * (m * (v[0] * a[0] + v[1] * a[1]) + inertia * w * al) + g * m * v[1]
@@ -271,11 +288,25 @@ class RmsTorque(_Dynamic):
     def from_nlp(self, y, omega2):
         return math.sqrt(max(y, 0.0))
 
-    def expression(self, f):
+    def epigraph(self, f):  # a kinked bar's length: a variable above each of its reaches (smooth where they cross),
+        # capped by their largest in ``measure`` (a row that binds only where a longer bar would lower the torque)
         s = _symbolic(f)
+        return [(f"length of the {b}", s.reaches(f.dead[0], b)) for b in s.kinked()]
+
+    def measure(self, f, z):
+        s = _symbolic(f)
+        lengths = dict(zip(s.kinked(), z, strict=True))
+        if not getattr(f, "_lengths_capped", False):  # and no longer than its farthest reach (more inertia may help)
+            f._lengths_capped = True
+            for name, length in lengths.items():
+                cap = s.reaches(f.dead[0], name)
+                top = cap[0]
+                for r in cap[1:]:
+                    top = casadi.fmax(top, r)
+                f.row(f"length of the {name}: its farthest reach", length - top, -casadi.inf, 0.0)
         total = 0
         for out, w, arc in f.strokes(_nodes()):
-            total += 0.5 * arc * w * s.torque(out) ** 2
+            total += 0.5 * arc * w * s.torque(out, lengths) ** 2
         return total / TWO_PI
 
     def exchange(self, f, problem, m, z, value_nlp, gap_tol):
