@@ -114,3 +114,24 @@ def test_a_dynamic_objective_names_what_it_needs(change, words):
     p = type_problem("crank-shaper", 1.5, 0.3)
     with pytest.raises(qropt.ProblemError, match=words):
         p.replace(objective="min_peak_torque", **change)
+
+
+def test_a_chart_by_peak_torque_on_two_dask_workers_carries_the_masses_and_loads():
+    """Tiles carry the problem's masses and loads to the workers: every cell equals a direct solve."""
+    p = qropt.Problem(
+        "crank-shaper",
+        free={"r1": (0.015, 1.5), "r2": (0.015, 1.5), "r4": (0.015, 1.5)},
+        targets={"time_ratio": 1.5, "stroke": 0.3},
+        objective="min_peak_torque",
+        masses=MASSES,
+        loads=LOADS,
+        omega2=10.0,
+    )
+    trs, strokes = [1.4, 1.8], [0.2, 0.3]
+    ch = qropt.chart(p, ("time_ratio", trs), ("stroke", strokes), workers=2, progress=False)
+    grid = ch.grid()
+    for i, s in enumerate(strokes):
+        for j, tr in enumerate(trs):
+            r = qropt.solve(p.replace(targets={"time_ratio": tr, "stroke": s}))
+            assert r.success, r.message
+            assert grid[i, j] == pytest.approx(r.objective, rel=1e-9)
