@@ -73,7 +73,50 @@ def test_the_nlp_states_the_exact_dynamics_at_any_design(kind, objective):
             assert e[:n] == pytest.approx(s2, rel=1e-9, abs=1e-9 * s2.max())
 
 
-@pytest.mark.parametrize("objective", ["min_peak_torque", "min_shaking_force", "min_rms_torque"])
+@pytest.mark.parametrize("kind", [*KINDS, "slot-ram-shaper"])
+def test_the_nlp_solves_the_newton_euler_system_of_any_design(kind):
+    """The bearing loads the NLP states at its samples (the Newton-Euler system assembled by the same code as the
+    exact analysis and solved symbolically) are the exact joint forces' squares, at a random design of every
+    type."""
+    params, m = random_mechanisms(kind, 1, seed=3)[0]
+    free = [k for k, kind_ in type(m).kinds().items() if kind_ != "branch" and k in params]
+    p = qropt.Problem(
+        type(m),
+        fixed={k: v for k, v in params.items() if k not in free},
+        free={
+            k: (v - 1e-3 if type(m).kinds()[k] != "length" else v / 2, v + 1) for k, v in params.items() if k in free
+        },
+        targets={"time_ratio": m.time_ratio(), "stroke": m.stroke()},
+        objective="min_peak_bearing_force",
+        masses=MASSES,
+        loads=LOADS,
+        omega2=7.0,
+        conditions={"grashof": m.grashof().kind} if type(m).FOUR_BAR else {},
+    )
+    branch = {k: v[0] for k, v in p.branches.items()}
+    m = p.build({k: params[k] for k in free}, branch)
+    a, b = m.stroke_angles()
+    f = Formulation(p, branch, 1 if a >= b else -1)
+    d = m.dead_centres()
+    w = f.w_blocks.join(free=[params[k] for k in f.free], theta=[d.theta_max, d.theta_max + a])
+    n = f.p_blocks.sizes["samples"]
+    th = np.linspace(0.1, 6.0, n)
+    pv = f.p_blocks.join(
+        fixed=[p.fixed[k] for k in f.fixed],
+        targets=[p.targets[k] for k in f.targets],
+        samples=th,
+        fractions=np.linspace(0, 1, n),
+    )
+    exact = m.dynamics(th, 7.0, masses=MASSES, loads=LOADS).joint_forces
+    keys = [k for k in exact if k != "slide"]
+    want = np.array([[np.sum(exact[k][i] ** 2) for k in keys] for i in range(n)])
+    got = np.array(f.epi_fun(w, pv)).ravel()[: n * len(keys)].reshape(n, len(keys))
+    assert np.sort(got, axis=1) == pytest.approx(np.sort(want, axis=1), rel=1e-9, abs=1e-9 * want.max())
+
+
+@pytest.mark.parametrize(
+    "objective", ["min_peak_torque", "min_shaking_force", "min_rms_torque", "min_peak_bearing_force"]
+)
 def test_the_optimum_is_the_best_of_a_dense_scan_of_the_crank_shaper_family(objective):
     """The crank-shaper's designs for a TR and stroke are one family (r2 = k r1, r4 = s / 2k) along r1; its masses
     follow r1 (the lever reaches max(r4, r1 + r2)). The certified optimum is at least as good as 1,000 designs

@@ -194,12 +194,23 @@ class _System:
     """The Newton-Euler system of one mechanism: bodies, unknowns and the rows they enter."""
 
     def __init__(self, m, masses: Masses):
-        link = linkage_of(m)
         self.props = body_masses(m, masses)
+        self._structure(linkage_of(m), type(m).__name__, lambda name: self.props[name].mass > 0)
+
+    @classmethod
+    def of_linkage(cls, link, name: str, massive) -> _System:
+        """The structure alone (no numbers): ``massive(body)`` says whether a body has a mass (the block's
+        decides whether it is a body of the system)."""
+        s = cls.__new__(cls)
+        s.props = None
+        s._structure(link, name, massive)
+        return s
+
+    def _structure(self, link, name, massive):
         bodies = list(link.bodies())
         conns = list(link.connections())
         block = next((b for b in bodies if b.kind == "block"), None)
-        self.block_massive = block is not None and self.props[block.name].mass > 0
+        self.block_massive = block is not None and massive(block.name)
         if block is not None and not self.block_massive:  # crank -> lever straight along the slot's normal
             bodies = [b for b in bodies if b is not block]
             pin = next(c for c in conns if c.receiver == block.name and c.kind == "pin")
@@ -231,10 +242,74 @@ class _System:
             n += 1
         if n != self.n_rows:
             raise InvalidParameter(
-                f"{type(m).__name__}: {self.n_rows} equations of motion against {n} unknown forces; the force "
+                f"{name}: {self.n_rows} equations of motion against {n} unknown forces; the force "
                 "analysis needs a linkage whose every body is held by pins, slots and the ram's guide"
             )
         self.n = n
+
+    def kind(self, body: str) -> str:
+        return next(b.kind for b in self.bodies if b.name == body)
+
+    def assemble(self, P, kin, g, sqrt):
+        """The Newton-Euler system as entries: ({(row, column): value}, {row: value}), the values numpy arrays
+        over crank angles or CasADi expressions alike. P: joint -> (x, y) (m); kin: body -> (G (x, y),
+        a_G (x, y), alpha, mass, inertia); g: gravity (m/s^2); sqrt: the namespace's square root. Column 0 is the
+        crank torque; the known loads (cutting force, a follower torque, friction) go on the right-hand side
+        afterwards."""
+        A, rhs = {}, {}
+
+        def add(r, c, v):
+            A[(r, c)] = A[(r, c)] + v if (r, c) in A else v
+
+        for b in self.bodies:
+            _, a, alpha, mass, inertia = kin[b.name]
+            r = self.rows[b.name]
+            rhs[r] = mass * a[0]
+            rhs[r + 1] = mass * a[1] + mass * g
+            if b.kind != "ram":
+                rhs[r + 2] = inertia * alpha
+        add(self.rows["crank"] + 2, 0, 1.0)  # the motor's torque on the crank
+
+        def put(body, col, fx, fy, at):
+            """A unit unknown in column col gives the force (fx, fy) on ``body`` at point ``at``."""
+            if body == "ground":
+                return
+            r, G = self.rows[body], kin[body][0]
+            add(r, col, fx)
+            add(r + 1, col, fy)
+            if self.kind(body) != "ram":
+                add(r + 2, col, (at[0] - G[0]) * fy - (at[1] - G[1]) * fx)
+
+        for c, col, _ in self.cols:
+            at = P[c.joint]
+            if c.kind == "pin":
+                for i, (fx, fy) in enumerate(((1.0, 0.0), (0.0, 1.0))):
+                    put(c.receiver, col + i, fx, fy, at)
+                    put(c.giver, col + i, -fx, -fy, at)
+            elif c.kind == "slot":
+                nx, ny = self.normal(c, P, sqrt)
+                put(c.receiver, col, nx, ny, at)
+                put(c.giver, col, -nx, -ny, at)
+            else:  # the guide under the ram: a force normal to the slide line, at the ram's joint
+                put(c.receiver, col, 0.0, 1.0, at if self.kind(c.receiver) != "yoke" else kin[c.receiver][0])
+        if self.yoke is not None:
+            add(self.rows[self.yoke] + 2, self.guide_moment_col, 1.0)
+        if self.block_massive:
+            block = next(b.name for b in self.bodies if b.kind == "block")
+            lever = next(c.receiver for c in self.conns if c.giver == block and c.kind == "slot")
+            add(self.rows[block] + 2, self.couple_col, 1.0)
+            add(self.rows[lever] + 2, self.couple_col, -1.0)
+        return A, rhs
+
+    @staticmethod
+    def normal(c, P, sqrt):
+        """The unit normal of a slot's line (rotated +90 degrees from a->b); the yoke's: +x."""
+        if c.line is None:
+            return 1.0, 0.0
+        (ax, ay), (bx, by) = P[c.line[0]], P[c.line[1]]
+        dx, dy = bx - ax, by - ay
+        L = sqrt(dx * dx + dy * dy)
+        return -dy / L, dx / L
 
 
 def inverse_dynamics(m, theta2, omega2: float = 1.0, alpha2: float = 0.0, *, masses=None, loads=None) -> Dynamics:
@@ -267,9 +342,6 @@ def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
     lp = m.evaluate(JET, Jet.seed(t, omega2, alpha2))
     pts = {j: (xy[0], xy[1]) for j, xy in lp.points.items()}
     P = {j: np.stack([_parts(x, shape)[0], _parts(y, shape)[0]], axis=-1) * k for j, (x, y) in pts.items()}
-    g = loads.gravity
-    A = np.zeros((s.n, s.n, n))  # entry-major: each (row, column) a contiguous vector over the angles
-    rhs = np.zeros((s.n, n))
     kin = {}
     for b in s.bodies:
         bm = s.props[b.name]
@@ -286,54 +358,24 @@ def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
         ax = ox[2] - ph[2] * ry - ph[1] ** 2 * rx
         ay = oy[2] + ph[2] * rx - ph[1] ** 2 * ry
         kin[b.name] = (np.stack([gx, gy], -1), np.stack([vx, vy], -1), np.stack([ax, ay], -1), ph[1], ph[2], bm)
-        r = s.rows[b.name]
-        rhs[r] = bm.mass * ax
-        rhs[r + 1] = bm.mass * ay + bm.mass * g
-        if b.kind != "ram":
-            rhs[r + 2] = bm.inertia * ph[2]
-    crank = s.rows["crank"]
-    A[crank + 2, 0] = 1.0  # the motor's torque on the crank
-    pattern_torque = (crank + 2, 0)
-
+    entries, rows = s.assemble(
+        {j: (p[:, 0], p[:, 1]) for j, p in P.items()},
+        {
+            name: ((G[:, 0], G[:, 1]), (a[:, 0], a[:, 1]), al, bm.mass, bm.inertia)
+            for name, (G, _, a, _, al, bm) in kin.items()
+        },
+        loads.gravity,
+        np.sqrt,
+    )
+    A = np.zeros((s.n, s.n, n))  # entry-major: each (row, column) a contiguous vector over the angles
     pattern = np.zeros((s.n, s.n), bool)  # the entries the assembly sets (the rest are zero at every angle)
-
-    def put(body, col, fx, fy, at):
-        """A unit unknown in column col gives the force (fx, fy) on ``body`` at point ``at``."""
-        if body == "ground":
-            return
-        r = s.rows[body]
-        G = kin[body][0]
-        A[r, col] += fx
-        A[r + 1, col] += fy
-        pattern[r : r + 2, col] = True
-        if _kind(s, body) != "ram":
-            A[r + 2, col] += (at[:, 0] - G[:, 0]) * fy - (at[:, 1] - G[:, 1]) * fx
-            pattern[r + 2, col] = True
-
-    guide_col = None
-    for c, col, _ in s.cols:
-        at = P[c.joint]
-        if c.kind == "pin":
-            for i, (fx, fy) in enumerate(((1.0, 0.0), (0.0, 1.0))):
-                put(c.receiver, col + i, fx, fy, at)
-                put(c.giver, col + i, -fx, -fy, at)
-        elif c.kind == "slot":
-            nx, ny = _normal(c, P, n)
-            put(c.receiver, col, nx, ny, at)
-            put(c.giver, col, -nx, -ny, at)
-        else:  # the guide under the ram: a force normal to the slide line, at the ram's joint
-            guide_col = col
-            put(c.receiver, col, 0.0, 1.0, at if _kind(s, c.receiver) != "yoke" else kin[c.receiver][0])
-    pattern[pattern_torque] = True
-    if s.yoke is not None:
-        A[s.rows[s.yoke] + 2, s.guide_moment_col] = 1.0
-        pattern[s.rows[s.yoke] + 2, s.guide_moment_col] = True
-    if s.block_massive:
-        block = next(b.name for b in s.bodies if b.kind == "block")
-        lever = next(c.receiver for c in s.conns if c.giver == block and c.kind == "slot")
-        A[s.rows[block] + 2, s.couple_col] = 1.0
-        A[s.rows[lever] + 2, s.couple_col] = -1.0
-        pattern[[s.rows[block] + 2, s.rows[lever] + 2], s.couple_col] = True
+    for (r, c), v in entries.items():
+        A[r, c] = v
+        pattern[r, c] = True
+    rhs = np.zeros((s.n, n))
+    for r, v in rows.items():
+        rhs[r] = v
+    guide_col = next((col for c, col, _ in s.cols if c.kind == "guide"), None)
 
     out_body = next((b for b in s.bodies if b.kind in ("ram", "yoke")), None)
     external = np.zeros((s.n, n))  # known applied forces moved to the right-hand side: cutting force, torque
@@ -373,10 +415,10 @@ def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
     forces = {}
     for c, col, _ in s.cols:
         if c.kind == "pin":
-            key = f"{c.joint}/block" if s.block_massive and _kind(s, c.receiver) == "block" else c.joint
+            key = f"{c.joint}/block" if s.block_massive and s.kind(c.receiver) == "block" else c.joint
             forces[key] = x[:, col : col + 2].copy()
         elif c.kind == "slot":
-            nx, ny = _normal(c, P, n)
+            nx, ny = s.normal(c, {j: (p[:, 0], p[:, 1]) for j, p in P.items()}, np.sqrt)
             forces[c.joint] = np.stack([x[:, col] * nx, x[:, col] * ny], -1) * np.ones((n, 1))
         else:
             forces["slide"] = np.stack([friction * np.ones(n), x[:, col]], -1)
@@ -491,20 +533,6 @@ def batched_solve(A: np.ndarray, b: np.ndarray, pattern: np.ndarray | None = Non
     if bad.any():
         x[bad] = np.linalg.solve(np.moveaxis(A[:, :, bad], 2, 0), b[:, bad].T[..., None])[..., 0]
     return x
-
-
-def _kind(s: _System, body: str) -> str:
-    return next(b.kind for b in s.bodies if b.name == body)
-
-
-def _normal(c, P, n):
-    """The unit normal of a slot's line (rotated +90 degrees from a->b); the yoke's: +x."""
-    if c.line is None:
-        return np.ones(n), np.zeros(n)
-    a, b = P[c.line[0]], P[c.line[1]]
-    d = b - a
-    L = np.hypot(d[:, 0], d[:, 1])
-    return -d[:, 1] / L, d[:, 0] / L
 
 
 def _working(m, t, omega2) -> np.ndarray:

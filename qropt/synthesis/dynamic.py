@@ -18,6 +18,7 @@ import casadi
 import numpy as np
 
 from qropt import units as units_
+from qropt.errors import InvalidParameter
 from qropt.synthesis.criteria import Criterion, Exchange, register
 
 TWO_PI = 2 * math.pi
@@ -157,6 +158,71 @@ class _Symbolic:
         v = (o[1][0] - w * ry, o[1][1] + w * rx)
         acc = (o[2][0] - al * ry - w * w * rx, o[2][1] + al * rx - w * w * ry)
         return v, acc, w, al
+
+    def centre(self, out, b, com):
+        """The centre of mass G of body b (SI)."""
+        o = self.point(out, b.joints[0])
+        if b.kind in ("ram", "yoke"):
+            return (o[0] + com[0], (0.0 if b.kind == "yoke" else o[1]) + com[1])
+        if b.kind == "block":
+            a, e = self.point(out, b.joints[1]), o
+        else:
+            a, e = o, self.point(out, b.joints[1])
+        dx, dy = e[0] - a[0], e[1] - a[1]
+        r = casadi.sqrt(dx * dx + dy * dy)
+        c, sn = dx / r, dy / r
+        return (o[0] + c * com[0] - sn * com[1], o[1] + sn * com[0] + c * com[1])
+
+    def system(self):
+        """The Newton-Euler structure of the linkage (``qropt.dynamics.inverse._System``)."""
+        if getattr(self, "_system", None) is None:
+            from qropt.dynamics.inverse import _System
+
+            masses = self.f.masses
+
+            def massive(name):
+                if masses is None:
+                    return False
+                return masses.bodies[name].mass > 0 if name in masses.bodies else masses.block > 0
+
+            self._system = _System.of_linkage(
+                self.f.mechanism.linkage(self.f.params), self.f.mechanism.__name__, massive
+            )
+        return self._system
+
+    def bearing_loads(self, out):
+        """joint -> |force|^2 (N^2) at one crank angle at constant omega2: every pin and every block or pin in a
+        slot (what its pin carries), from the Newton-Euler system solved symbolically."""
+        f, s = self.f, self.system()
+        w2 = f.omega2**2
+        models = self.mass_model(out)
+        kin = {}
+        for b in s.bodies:
+            mass, com, inertia = models.get(b.name, (0.0, (0.0, 0.0), 0.0))
+            _, a, _, al = self.kinematics(out, b, com)
+            kin[b.name] = (self.centre(out, b, com), (a[0] * w2, a[1] * w2), al * w2, mass, inertia)
+        P = {j: self.point(out, j) for j in f.joint_index}
+        g = f.loads.gravity if f.loads is not None else 0.0
+        entries, rows = s.assemble(P, kin, g, casadi.sqrt)
+        A = casadi.SX(s.n, s.n)
+        for (r, c), v in entries.items():
+            A[r, c] = v
+        rhs = casadi.SX(s.n, 1)
+        for r, v in rows.items():
+            rhs[r] = v
+        ram = next((b for b in s.bodies if b.kind in ("ram", "yoke")), None)
+        force = f.loads.cutting_force if f.loads is not None else 0.0
+        if ram is not None and force:  # the cutting force against the ram on the working stroke
+            way = (-1.0 if f.orientation > 0 else 1.0) * math.copysign(1.0, f.omega2)
+            rhs[s.rows[ram.name]] -= casadi.if_else(way * out.v * f.omega2 > 0, -force * way, 0.0)
+        x = casadi.solve(A, rhs)
+        loads = {}
+        for c, col, _ in s.cols:
+            if c.kind == "pin" and not (s.block_massive and s.kind(c.receiver) == "block"):
+                loads[c.joint] = x[col] ** 2 + x[col + 1] ** 2
+            elif c.kind == "slot":
+                loads[c.joint] = x[col] ** 2
+        return loads
 
     def torque(self, out, lengths=None):
         """The crank torque (N m) at constant omega2 at one crank angle (``lengths`` as ``mass_model``)."""
@@ -357,7 +423,53 @@ class ShakingForce(_Dynamic):
         return [_cycle(problem, m).peak(lambda d: np.hypot(*d.shaking_force.T)).theta2], []
 
 
-for _c in (PeakTorque(), RmsTorque(), ShakingForce()):
+class PeakBearingForce(_Dynamic):
+    """The largest force a bearing carries over the turn at constant omega2 (N): every pin and every block or pin
+    in a slot, or one named joint (``PeakBearingForce("O2")``, registered as ``peak_bearing_force_O2``)."""
+
+    unit, label, slider_only = "N", "peak bearing force", True
+
+    def __init__(self, joint: str | None = None):
+        self.joint = joint
+        self.name = "peak_bearing_force" + (f"_{joint}" if joint else "")
+        self.label = "peak bearing force" + (f" at {joint}" if joint else "")
+
+    def _peak(self, problem, m):
+        def worst(d):
+            keys = [k for k in d.joint_forces if k != "slide" and (self.joint is None or k == self.joint)]
+            if not keys:
+                raise InvalidParameter(f"{type(m).__name__} has no joint {self.joint!r}: {sorted(d.joint_forces)}")
+            return np.max([np.hypot(*d.joint_forces[k].T) for k in keys], axis=0)
+
+        return _cycle(problem, m).peak(worst)
+
+    def value(self, problem, m):
+        return self._peak(problem, m).value
+
+    def to_nlp(self, v, omega2):
+        return v * v
+
+    def from_nlp(self, y, omega2):
+        return math.sqrt(max(y, 0.0))
+
+    def epigraph(self, f):
+        s = _symbolic(f)
+        exprs = []
+        for out in f.sampled:
+            loads = s.bearing_loads(out)
+            exprs += [v for k, v in loads.items() if self.joint is None or k == self.joint]
+        return [(f"peak {self.label}^2", exprs)]
+
+    def exchange(self, f, problem, m, z, value_nlp, gap_tol):
+        p = self._peak(problem, m)
+        gap = (p.value**2 - z[0]) / max(1.0, p.value**2)
+        return Exchange(self.from_nlp(z[0], 1.0), p.value, gap, [p.theta2] if gap > gap_tol else [], [])
+
+    def exceeded(self, problem, m):
+        return [self._peak(problem, m).theta2], []
+
+
+for _c in (PeakTorque(), RmsTorque(), ShakingForce(), PeakBearingForce()):
     register(_c)
 
-__all__ = ["PeakTorque", "RmsTorque", "ShakingForce"]
+__all__ = ["PeakTorque", "RmsTorque", "ShakingForce", "PeakBearingForce"]
