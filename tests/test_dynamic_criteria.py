@@ -18,55 +18,59 @@ LOADS = qropt.Loads(1000.0, gravity=9.81)
 KINDS = ("slider-crank", "crank-shaper", "whitworth", "crank-rocker-slider", "drag-link-slider", "coupler-slider")
 
 
+def _at_random_design(kind, objective, seed):
+    """A problem of a random design's own targets (free parameters around it), its Formulation, and the NLP point
+    and parameters at that design with n sample angles: (p, m, f, w, pv, th, params)."""
+    params, m = random_mechanisms(kind, 1, seed=seed)[0]
+    kinds = type(m).kinds()
+    free = [k for k in kinds if kinds[k] != "branch" and k in params]
+    p = qropt.Problem(
+        type(m),
+        fixed={k: v for k, v in params.items() if k not in free},
+        free={k: (v - 1e-3 if kinds[k] != "length" else v / 2, v + 1) for k, v in params.items() if k in free},
+        targets={"time_ratio": m.time_ratio(), "stroke": m.stroke()},
+        objective=objective,
+        masses=MASSES,
+        loads=LOADS,
+        omega2=7.0,
+        conditions={"grashof": m.grashof().kind} if type(m).FOUR_BAR else {},
+    )
+    branch = {k: v[0] for k, v in p.branches.items()}
+    m = p.build({k: params[k] for k in free}, branch)
+    a, _ = m.stroke_angles()
+    f = Formulation(p, branch, 1 if a >= 2 * np.pi - a else -1)
+    d = m.dead_centres()
+    w = f.w_blocks.join(free=[params[k] for k in f.free], theta=[d.theta_max, d.theta_max + a])  # the NLP's span
+    n = f.p_blocks.sizes["samples"]
+    th = np.linspace(0.1, 6.0, n)
+    pv = f.p_blocks.join(
+        fixed=[p.fixed[k] for k in f.fixed],
+        targets=[p.targets[k] for k in f.targets],
+        samples=th,
+        fractions=np.linspace(0, 1, n),
+    )
+    return p, m, f, w, pv, th, params
+
+
 @pytest.mark.parametrize("kind", [*KINDS, "slot-ram-shaper"])
 @pytest.mark.parametrize("objective", ["min_peak_torque", "min_shaking_force", "min_rms_torque"])
 def test_the_nlp_states_the_exact_dynamics_at_any_design(kind, objective):
     """The NLP's expressions (torque at sample angles, shaking force squared, the RMS torque's Gauss quadrature
     over strokes that move with the dead centres), evaluated at random designs, against the exact analysis."""
-    for params, m in random_mechanisms(kind, 2, seed=11):
-        free = [k for k in type(m).kinds() if type(m).kinds()[k] != "branch" and k in params]
-        fixed = {k: v for k, v in params.items() if k not in free}
-        p = qropt.Problem(
-            type(m),
-            fixed=fixed,
-            free={
-                k: (v - 1e-3 if type(m).kinds()[k] != "length" else v / 2, v + 1)
-                for k, v in params.items()
-                if k in free
-            },
-            targets={"time_ratio": m.time_ratio(), "stroke": m.stroke()},
-            objective=objective,
-            masses=MASSES,
-            loads=LOADS,
-            omega2=7.0,
-            conditions={"grashof": m.grashof().kind} if type(m).FOUR_BAR else {},
-        )
-        m = p.build({k: params[k] for k in free}, {k: v[0] for k, v in p.branches.items()})
-        a, b = m.stroke_angles()
-        f = Formulation(p, {k: v[0] for k, v in p.branches.items()}, 1 if a >= b else -1)
-        d = m.dead_centres()
-        w = f.w_blocks.join(free=[params[k] for k in f.free], theta=[d.theta_max, d.theta_max + a])  # the NLP's span
-        n = f.p_blocks.sizes["samples"]
-        th = np.linspace(0.1, 6.0, n)
-        pv = f.p_blocks.join(
-            fixed=[p.fixed[k] for k in f.fixed],
-            targets=[p.targets[k] for k in f.targets],
-            samples=th,
-            fractions=np.linspace(0, 1, n),
-        )
+    for seed in (11, 12):
+        p, m, f, w, pv, th, params = _at_random_design(kind, objective, seed)
+        n = th.size
         c = criteria.of(objective)
         exact = m.dynamics(th, 7.0, masses=MASSES, loads=LOADS)
+        e = np.array(f.epi_fun(w, pv)).ravel()
         if objective == "min_rms_torque":
             import casadi
 
-            e = np.array(f.epi_fun(w, pv)).ravel()[: f.epi_index.size]  # a kinked bar's length: its largest reach
-            z = [e[f.epi_index == i].max() for i in range(f.w_blocks.sizes["z"])]
-            w = f.w_blocks.join(free=[params[k] for k in f.free], theta=[d.theta_max, d.theta_max + a], z=z)
+            z = [e[: f.epi_index.size][f.epi_index == i].max() for i in range(f.w_blocks.sizes["z"])]  # a bar's reach
+            w = f.w_blocks.join(free=[params[k] for k in f.free], theta=f.w_blocks.split(w)["theta"], z=z)
             value = float(casadi.Function("f", [f.w_sym, f.p_sym], [f.f_sym])(w, pv))
             assert c.from_nlp(value, 7.0) == pytest.approx(c.value(p, m), rel=1e-9)
-            continue
-        e = np.array(f.epi_fun(w, pv)).ravel()
-        if objective == "min_peak_torque":
+        elif objective == "min_peak_torque":
             assert e[0 : 2 * n : 2] == pytest.approx(exact.torque, rel=1e-9, abs=1e-9 * np.abs(exact.torque).max())
         else:
             s2 = np.sum(exact.shaking_force**2, axis=1)
@@ -78,35 +82,8 @@ def test_the_nlp_solves_the_newton_euler_system_of_any_design(kind):
     """The bearing loads the NLP states at its samples (the Newton-Euler system assembled by the same code as the
     exact analysis and solved symbolically) are the exact joint forces' squares, at a random design of every
     type."""
-    params, m = random_mechanisms(kind, 1, seed=3)[0]
-    free = [k for k, kind_ in type(m).kinds().items() if kind_ != "branch" and k in params]
-    p = qropt.Problem(
-        type(m),
-        fixed={k: v for k, v in params.items() if k not in free},
-        free={
-            k: (v - 1e-3 if type(m).kinds()[k] != "length" else v / 2, v + 1) for k, v in params.items() if k in free
-        },
-        targets={"time_ratio": m.time_ratio(), "stroke": m.stroke()},
-        objective="min_peak_bearing_force",
-        masses=MASSES,
-        loads=LOADS,
-        omega2=7.0,
-        conditions={"grashof": m.grashof().kind} if type(m).FOUR_BAR else {},
-    )
-    branch = {k: v[0] for k, v in p.branches.items()}
-    m = p.build({k: params[k] for k in free}, branch)
-    a, b = m.stroke_angles()
-    f = Formulation(p, branch, 1 if a >= b else -1)
-    d = m.dead_centres()
-    w = f.w_blocks.join(free=[params[k] for k in f.free], theta=[d.theta_max, d.theta_max + a])
-    n = f.p_blocks.sizes["samples"]
-    th = np.linspace(0.1, 6.0, n)
-    pv = f.p_blocks.join(
-        fixed=[p.fixed[k] for k in f.fixed],
-        targets=[p.targets[k] for k in f.targets],
-        samples=th,
-        fractions=np.linspace(0, 1, n),
-    )
+    _, m, f, w, pv, th, _ = _at_random_design(kind, "min_peak_bearing_force", 3)
+    n = th.size
     exact = m.dynamics(th, 7.0, masses=MASSES, loads=LOADS).joint_forces
     keys = [k for k in exact if k != "slide"]
     want = np.array([[np.sum(exact[k][i] ** 2) for k in keys] for i in range(n)])

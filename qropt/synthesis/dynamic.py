@@ -292,6 +292,16 @@ class _Dynamic(Criterion):
         return y
 
 
+class _Squared(_Dynamic):
+    """A criterion the NLP states squared (a force's magnitude: smooth where the magnitude's root is not)."""
+
+    def to_nlp(self, v, omega2):
+        return v * v
+
+    def from_nlp(self, y, omega2):
+        return math.sqrt(max(y, 0.0))
+
+
 class PeakTorque(_Dynamic):
     """The largest |crank torque| over the turn at constant omega2 (N m)."""
 
@@ -339,20 +349,14 @@ def _nodes():
     return GAUSS_NODES
 
 
-class RmsTorque(_Dynamic):
+class RmsTorque(_Squared):
     """The root mean square of the crank torque over the turn at constant omega2 (N m): a quadrature, the same
-    Gauss-Legendre rule on each stroke in the NLP as in the exact value."""
+    Gauss-Legendre rule on each stroke in the NLP as in the exact value; the NLP states the mean square."""
 
     name, unit, label = "rms_torque", "N m", "RMS crank torque"
 
     def value(self, problem, m):
         return math.sqrt(_cycle(problem, m).quadrature(lambda d: d.torque**2) / TWO_PI)
-
-    def to_nlp(self, v, omega2):  # the NLP states the mean square (smooth where the RMS's root is not)
-        return v * v
-
-    def from_nlp(self, y, omega2):
-        return math.sqrt(max(y, 0.0))
 
     def epigraph(self, f):  # a kinked bar's length: a variable above each of its reaches (smooth where they cross),
         # capped by their largest in ``measure`` (a row that binds only where a longer bar would lower the torque)
@@ -382,19 +386,13 @@ class RmsTorque(_Dynamic):
         return Exchange(nlp, exact, gap, [], [])
 
 
-class ShakingForce(_Dynamic):
+class ShakingForce(_Squared):
     """The largest shaking force |sum(m a_G)| over the turn at constant omega2 (N); the NLP bounds its square."""
 
     name, unit, label = "shaking_force", "N", "peak shaking force"
 
     def value(self, problem, m):
         return _cycle(problem, m).peak(lambda d: np.hypot(*d.shaking_force.T)).value
-
-    def to_nlp(self, v, omega2):
-        return v * v
-
-    def from_nlp(self, y, omega2):
-        return math.sqrt(max(y, 0.0))
 
     def epigraph(self, f):
         s = _symbolic(f)
@@ -423,7 +421,7 @@ class ShakingForce(_Dynamic):
         return [_cycle(problem, m).peak(lambda d: np.hypot(*d.shaking_force.T)).theta2], []
 
 
-class PeakBearingForce(_Dynamic):
+class PeakBearingForce(_Squared):
     """The largest force a bearing carries over the turn at constant omega2 (N): every pin and every block or pin
     in a slot, or one named joint (``PeakBearingForce("O2")``, registered as ``peak_bearing_force_O2``)."""
 
@@ -445,12 +443,6 @@ class PeakBearingForce(_Dynamic):
 
     def value(self, problem, m):
         return self._peak(problem, m).value
-
-    def to_nlp(self, v, omega2):
-        return v * v
-
-    def from_nlp(self, y, omega2):
-        return math.sqrt(max(y, 0.0))
 
     def epigraph(self, f):
         s = _symbolic(f)
