@@ -15,7 +15,6 @@ import pytest
 import qropt
 from qropt.kinematics.closures import (
     RIGHT_ANGLE,
-    circle_circle,
     joint_lines,
     on_ray,
     pin_in_slot,
@@ -28,6 +27,7 @@ from qropt.kinematics.closures import (
 from qropt.kinematics.ops import CASADI, JET, NUMPY, Jet
 from qropt.mechanisms.base import Body, Loop
 from qropt.mechanisms.builder import Linkage, LinkageError
+from qropt.mechanisms.four_bar import four_bar as four_bar_closure  # the four-bar the hand-written loops used
 from tests import randmech
 from tests.test_sixbars import _coupler_designs, _slot_ram_designs
 
@@ -80,17 +80,8 @@ def ref_whitworth(xp, theta2, p):
     )
 
 
-def ref_four_bar_closure(xp, theta2, p):
-    """The driving four-bar: (A, O4, B, theta3, theta4, margin) on branch p['sigma']."""
-    o4 = (p["r1"], 0.0)
-    a = (p["r2"] * xp.cos(theta2), p["r2"] * xp.sin(theta2))
-    b, theta4, m = circle_circle(xp, a, p["r3"], o4, p["r4"], p["sigma"], around=math.pi)
-    theta3 = xp.atan2(b[1] - a[1], b[0] - a[0])
-    return a, o4, b, theta3, theta4, m
-
-
 def ref_four_bar(xp, theta2, p):
-    a, o4, b, theta3, theta4, m = ref_four_bar_closure(xp, theta2, p)
+    a, o4, b, theta3, theta4, m = four_bar_closure(xp, theta2, p)
     return Loop(
         points={"O2": (0.0, 0.0), "A": a, "B": b, "O4": o4},
         angles={"theta2": theta2, "theta3": theta3, "theta4": theta4},
@@ -100,41 +91,34 @@ def ref_four_bar(xp, theta2, p):
     )
 
 
-def ref_four_bar_slider(xp, theta2, p):
-    a, o4, b, theta3, theta4, m4 = ref_four_bar_closure(xp, theta2, p)
-    c = on_ray(xp, o4, theta4, p["r5"])
-    d, m6 = rod_to_line(xp, c, p["r6"], p["h"], p["sigma_slider"])
+def _ref_rod_after_four_bar(xp, theta2, p, pin_name, pin_of):
+    """The four-bar, then a rod from the pin ``pin_of(a, o4, theta3, theta4)`` (named pin_name) to the ram D."""
+    a, o4, b, theta3, theta4, m4 = four_bar_closure(xp, theta2, p)
+    pin = pin_of(a, o4, theta3, theta4)
+    d, m6 = rod_to_line(xp, pin, p["r6"], p["h"], p["sigma_slider"])
     return Loop(
-        points={"O2": (0.0, 0.0), "A": a, "B": b, "O4": o4, "C": c, "D": d},
+        points={"O2": (0.0, 0.0), "A": a, "B": b, "O4": o4, pin_name: pin, "D": d},
         angles={
             "theta2": theta2,
             "theta3": theta3,
             "theta4": theta4,
-            "theta6": xp.atan2(d[1] - c[1], d[0] - c[0]),
+            "theta6": xp.atan2(d[1] - pin[1], d[0] - pin[0]),
         },
         x=d[0],
-        transmission={"B": joint_lines(a, o4, b), "D": rod_lines(c, d)},
-        margins=[("four-bar closure at B", m4), ("rod CD reaching the slide line", m6)],
+        transmission={"B": joint_lines(a, o4, b), "D": rod_lines(pin, d)},
+        margins=[("four-bar closure at B", m4), (f"rod {pin_name}D reaching the slide line", m6)],
     )
+
+
+def ref_four_bar_slider(xp, theta2, p):
+    return _ref_rod_after_four_bar(xp, theta2, p, "C", lambda a, o4, t3, t4: on_ray(xp, o4, t4, p["r5"]))
 
 
 def ref_coupler_slider(xp, theta2, p):
-    a, o4, b, theta3, theta4, m4 = ref_four_bar_closure(xp, theta2, p)
-    phi = theta3 + p["beta"]
-    pp = (a[0] + p["r5"] * xp.cos(phi), a[1] + p["r5"] * xp.sin(phi))
-    d, m6 = rod_to_line(xp, pp, p["r6"], p["h"], p["sigma_slider"])
-    return Loop(
-        points={"O2": (0.0, 0.0), "A": a, "B": b, "O4": o4, "P": pp, "D": d},
-        angles={
-            "theta2": theta2,
-            "theta3": theta3,
-            "theta4": theta4,
-            "theta6": xp.atan2(d[1] - pp[1], d[0] - pp[0]),
-        },
-        x=d[0],
-        transmission={"B": joint_lines(a, o4, b), "D": rod_lines(pp, d)},
-        margins=[("four-bar closure at B", m4), ("rod PD reaching the slide line", m6)],
-    )
+    def coupler_point(a, o4, t3, t4):
+        return (a[0] + p["r5"] * xp.cos(t3 + p["beta"]), a[1] + p["r5"] * xp.sin(t3 + p["beta"]))
+
+    return _ref_rod_after_four_bar(xp, theta2, p, "P", coupler_point)
 
 
 def ref_slot_ram_shaper(xp, theta2, p):
