@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from qropt import units as units_
-from qropt.dynamics.model import BodyMass, Loads, Masses
+from qropt.dynamics.model import BodyMass, Loads, Masses, slender_bar, union
 from qropt.errors import DegenerateMechanism, InvalidParameter
 from qropt.kinematics.ops import JET, Jet
 
@@ -66,6 +66,20 @@ def _parts(j, shape) -> np.ndarray:
     return out
 
 
+def _com_motion(b, bm, pts, shape, k):
+    """Body b's centre of mass from the loop's jets (``pts``: joint -> (x, y) jets), in metres (k: metres per
+    the mechanism's unit): its position, velocity and acceleration (each (x, y)) and the (3, n) jet of the body's
+    angle. r_G = o + R(phi) c: velocity o' + phi' J R c, acceleration o'' + phi'' J R c - phi'^2 R c."""
+    origin, phi = _frame(b, pts)
+    ph = _parts(phi, shape)
+    ox, oy = (_parts(c, shape) * k for c in origin)
+    c, sn = np.cos(ph[0]), np.sin(ph[0])
+    rx, ry = c * bm.com[0] - sn * bm.com[1], sn * bm.com[0] + c * bm.com[1]
+    v = (ox[1] - ph[1] * ry, oy[1] + ph[1] * rx)
+    a = (ox[2] - ph[2] * ry - ph[1] ** 2 * rx, oy[2] + ph[2] * rx - ph[1] ** 2 * ry)
+    return (ox[0] + rx, oy[0] + ry), v, a, ph
+
+
 def linkage_of(m):
     """The builder linkage of a mechanism (InvalidParameter for a hand-written loop)."""
     link = type(m).linkage(m.params)
@@ -77,7 +91,7 @@ def linkage_of(m):
     return link
 
 
-def _frame(body, pts, kind_angle):
+def _frame(body, pts):
     """(origin (x, y) jets, angle jet) of a body's frame: origin at its first joint, x along the body."""
     first = pts[body.joints[0]]
     if body.kind in ("ram",):
@@ -117,7 +131,7 @@ def body_masses(m, masses: Masses) -> dict[str, BodyMass]:
             bars = [k * reach(b.joints[0], j) for j in b.joints[1:]]
             if b.kind != "plate":
                 bars = [max(bars)]
-            bm = _bars(b, bars, m, k, masses.density)
+            bm = _bars(b, bars, m, masses.density)
         if b.name == "crank" and masses.counterweight is not None and masses.counterweight.mass > 0:
             cw = masses.counterweight
             bm = _combined(bm, BodyMass(cw.mass, (cw.radius * math.cos(cw.angle), cw.radius * math.sin(cw.angle))))
@@ -155,39 +169,27 @@ def _reaches(m, t):
     return reach
 
 
-def _bars(body, lengths, m, k, density) -> BodyMass:
+def _bars(body, lengths, m, density) -> BodyMass:
     """Uniform slender bars from the body's first joint along each other joint's direction (the body frame's
     x-axis for the first; a plate's other bars at their angle in the frame)."""
     if body.kind != "plate":
-        L = lengths[0]
-        mass = density * L
-        return BodyMass(mass, (L / 2, 0.0), mass * L * L / 12)
+        return BodyMass(*slender_bar(density, lengths[0]))
     pos = m.positions(np.array([0.0])).points
     o = pos[body.joints[0]][0]
     x_dir = pos[body.joints[1]][0] - o
     phi = math.atan2(x_dir[1], x_dir[0])
-    parts = []
+    out = None
     for j, L in zip(body.joints[1:], lengths, strict=True):
         d = pos[j][0] - o
         a = math.atan2(d[1], d[0]) - phi
-        mass = density * L
-        parts.append(BodyMass(mass, (L / 2 * math.cos(a), L / 2 * math.sin(a)), mass * L * L / 12))
-    out = parts[0]
-    for p in parts[1:]:
-        out = _combined(out, p)
-    return out
+        part = slender_bar(density, L, math.cos(a), math.sin(a))
+        out = part if out is None else union(out, part)
+    return BodyMass(*out)
 
 
 def _combined(a: BodyMass, b: BodyMass) -> BodyMass:
     """Two rigid parts in one frame as one body (parallel axes)."""
-    mass = a.mass + b.mass
-    if mass == 0:
-        return BodyMass(0.0)
-    com = tuple((a.mass * ca + b.mass * cb) / mass for ca, cb in zip(a.com, b.com, strict=True))
-    inertia = a.inertia + b.inertia
-    inertia += a.mass * ((a.com[0] - com[0]) ** 2 + (a.com[1] - com[1]) ** 2)
-    inertia += b.mass * ((b.com[0] - com[0]) ** 2 + (b.com[1] - com[1]) ** 2)
-    return BodyMass(mass, com, inertia)
+    return BodyMass(*union((a.mass, a.com, a.inertia), (b.mass, b.com, b.inertia)))
 
 
 class _System:
@@ -345,18 +347,7 @@ def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
     kin = {}
     for b in s.bodies:
         bm = s.props[b.name]
-        origin, phi = _frame(b, pts, None)
-        ph = _parts(phi, shape)
-        ox, oy = (_parts(c, shape) * k for c in origin)
-        c, sn = np.cos(ph[0]), np.sin(ph[0])
-        cx, cy = bm.com
-        gx = ox[0] + c * cx - sn * cy
-        gy = oy[0] + sn * cx + c * cy
-        # r_G = o + R(phi) c: velocity o' + phi' J R c, acceleration o'' + phi'' J R c - phi'^2 R c
-        rx, ry = c * cx - sn * cy, sn * cx + c * cy
-        vx, vy = ox[1] - ph[1] * ry, oy[1] + ph[1] * rx
-        ax = ox[2] - ph[2] * ry - ph[1] ** 2 * rx
-        ay = oy[2] + ph[2] * rx - ph[1] ** 2 * ry
+        (gx, gy), (vx, vy), (ax, ay), ph = _com_motion(b, bm, pts, shape, k)
         kin[b.name] = (np.stack([gx, gy], -1), np.stack([vx, vy], -1), np.stack([ax, ay], -1), ph[1], ph[2], bm)
     entries, rows = s.assemble(
         {j: (p[:, 0], p[:, 1]) for j, p in P.items()},
@@ -461,14 +452,7 @@ def generalised(m, theta2, *, masses=None, loads=None, sense: float = 1.0) -> Ge
     Q = np.zeros(t.shape)
     for b in s.bodies:
         bm = s.props[b.name]
-        origin, phi = _frame(b, pts, None)
-        ph = _parts(phi, t.shape)
-        ox, oy = (_parts(c, t.shape) * k for c in origin)
-        c, sn = np.cos(ph[0]), np.sin(ph[0])
-        rx, ry = c * bm.com[0] - sn * bm.com[1], sn * bm.com[0] + c * bm.com[1]
-        vx, vy = ox[1] - ph[1] * ry, oy[1] + ph[1] * rx  # dr_G/dtheta2
-        ax = ox[2] - ph[2] * ry - ph[1] ** 2 * rx
-        ay = oy[2] + ph[2] * rx - ph[1] ** 2 * ry
+        _, (vx, vy), (ax, ay), ph = _com_motion(b, bm, pts, t.shape, k)  # per unit theta2 (seeded 1, 0)
         M += bm.mass * (vx * vx + vy * vy) + bm.inertia * ph[1] ** 2
         dM += 2 * (bm.mass * (vx * ax + vy * ay) + bm.inertia * ph[1] * ph[2])
         Q += bm.mass * loads.gravity * vy

@@ -144,6 +144,25 @@ class Masses:
 STEEL = 7850.0  # kg/m^3
 
 
+def slender_bar(density, length, ux=1.0, uy=0.0) -> tuple:
+    """A uniform slender bar from its body frame's origin along the unit vector (ux, uy): (mass, (cx, cy),
+    inertia about its centre) = (rho L, L/2 (ux, uy), m L^2 / 12). Numbers or CasADi expressions alike."""
+    mass = density * length
+    return (mass, (length / 2 * ux, length / 2 * uy), mass * length * length / 12)
+
+
+def union(a: tuple, b: tuple) -> tuple:
+    """Two rigid parts (mass, (cx, cy), inertia) in one body frame as one body (parallel axes); numbers or CasADi
+    expressions alike (two massless numbers give a massless part at the origin)."""
+    (ma, ca, ia), (mb, cb, ib) = a, b
+    mass = ma + mb
+    if isinstance(mass, (int, float)) and mass == 0:
+        return (0.0, (0.0, 0.0), 0.0)
+    cx, cy = (ma * ca[0] + mb * cb[0]) / mass, (ma * ca[1] + mb * cb[1]) / mass
+    inertia = ia + ib + ma * ((ca[0] - cx) ** 2 + (ca[1] - cy) ** 2) + mb * ((cb[0] - cx) ** 2 + (cb[1] - cy) ** 2)
+    return (mass, (cx, cy), inertia)
+
+
 @dataclass(frozen=True)
 class Loads:
     """What the mechanism works against. ``cutting_force`` (N) resists the ram's motion on the working (slow)
@@ -200,4 +219,4 @@ class Loads:
         return cls(**d)
 
 
-__all__ = ["BodyMass", "Counterweight", "Masses", "Loads", "STEEL"]
+__all__ = ["BodyMass", "Counterweight", "Masses", "Loads", "STEEL", "slender_bar", "union"]

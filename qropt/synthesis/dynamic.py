@@ -18,6 +18,7 @@ import casadi
 import numpy as np
 
 from qropt import units as units_
+from qropt.dynamics.model import slender_bar, union
 from qropt.errors import InvalidParameter
 from qropt.synthesis.criteria import Criterion, Exchange, register
 
@@ -86,7 +87,7 @@ class _Symbolic:
             if b.name == "crank" and masses.counterweight is not None and masses.counterweight.mass > 0:
                 cw = masses.counterweight
                 point = (cw.mass, (cw.radius * math.cos(cw.angle), cw.radius * math.sin(cw.angle)), 0.0)
-                model = _union(model, point)
+                model = union(model, point)
             out_models[b.name] = model
         return out_models
 
@@ -119,18 +120,15 @@ class _Symbolic:
             L = reaches[0]
             for r in reaches[1:]:
                 L = casadi.fmax(L, r)
-            L = L if length is None else length
-            m = density * L
-            return (m, (L / 2, 0.0), m * L * L / 12)
+            return slender_bar(density, L if length is None else length)
         (ox, oy), (sx, sy) = self.point(out, b.joints[0]), self.point(out, b.joints[1])
         phi = casadi.atan2(sy - oy, sx - ox)
         model = None
         for j, L in zip(b.joints[1:], reaches, strict=True):
             jx, jy = self.point(out, j)
             a = casadi.atan2(jy - oy, jx - ox) - phi
-            m = density * L
-            part = (m, (L / 2 * casadi.cos(a), L / 2 * casadi.sin(a)), m * L * L / 12)
-            model = part if model is None else _union(model, part)
+            part = slender_bar(density, L, casadi.cos(a), casadi.sin(a))
+            model = part if model is None else union(model, part)
         return model
 
     def kinematics(self, out, b, com):
@@ -256,15 +254,6 @@ class _Symbolic:
             _, a, _, _ = self.kinematics(out, b, com)
             sx, sy = sx + m * a[0] * w2, sy + m * a[1] * w2
         return sx * sx + sy * sy
-
-
-def _union(a, b):
-    (ma, ca, ia), (mb, cb, ib) = a, b
-    m = ma + mb
-    cx = (ma * ca[0] + mb * cb[0]) / m
-    cy = (ma * ca[1] + mb * cb[1]) / m
-    inertia = ia + ib + ma * ((ca[0] - cx) ** 2 + (ca[1] - cy) ** 2) + mb * ((cb[0] - cx) ** 2 + (cb[1] - cy) ** 2)
-    return (m, (cx, cy), inertia)
 
 
 def _symbolic(f) -> _Symbolic:
