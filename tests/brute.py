@@ -112,13 +112,18 @@ def _transmissions(kind, p, th):
 
 def gamma_min(kind, p):
     """Smallest transmission angle: grid minimum refined by bounded Brent in the neighbouring cells."""
+    return _least_transmission(lambda th: _transmissions(kind, p, th))
+
+
+def _least_transmission(angles) -> float:
+    """The smallest of every joint's transmission angle (``angles(th)``: joint -> array) over the turn: each
+    joint's grid minimum refined by bounded Brent in the neighbouring cells; pi/2 without a joint."""
     best = np.pi / 2
-    for name in _transmissions(kind, p, TH[:1]):
-        g = _transmissions(kind, p, TH)[name]
+    h = 2 * np.pi / N
+    for name, g in angles(TH).items():
         i = int(np.argmin(g))
-        h = 2 * np.pi / N
         r = minimize_scalar(
-            lambda t, n=name: float(_transmissions(kind, p, np.array([t]))[n][0]),
+            lambda t, n=name: float(angles(np.array([t]))[n][0]),
             bounds=(TH[i] - h, TH[i] + h),
             method="bounded",
             options={"xatol": 1e-13},
@@ -193,16 +198,7 @@ def sixbar_cycle(kind, p):
         t = brentq(dx, TH[i] - h, TH[i] + h, xtol=1e-15)
         ext.append((t % (2 * np.pi), float(sixbar_x(kind, p, t))))
     (t_max, x_max), (t_min, x_min) = ext
-    best = np.pi / 2
-    for name, g in sixbar_transmissions(kind, p, TH).items():
-        i = int(np.argmin(g))
-        r = minimize_scalar(
-            lambda t, n=name: float(sixbar_transmissions(kind, p, np.array([t]))[n][0]),
-            bounds=(TH[i] - h, TH[i] + h),
-            method="bounded",
-            options={"xatol": 1e-13},
-        )
-        best = min(best, float(r.fun), float(g[i]))
+    best = _least_transmission(lambda th: sixbar_transmissions(kind, p, th))
     return t_max, t_min, x_max, x_min, time_ratio(t_max, t_min), x_max - x_min, best
 
 
