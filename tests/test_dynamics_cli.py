@@ -57,6 +57,8 @@ def test_text_plot_and_csv(tmp_path, capsys):
         (["--force", "-5"], "cutting_force"),
         (["--cs", "3"], "cs"),
         (["--omega2", "0"], "omega2"),
+        (["--counterweight", "5", "x", "180deg"], "not a number"),
+        (["--counterweight", "-5", "0.1", "180deg"], "counterweight's mass"),
     ],
 )
 def test_bad_dynamics_input_is_one_line(extra, words, capsys):
@@ -91,3 +93,31 @@ def test_design_by_min_peak_torque_on_the_command_line(capsys):
     assert row["peak_torque"] == pytest.approx(m.dynamic_extremes(10.0, masses=masses, loads=loads).peak_torque.value)
     assert cli.main(argv) != 0  # no masses and no loads: a one-line reason
     assert "needs masses or loads" in capsys.readouterr().err
+
+
+def test_a_counterweight_on_the_command_line_is_the_librarys(capsys):
+    assert cli.main([*ARGS, "--counterweight", "5", "0.1", "180deg", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    m = paper_mechanism()
+    masses = qropt.Masses.bars(1.57, 20.0, counterweight=qropt.Counterweight(5.0, 0.1, math.pi))
+    ex = m.dynamic_extremes(10.0, masses=masses, loads=qropt.Loads(1000.0))
+    assert out["peak_forces"]["O2"]["value"] == pytest.approx(ex.peak_forces["O2"].value, rel=1e-12)
+    assert out["peak_forces"]["O2"]["value"] != pytest.approx(_library()[3].peak_forces["O2"].value, rel=1e-3)
+
+
+def test_design_balances_with_a_free_counterweight_on_the_command_line(capsys):
+    """--balance leaves each row's counterweight to the solve; the row's shaking force is the library's with the
+    counterweight its result chose, and lower than without one."""
+    argv = ["design", "--tr", "1.5", "--stroke", "0.3", "--types", "slider-crank", "--objective", "min_shaking_force"]
+    dyn = ["--density", "3.14", "--ram-mass", "20", "--force", "1000", "--omega2", "10", "--json"]
+    assert cli.main([*argv, *dyn, "--balance", "0.1", "30"]) == 0
+    row = json.loads(capsys.readouterr().out)["rows"][0]
+    assert cli.main([*argv, *dyn]) == 0
+    plain = json.loads(capsys.readouterr().out)["rows"][0]
+    cw = qropt.Counterweight(**row["counterweight"])
+    assert plain["counterweight"] is None
+    m = qropt.SliderCrank(**row["params"])
+    masses = qropt.Masses.bars(3.14, 20.0, counterweight=cw)
+    exact = m.dynamic_extremes(10.0, masses=masses, loads=qropt.Loads(1000.0)).peak_shaking_force.value
+    assert row["shaking_force"] == pytest.approx(exact, rel=1e-9)
+    assert row["shaking_force"] < 0.8 * plain["shaking_force"]

@@ -349,12 +349,16 @@ def dynamics(args, m) -> int:
     force and moment and the flywheel for --cs, at --omega2 (SI); --plot, --csv (the turn degree by degree) and
     --json as for the kinematics."""
     from qropt.dynamics.cycle import CycleDynamics
-    from qropt.dynamics.model import Loads, Masses
+    from qropt.dynamics.model import Counterweight, Loads, Masses
 
     try:
-        masses = Masses.bars(args.density, args.ram_mass, block=args.block_mass)
+        cw = None
+        if args.counterweight is not None:
+            mass, radius, at = args.counterweight
+            cw = Counterweight(real(mass), real(radius), angle(at))
+        masses = Masses.bars(args.density, args.ram_mass, block=args.block_mass, counterweight=cw)
         loads = Loads(args.force, friction=args.friction, gravity=args.gravity)
-    except QroptError as e:
+    except (QroptError, argparse.ArgumentTypeError) as e:
         raise CliError(str(e)) from None
     cd = CycleDynamics(m, args.omega2, args.alpha2, masses, loads)
     ex = cd.extremes()
@@ -381,7 +385,9 @@ def dynamics(args, m) -> int:
         print(
             f"{type(m).__name__} at omega2 = {args.omega2:g} rad/s, alpha2 = {args.alpha2:g} rad/s^2: links "
             f"{args.density:g} kg/m, ram {args.ram_mass:g} kg, cutting force {args.force:g} N, friction "
-            f"{args.friction:g}, gravity {args.gravity:g} m/s^2 (SI)"
+            f"{args.friction:g}, gravity {args.gravity:g} m/s^2"
+            + (f", counterweight {cw.mass:g} kg at {cw.radius:g} m, {math.degrees(cw.angle):g} deg" if cw else "")
+            + " (SI)"
         )
         at = math.degrees(ex.peak_torque.theta2)
         print(f"  peak torque     {ex.peak_torque.value:12.6g} N m at theta2 = {at:.2f} deg")
@@ -475,6 +481,12 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("--density", type=real, default=0.0, help="links as uniform bars of this many kg per metre")
     a.add_argument("--ram-mass", dest="ram_mass", type=real, default=0.0, help="the ram's mass, kg")
     a.add_argument("--block-mass", dest="block_mass", type=real, default=0.0, help="the crank-pin block's mass, kg")
+    a.add_argument(
+        "--counterweight",
+        nargs=3,
+        metavar=("MASS", "RADIUS", "ANGLE"),
+        help="a crank counterweight: MASS kg at RADIUS m, ANGLE from the crank pin (e.g. 180deg)",
+    )
     a.add_argument("--force", type=real, default=0.0, help="cutting force on the working stroke, N")
     a.add_argument("--friction", type=real, default=0.0, help="the slide's friction coefficient")
     a.add_argument("--gravity", type=real, default=0.0, help="gravity along -y, m/s^2 (e.g. 9.81)")

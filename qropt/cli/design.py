@@ -42,6 +42,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--ram-mass", dest="ram_mass", type=real, help="the ram's mass, kg (dynamics)")
     parser.add_argument("--force", type=real, help="cutting force on the working stroke, N (dynamics)")
     parser.add_argument("--gravity", type=real, help="gravity along -y, m/s^2 (dynamics)")
+    parser.add_argument(
+        "--balance",
+        nargs=2,
+        type=real,
+        metavar=("RADIUS", "MAX_MASS"),
+        help="a crank counterweight each solve chooses: at RADIUS m, up to MAX_MASS kg (dynamics)",
+    )
     parser.add_argument("--pareto", nargs=2, metavar=("A", "B"), help="also each type's front between two objectives")
     parser.add_argument("--n", type=int, default=12, help="front points per type with --pareto (default 12)")
     parser.add_argument("--csv", metavar="FILE", help="write the comparison table as CSV")
@@ -71,11 +78,13 @@ def conditions_of(args) -> dict:
 
 def dynamics_of(args) -> tuple:
     """(masses, loads) from the dynamics flags, each None where none of its flags is given."""
-    from qropt.dynamics.model import Loads, Masses
+    from qropt.dynamics.model import Counterweight, Loads, Masses
 
     masses = loads = None
-    if args.density is not None or args.ram_mass is not None:
-        masses = Masses.bars(args.density or 0.0, args.ram_mass or 0.0)
+    balance = getattr(args, "balance", None)
+    if args.density is not None or args.ram_mass is not None or balance:
+        cw = Counterweight.balancing(*balance) if balance else None
+        masses = Masses.bars(args.density or 0.0, args.ram_mass or 0.0, counterweight=cw)
     if args.force is not None or args.gravity is not None:
         loads = Loads(args.force or 0.0, gravity=args.gravity or 0.0)
     return masses, loads
@@ -141,6 +150,11 @@ def run(args) -> int:
                 f"  {r.type:20s} peak torque {c['peak_torque']:10.4g}  RMS torque {c['rms_torque']:10.4g}  "
                 f"peak shaking force {c['shaking_force']:10.4g}"
             )
+    for r in cmp.rows:
+        cw = r.result.counterweight if r.success else None
+        if cw is not None:
+            at = math.degrees(cw.angle)
+            print(f"  {r.type:20s} counterweight {cw.mass:.4g} kg at {cw.radius:g} m, {at:.1f} deg from the crank pin")
     print(f"  (T/F: peak crank torque per newton of cutting force, N {u} per N)")
     if args.csv:
         print(f"table written to {args.csv}")

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from qropt.dynamics.inverse import _solve, _System
+from qropt.dynamics.inverse import _solve, system_of
 from qropt.dynamics.model import Loads, Masses
 
 GRID = 720  # crank angles of the search grid
@@ -75,7 +75,7 @@ class CycleDynamics:
             raise InvalidParameter(f"loads is a qropt.Loads, got {type(self.loads).__name__}")
         if self.omega2 == 0.0 and _has_load(self.loads):
             raise InvalidParameter("omega2 must be nonzero with a cutting force or friction: they resist the motion")
-        self.system = _System(m, Masses() if masses is None else masses)
+        self.system = system_of(m, Masses() if masses is None else masses)
         d = m.dead_centres()
         a, _ = m.stroke_angles()
         self.pieces = [(d.theta_max, d.theta_max + a), (d.theta_max + a, d.theta_max + TWO_PI)]
@@ -110,6 +110,23 @@ class CycleDynamics:
         if best >= v[i]:
             return Peak(best, float(r.x % TWO_PI))
         return Peak(float(v[i]), float(t[i]))
+
+    def peaks(self, f, n: int) -> list[Peak]:
+        """The n largest local maxima of f(Dynamics) over the turn, largest first, each refined like ``peak``."""
+        t = np.linspace(0.0, TWO_PI, GRID, endpoint=False)
+        v = f(self.at(t))
+        h = TWO_PI / GRID
+        tops = [i for i in range(GRID) if v[i] >= v[i - 1] and v[i] >= v[(i + 1) % GRID]]
+        out = []
+        for i in sorted(tops, key=lambda i: -v[i])[:n]:
+            r = minimize_scalar(
+                lambda th: -float(f(self.at(th % TWO_PI))[0]),
+                bounds=(t[i] - h, t[i] + h),
+                method="bounded",
+                options={"xatol": 1e-12},
+            )
+            out.append(Peak(-float(r.fun), float(r.x % TWO_PI)) if -r.fun >= v[i] else Peak(float(v[i]), float(t[i])))
+        return out
 
     def extremes(self) -> DynamicExtremes:
         t = np.linspace(0.0, TWO_PI, GRID, endpoint=False)

@@ -63,19 +63,41 @@ class BodyMass:
 @dataclass(frozen=True)
 class Counterweight:
     """A point mass (kg) on the crank at ``radius`` (m) from O2, ``angle`` (rad) counter-clockwise from the
-    crank's direction O2->A (pi: opposite the pin)."""
+    crank's direction O2->A (pi: opposite the pin). ``free``: a solve chooses its mass (up to ``mass``) and its
+    angle (``Counterweight.balancing``); the chosen one is the Result's ``counterweight``."""
 
     mass: float
     radius: float
     angle: float = math.pi
+    free: bool = False
 
     def __post_init__(self):
         object.__setattr__(self, "mass", _real("the counterweight's mass", self.mass, nonneg=True))
         object.__setattr__(self, "radius", _real("the counterweight's radius", self.radius, nonneg=True))
         object.__setattr__(self, "angle", _real("the counterweight's angle", self.angle))
+        if not isinstance(self.free, bool):
+            raise InvalidParameter(f"the counterweight's free is true or false, got {self.free!r}")
+        if self.free and not (self.mass > 0 and self.radius > 0):
+            raise InvalidParameter(
+                "a free counterweight needs a positive largest mass and radius (Counterweight.balancing(radius, "
+                f"max_mass)), got mass {self.mass:g} kg at radius {self.radius:g} m"
+            )
+
+    @classmethod
+    def balancing(cls, radius: float, max_mass: float) -> Counterweight:
+        """A counterweight a solve chooses: any mass up to ``max_mass`` (kg), at any angle, at ``radius`` (m)."""
+        return cls(max_mass, radius, math.pi, True)
+
+    def start(self) -> Counterweight:
+        """Where a solve starts a free counterweight: half its largest mass, opposite the pin (a fixed one: itself)."""
+        return Counterweight(self.mass / 2, self.radius, math.pi) if self.free else self
+
+    def with_moment(self, mx: float, my: float) -> Counterweight:
+        """The fixed counterweight of first moment (mx, my) kg m in the crank's frame, at this radius."""
+        return Counterweight(math.hypot(mx, my) / self.radius, self.radius, math.atan2(my, mx))
 
     def to_dict(self) -> dict:
-        return {"mass": self.mass, "radius": self.radius, "angle": self.angle}
+        return {"mass": self.mass, "radius": self.radius, "angle": self.angle} | ({"free": True} if self.free else {})
 
 
 @dataclass(frozen=True)
@@ -105,8 +127,8 @@ class Masses:
         object.__setattr__(self, "bodies", bodies)
         cw = self.counterweight
         if cw is not None and not isinstance(cw, Counterweight):
-            if not isinstance(cw, dict) or set(cw) - {"mass", "radius", "angle"}:
-                raise InvalidParameter(f"counterweight is a Counterweight or {{mass, radius, angle}}, got {cw!r}")
+            if not isinstance(cw, dict) or set(cw) - {"mass", "radius", "angle", "free"}:
+                raise InvalidParameter(f"counterweight is a Counterweight or {{mass, radius, angle, free}}, got {cw!r}")
             object.__setattr__(self, "counterweight", Counterweight(**cw))
 
     @classmethod
@@ -121,6 +143,15 @@ class Masses:
 
     def replace(self, **kw) -> Masses:
         return Masses(**{**self.__dict__, **kw})
+
+    @property
+    def balancing(self) -> bool:
+        """Whether a solve chooses the counterweight (``Counterweight.balancing``)."""
+        return self.counterweight is not None and self.counterweight.free
+
+    def started(self) -> Masses:
+        """These masses with a free counterweight at its start (the masses themselves otherwise)."""
+        return self.replace(counterweight=self.counterweight.start()) if self.balancing else self
 
     def to_dict(self) -> dict:
         return {

@@ -124,10 +124,13 @@ class Row:
         return self.result.status in SOLUTION_PRESENT
 
     def record(self) -> dict:
-        """Flat, JSON-ready: type, status, objective, each criterion, the parameters, the reason."""
+        """Flat, JSON-ready: type, status, objective, each criterion, the parameters, the counterweight the solve
+        chose (where the problem left it free; else None), the reason."""
         d = {"type": self.type, "status": self.result.status, "objective": self.result.objective}
         d |= {k: self.criteria.get(k) for k in columns()}
         d["params"] = dict(self.result.params)
+        cw = self.result.counterweight
+        d["counterweight"] = None if cw is None else cw.to_dict()
         d["reason"] = self.reason
         return d
 
@@ -205,8 +208,10 @@ class Comparison:
         names = sorted({k for r in rows for k in r["params"]})
         with open(path, "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["type", "status", "objective", *columns(), *names, "reason", "units"])
+            cw = ["counterweight_kg", "counterweight_radius_m", "counterweight_angle_rad"]
+            w.writerow(["type", "status", "objective", *columns(), *names, *cw, "reason", "units"])
             for r in rows:
+                c = r["counterweight"] or {}
                 w.writerow(
                     [
                         r["type"],
@@ -214,6 +219,7 @@ class Comparison:
                         _cell(r["objective"]),
                         *(_cell(r[k]) for k in columns()),
                         *(_cell(r["params"].get(k)) for k in names),
+                        *(_cell(c.get(k)) for k in ("mass", "radius", "angle")),
                         r["reason"],
                         self.units,
                     ]
@@ -333,6 +339,7 @@ def _row(kind, problem, r: Result) -> Row:
     if r.status not in SOLUTION_PRESENT:
         return Row(kind, r, {}, r.message)
     dynamic = problem.masses is not None or problem.loads is not None  # the dynamic criteria need them
+    problem = problem.settled(r)  # with the counterweight the solve chose, where it was free
     values = {
         name: c.value(problem, r.mechanism)
         for name, c in criteria.CRITERIA.items()

@@ -114,14 +114,14 @@ def _lexicographic(solver, base, end, first, second, size):
     """The design optimising ``second`` among those within LEXICOGRAPHIC of ``end``'s optimum of ``first`` (the
     end itself if that solve does not improve on it)."""
     c1, c2 = criteria.of(first, size), criteria.of(second, size)
-    v1 = c1.value(base, end.mechanism)
+    v1 = c1.value(base.settled(end), end.mechanism)
     give = LEXICOGRAPHIC * max(1.0, abs(v1))
     bound = v1 - give if c1.maximise else v1 + give
     p = base.replace(objective=second, conditions={**base.conditions, c1.bound: bound})
     r = solver.solve(p, extra_starts=[_free(p, end)], starts_n=0, use_analytic=False, diagnose=False)
     if r.status not in SOLUTION_PRESENT:
         return end
-    better = c2.better(c2.value(base, r.mechanism), c2.value(base, end.mechanism))
+    better = c2.better(c2.value(base.settled(r), r.mechanism), c2.value(base.settled(end), end.mechanism))
     return r if better else end
 
 
@@ -168,7 +168,7 @@ def _dominates(a1, b1, a2, b2, tol=1e-9) -> bool:
 
 
 def _value(problem, quantity, r: Result) -> float:
-    return criteria.CRITERIA[quantity].value(problem, r.mechanism)
+    return criteria.CRITERIA[quantity].value(problem.settled(r), r.mechanism)
 
 
 def _free(problem, r: Result) -> dict:

@@ -120,14 +120,16 @@ def angle_gap(a, b):
     return abs((a - b + math.pi) % TWO_PI - math.pi)
 
 
-def certify(problem, form, values, branch, th, z, f, gap_tol, feas_tol, build=build):
+def certify(problem, form, values, branch, th, z, f, gap_tol, feas_tol, build=build, concrete=None):
     """Exact check of an NLP point of Formulation ``form``. Returns (mechanism or None, info dict, angles to add,
     working-arc fractions to add).
 
-    z: the epigraph values and f the NLP objective (z None for a point that did not come from the NLP).
+    z: the epigraph values and f the NLP objective (z None for a point that did not come from the NLP);
+    concrete: the problem as the point fixes it (a free counterweight chosen), which the exact values use.
     """
     try:
-        return _certify(problem, form, build(problem, values, branch), th, z, f, gap_tol, feas_tol)
+        m = build(problem, values, branch)
+        return _certify(concrete or problem, form, m, th, z, f, gap_tol, feas_tol)
     except AssemblyError as e:
         mids = [((lo + hi) / 2) % TWO_PI for _, lo, hi in e.failures]
         return None, {"ok": False, "reason": str(e)}, mids, []

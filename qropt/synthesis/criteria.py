@@ -129,6 +129,13 @@ class Criterion:
         named kinematic outputs. [] where the measure is an explicit expression."""
         return []
 
+    def auxiliaries(self, f) -> list[tuple[str, list, float, bool]]:
+        """Auxiliary NLP variables its epigraph and measure use (``f.aux[name]``), made before them: (name,
+        expressions each bounds from above, its start where none does, whether it is also at most the largest of
+        them). The largest of several smooth quantities (a bar as long as its farthest joint) is smooth this way;
+        a free counterweight is two of them. Shared by name between criteria."""
+        return []
+
     def expression(self, f):
         """The value as an expression of the Formulation f's parameters (``f.params``), for a criterion of the
         parameters alone (no epigraph)."""

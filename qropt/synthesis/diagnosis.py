@@ -111,7 +111,7 @@ class Diagnosis:
                 msg += (
                     f"; designs meeting every target and condition exist (one: {shown}), so the {problem.objective}"
                     " optimum was not reached (it may lie at a singular limit: a dead point, a link of zero "
-                    "length or a bound)"
+                    "length or a bound)" + _dead_point_hint(problem)
                 )
                 return done("failed", msg, reachable=reach)
             # the backend's own failures (invalid numbers, iteration limits) prove nothing: only converged or
@@ -123,7 +123,7 @@ class Diagnosis:
         msg = f"no start converged to a certified design ({why}); " + "; ".join(msgs)
         if found:
             shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
-            msg += f"; a design meeting every target and condition: {shown}"
+            msg += f"; a design meeting every target and condition: {shown}" + _dead_point_hint(problem)
         return done("failed", msg, reachable=reach)
 
     def bound_out_of_reach(self, problem, targets, starts_n, seed):
@@ -178,6 +178,18 @@ def range_message(problem, k, v, lo, hi):
         return f"no sampled design turns fully and meets the conditions for {bounds}"
     where = "inside" if inside(v, lo, hi) else "below" if v < lo else "above"
     return f"{k} {v:g} is {where} the reachable {lo:.6g}..{hi:.6g} for {bounds}"
+
+
+def _dead_point_hint(problem) -> str:
+    """For a dynamic objective without a transmission bound: why its optimum may sit at a dead point."""
+    c = criteria.of_problem(problem)
+    if c is None or c.kinematic or "gamma_min" in problem.conditions:
+        return ""
+    return (
+        f"; {problem.objective} may drive a design toward a dead point of a joint (a transmission angle of zero, "
+        "where the joint forces grow without bound but the torque and shaking stay finite): a gamma_min condition "
+        "keeps the designs away from it"
+    )
 
 
 __all__ = ["Diagnosis", "DIAGNOSIS_STARTS", "inside", "range_message"]

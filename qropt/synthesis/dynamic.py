@@ -23,7 +23,18 @@ from qropt.errors import InvalidParameter
 from qropt.synthesis.criteria import Criterion, Exchange, register
 
 TWO_PI = 2 * math.pi
-LIFTS = 1  # torque extremes the NLP lifts for the peak torque
+LIFTS = 2  # extremes the NLP lifts for the peak torque and the peak shaking force (two: an optimum often has two
+# equal peaks, one of them sharp)
+CW_X, CW_Y = "counterweight moment x", "counterweight moment y"  # a free counterweight's variables (kg m)
+EXCHANGE_PEAKS = 4  # local maxima the exchange loop looks at: each above the NLP's bound becomes a sample angle
+
+
+def _abs_torque(d):
+    return np.abs(d.torque)
+
+
+def _shaking(d):
+    return np.hypot(d.shaking_force[:, 0], d.shaking_force[:, 1])
 
 
 def _problem_check(c, problem) -> str | None:
@@ -38,9 +49,12 @@ def _problem_check(c, problem) -> str | None:
 
 
 def _cycle(problem, m):
+    """The exact dynamics of design m; a free counterweight at its start (a start's score; a solve's certificate
+    is given the problem with the counterweight it chose, ``Formulation.concrete``)."""
     from qropt.dynamics.cycle import CycleDynamics
 
-    return CycleDynamics(m, problem.omega2, 0.0, problem.masses, problem.loads)
+    masses = problem.masses.started() if problem.masses is not None else None
+    return CycleDynamics(m, problem.omega2, 0.0, masses, problem.loads)
 
 
 class _Symbolic:
@@ -69,11 +83,14 @@ class _Symbolic:
     def mass_model(self, out, lengths=None):
         """body -> (mass, (cx, cy), inertia): the problem's overrides, else uniform bars of the density (a plate
         the union of bars from its first joint), the ram and block as points, the counterweight on the crank;
-        ``lengths``: body -> a bar's length given (an NLP variable bounding its joints' reaches)."""
+        ``lengths``: body -> a bar's length given (default: the NLP's length variable of each kinked bar)."""
         masses = self.f.masses
         out_models = {}
         if masses is None:
             return out_models
+        if lengths is None:
+            aux = getattr(self.f, "aux", {})
+            lengths = {b: aux[_length_name(b)] for b in self.kinked() if _length_name(b) in aux}
         for b in self.bodies:
             if b.name in masses.bodies:
                 bm = masses.bodies[b.name]
@@ -84,43 +101,69 @@ class _Symbolic:
                 model = (masses.block, (0.0, 0.0), 0.0)
             else:
                 model = self._bars(out, b, masses.density, (lengths or {}).get(b.name))
-            if b.name == "crank" and masses.counterweight is not None and masses.counterweight.mass > 0:
+            if b.name == "crank" and masses.balancing:
+                model = self._free_counterweight(model, masses.counterweight.radius)
+            elif b.name == "crank" and masses.counterweight is not None and masses.counterweight.mass > 0:
                 cw = masses.counterweight
                 point = (cw.mass, (cw.radius * math.cos(cw.angle), cw.radius * math.sin(cw.angle)), 0.0)
                 model = union(model, point)
             out_models[b.name] = model
         return out_models
 
-    def _reach(self, out, b, j):
+    def _free_counterweight(self, crank, radius):
+        """The crank with the NLP's counterweight: its first moment (u, v) kg m in the crank's frame is the pair
+        of variables, its mass sqrt(u^2 + v^2) / radius (a point: the parallel axes through O2)."""
+        u, v = self.f.aux[CW_X], self.f.aux[CW_Y]
+        if not getattr(self, "_counterweight_row", False):  # its mass up to the largest
+            self._counterweight_row = True
+            top = self.f.masses.counterweight.mass * radius
+            self.f.row("counterweight: at most its largest mass", u * u + v * v - top * top, -casadi.inf, 0.0)
+        mc = casadi.sqrt(u * u + v * v) / radius
+        ma, (ax, ay), ia = crank
+        mass = ma + mc
+        mx, my = ma * ax + u, ma * ay + v
+        inertia = ia + ma * (ax * ax + ay * ay) + mc * radius * radius - (mx * mx + my * my) / mass
+        return (mass, (mx / mass, my / mass), inertia)
+
+    def _reach_terms(self, out, b, j) -> list:
+        """The distances from body b's first joint whose largest is joint j's farthest reach (smooth each)."""
         first = b.joints[0]
         if j not in self.sliding[b.name]:
-            return self._dist(out, first, j)
+            return [self._dist(out, first, j)]
         if j == self.crank.joints[1]:  # the crank pin in the lever's slot: at most |pivot - O2| + r2 away
-            return self._dist(out, first, self.crank.joints[0]) + self._dist(out, self.crank.joints[0], j)
-        return casadi.fmax(*(self._dist(d, first, j) for d in self.f.dead))  # a sliding output: at a dead centre
+            return [self._dist(out, first, self.crank.joints[0]) + self._dist(out, self.crank.joints[0], j)]
+        return [self._dist(d, first, j) for d in self.f.dead]  # a sliding output: at a dead centre
 
-    def kinked(self):
-        """The bars whose length is the largest of several reaches (a kink of the mass model where they cross)."""
+    def _reach(self, out, b, j):
+        return _largest(self._reach_terms(out, b, j))
+
+    def kinked(self) -> list:
+        """The bars whose length is the largest of several smooth reaches (a kink of the mass model where two
+        cross): the NLP gives each a length variable above them all (``_Dynamic.auxiliaries``)."""
         masses = self.f.masses
         if masses is None:
             return []
+        if getattr(self, "_kinked", None) is None:
+            self._kinked = self._find_kinked(masses)
+        return self._kinked
+
+    def _find_kinked(self, masses) -> list:
         return [
             b.name
             for b in self.bodies
-            if b.name not in masses.bodies and b.kind in ("bar", "slot-lever") and len(b.joints) > 2
+            if b.name not in masses.bodies
+            and b.kind in ("bar", "slot-lever")
+            and sum(len(self._reach_terms(self.f.dead[0], b, j)) for j in b.joints[1:]) > 1
         ]
 
-    def reaches(self, out, name):
+    def length_terms(self, name) -> list:
         b = next(x for x in self.bodies if x.name == name)
-        return [self._reach(out, b, j) for j in b.joints[1:]]
+        return [t for j in b.joints[1:] for t in self._reach_terms(self.f.dead[0], b, j)]
 
     def _bars(self, out, b, density, length=None):
         reaches = [self._reach(out, b, j) for j in b.joints[1:]]
         if b.kind != "plate":
-            L = reaches[0]
-            for r in reaches[1:]:
-                L = casadi.fmax(L, r)
-            return slender_bar(density, L if length is None else length)
+            return slender_bar(density, _largest(reaches) if length is None else length)
         (ox, oy), (sx, sy) = self.point(out, b.joints[0]), self.point(out, b.joints[1])
         phi = casadi.atan2(sy - oy, sx - ox)
         model = None
@@ -256,6 +299,17 @@ class _Symbolic:
         return sx * sx + sy * sy
 
 
+def _largest(terms):
+    out = terms[0]
+    for t in terms[1:]:
+        out = casadi.fmax(out, t)
+    return out
+
+
+def _length_name(body: str) -> str:
+    return f"length of the {body}"
+
+
 def _symbolic(f) -> _Symbolic:
     s = getattr(f, "_dynamic_symbolic", None)
     if s is None:
@@ -273,6 +327,15 @@ class _Dynamic(Criterion):
 
     def check(self, problem) -> str | None:
         return _problem_check(self, problem)
+
+    def auxiliaries(self, f):  # a kinked bar's length: a variable above each of its reaches and below the one that
+        # is the farthest at the design the solve is at (smooth where they cross; the exchange loop moves the pick)
+        s = _symbolic(f)
+        out = [(_length_name(name), s.length_terms(name), 0.0, True) for name in s.kinked()]
+        if f.masses is not None and f.masses.balancing:  # a free counterweight: its first moment, from its start
+            cw = f.masses.counterweight
+            out += [(CW_X, [], -cw.mass * cw.radius / 2, False), (CW_Y, [], 0.0, False)]
+        return out
 
     def to_nlp(self, v, omega2):
         return v
@@ -297,7 +360,7 @@ class PeakTorque(_Dynamic):
     name, unit, label = "peak_torque", "N m", "peak crank torque"
 
     def value(self, problem, m):
-        return _cycle(problem, m).peak(lambda d: np.abs(d.torque)).value
+        return _cycle(problem, m).peak(_abs_torque).value
 
     def epigraph(self, f):
         s = _symbolic(f)
@@ -311,19 +374,18 @@ class PeakTorque(_Dynamic):
         f.row("lifted torque extreme: stationary", casadi.jacobian(T, phi), 0.0, 0.0, kind="lift")
         return [T, -T]
 
-    def lift_start(self, f, problem, m, n):
-        t = np.linspace(0.0, TWO_PI, 360, endpoint=False)
-        v = np.abs(_cycle(problem, m).at(t).torque)
-        peaks = [i for i in range(t.size) if v[i] >= v[i - 1] and v[i] >= v[(i + 1) % t.size]]
-        return [float(t[i]) for i in sorted(peaks, key=lambda i: -v[i])][:n]
+    def lift_start(self, f, problem, m, n):  # at the largest extremes exactly: the stationarity rows start met
+        return [p.theta2 for p in _cycle(problem, m).peaks(_abs_torque, n)]
 
     def exchange(self, f, problem, m, z, value_nlp, gap_tol):
-        p = _cycle(problem, m).peak(lambda d: np.abs(d.torque))
+        peaks = _cycle(problem, m).peaks(_abs_torque, EXCHANGE_PEAKS)
+        p = peaks[0]
         gap = (p.value - z[0]) / max(1.0, p.value)
-        return Exchange(z[0], p.value, gap, [p.theta2] if gap > gap_tol else [], [])
+        add = [q.theta2 for q in peaks if q.value > z[0]] if gap > gap_tol else []  # every extreme above the bound
+        return Exchange(z[0], p.value, gap, add, [])
 
     def exceeded(self, problem, m):
-        return [_cycle(problem, m).peak(lambda d: np.abs(d.torque)).theta2], []
+        return [_cycle(problem, m).peak(_abs_torque).theta2], []
 
 
 GAUSS_NODES = None  # the cycle module's Gauss-Legendre rule, read once
@@ -347,25 +409,11 @@ class RmsTorque(_Squared):
     def value(self, problem, m):
         return math.sqrt(_cycle(problem, m).quadrature(lambda d: d.torque**2) / TWO_PI)
 
-    def epigraph(self, f):  # a kinked bar's length: a variable above each of its reaches (smooth where they cross),
-        # capped by their largest in ``measure`` (a row that binds only where a longer bar would lower the torque)
-        s = _symbolic(f)
-        return [(f"length of the {b}", s.reaches(f.dead[0], b)) for b in s.kinked()]
-
     def measure(self, f, z):
         s = _symbolic(f)
-        lengths = dict(zip(s.kinked(), z, strict=True))
-        if not getattr(f, "_lengths_capped", False):  # and no longer than its farthest reach (more inertia may help)
-            f._lengths_capped = True
-            for name, length in lengths.items():
-                cap = s.reaches(f.dead[0], name)
-                top = cap[0]
-                for r in cap[1:]:
-                    top = casadi.fmax(top, r)
-                f.row(f"length of the {name}: its farthest reach", length - top, -casadi.inf, 0.0)
         total = 0
         for out, w, arc in f.strokes(_nodes()):
-            total += 0.5 * arc * w * s.torque(out, lengths) ** 2
+            total += 0.5 * arc * w * s.torque(out) ** 2
         return total / TWO_PI
 
     def exchange(self, f, problem, m, z, value_nlp, gap_tol):
@@ -381,7 +429,7 @@ class ShakingForce(_Squared):
     name, unit, label = "shaking_force", "N", "peak shaking force"
 
     def value(self, problem, m):
-        return _cycle(problem, m).peak(lambda d: np.hypot(*d.shaking_force.T)).value
+        return _cycle(problem, m).peak(_shaking).value
 
     def epigraph(self, f):
         s = _symbolic(f)
@@ -396,18 +444,17 @@ class ShakingForce(_Squared):
         return [s2]
 
     def lift_start(self, f, problem, m, n):
-        t = np.linspace(0.0, TWO_PI, 360, endpoint=False)
-        v = np.hypot(*_cycle(problem, m).at(t).shaking_force.T)
-        peaks = [i for i in range(t.size) if v[i] >= v[i - 1] and v[i] >= v[(i + 1) % t.size]]
-        return [float(t[i]) for i in sorted(peaks, key=lambda i: -v[i])][:n]
+        return [p.theta2 for p in _cycle(problem, m).peaks(_shaking, n)]
 
     def exchange(self, f, problem, m, z, value_nlp, gap_tol):
-        p = _cycle(problem, m).peak(lambda d: np.hypot(*d.shaking_force.T))
+        peaks = _cycle(problem, m).peaks(_shaking, EXCHANGE_PEAKS)
+        p = peaks[0]
         gap = (p.value**2 - z[0]) / max(1.0, p.value**2)
-        return Exchange(self.from_nlp(z[0], 1.0), p.value, gap, [p.theta2] if gap > gap_tol else [], [])
+        add = [q.theta2 for q in peaks if q.value**2 > z[0]] if gap > gap_tol else []
+        return Exchange(self.from_nlp(z[0], 1.0), p.value, gap, add, [])
 
     def exceeded(self, problem, m):
-        return [_cycle(problem, m).peak(lambda d: np.hypot(*d.shaking_force.T)).theta2], []
+        return [_cycle(problem, m).peak(_shaking).theta2], []
 
 
 class PeakBearingForce(_Squared):

@@ -182,8 +182,38 @@ class Formulation:
         travel, span = self._core_rows(TH, PT)
         self._condition_rows(problem)
 
+        # auxiliary variables first (the epigraph groups may use them), each above its expressions
+        aux = {}
+        for c in used:
+            for name, exprs, start, capped in c.auxiliaries(self):
+                aux.setdefault(name, (exprs, start, capped))
+        ZA = casadi.SX.sym("za", len(aux))
+        self.aux = {name: ZA[i] for i, name in enumerate(aux)}
+        self.aux_index = {name: i for i, name in enumerate(aux)}
+        self.n_aux = len(aux)  # the first z: auxiliary variables; the criteria's epigraph variables follow
+        self.aux_start = np.array([start for _, start, _ in aux.values()], float)
+        # a capped one is at most a sum of its expressions that parameters CAP pick: all of them (loose), or the one
+        # that is the largest at the design the solve is at (one-hot, like the box sides'; see ``caps``)
+        capped = [exprs for exprs, _, cap in aux.values() if cap]
+        self.cap_sizes = [len(e) for e in capped]
+        self._capped_index = [i for i, (_, _, cap) in enumerate(aux.values()) if cap]
+        CAP = casadi.SX.sym("cap", sum(self.cap_sizes))
+        k = 0
+        for i, (name, (exprs, _, cap)) in enumerate(aux.items()):
+            if cap:
+                pick = CAP[k : k + len(exprs)]
+                self.row(
+                    f"{name}: its largest",
+                    ZA[i] - casadi.dot(pick, casadi.vertcat(*exprs)),
+                    -casadi.inf,
+                    0.0,
+                    RowKind.EPIGRAPH,
+                )
+                k += len(exprs)
+        self._capped = casadi.vertcat(*[e for exprs in capped for e in exprs])
         # the criteria: the objective's epigraph group first, then each bound's (each criterion's group once)
-        self.z_names, self._z_of, epi = [], {}, []
+        self.z_names, self._z_of = list(aux), {}
+        epi = [(i, e) for i, (exprs, _, _) in enumerate(aux.values()) for e in exprs]
         for c in used:
             if c.name not in self._z_of:
                 groups = c.epigraph(self)
@@ -191,7 +221,7 @@ class Formulation:
                 for name, exprs in groups:
                     epi += [(len(self.z_names), e) for e in exprs]
                     self.z_names.append(name)
-        Z = casadi.SX.sym("z", len(self.z_names))
+        Z = casadi.vertcat(ZA, casadi.SX.sym("z", len(self.z_names) - len(aux)))
         # lifted extremes, like the dead centres: crank angles of a criterion's worst values that move with the design
         # faster than samples follow them (each criterion says how many, and their rows)
         self.lifts = []
@@ -233,8 +263,10 @@ class Formulation:
             fractions=n,
             bounds=len(self.bound_keys),
             select=n_box * self.n_coords,
+            caps=CAP.numel(),
         )
-        self.w_sym, self.p_sym = casadi.vertcat(X, TH, Z, PHI, PSI), casadi.vertcat(PF, PT, S, W, PB, SEL)
+        self.w_sym, self.p_sym = casadi.vertcat(X, TH, Z, PHI, PSI), casadi.vertcat(PF, PT, S, W, PB, SEL, CAP)
+        self.caps_fun = casadi.Function("caps", [self.w_sym, self.p_sym], [self._capped])
         self.g_sym, self.f_sym = casadi.vertcat(*[r.expr for r in self.rows]), f
         self.design_sym = casadi.vertcat(X, TH)  # the free parameters and the dead centres
         self.design = slice(0, self.w_blocks.slices["theta"].stop)  # where design_sym sits in w
@@ -244,7 +276,16 @@ class Formulation:
         self.lbg = np.array([r.lb for r in self.rows], float)
         self.ubg = np.array([r.ub for r in self.rows], float)
         self.nx, self.nz, self.n_lift, self.n_box = len(self.free), len(self.z_names), len(self.lifts), n_box
-        del self.params, self.dead, self.sampled, self.exact, self._working, self._strokes  # the build's symbols
+        del (
+            self.params,
+            self.dead,
+            self.sampled,
+            self.exact,
+            self._working,
+            self._strokes,
+            self.aux,
+            self._capped,
+        )  # the build's
 
     # ---- the build -----------------------------------------------------------------------------------
     def _kinematics(self, X, PF):
@@ -366,10 +407,24 @@ class Formulation:
         return self.w_blocks.join(
             free=[values[k] for k in self.free],
             theta=list(theta),
-            z=np.zeros(self.nz) if z is None else z,
+            z=np.concatenate([self.aux_start, np.zeros(self.nz - self.n_aux)]) if z is None else z,
             phi=phi,
             psi=self.box_angles(box),
         )
+
+    def concrete(self, problem, z=None):
+        """The problem as the design at epigraph values z fixes it: a free counterweight at the NLP's (at its
+        start without z); the problem itself otherwise."""
+        if "counterweight moment x" not in self.aux_index:
+            return problem
+        cw = problem.masses.counterweight
+        if z is None:
+            memo = self.__dict__.setdefault("_started", {})
+            if problem not in memo:
+                memo[problem] = problem.replace(masses=problem.masses.started())
+            return memo[problem]
+        i, j = self.aux_index["counterweight moment x"], self.aux_index["counterweight moment y"]
+        return problem.replace(masses=problem.masses.replace(counterweight=cw.with_moment(z[i], z[j])))
 
     def with_box(self, w, box) -> np.ndarray:
         """w with its box sides moved to a BoundingBox's angles."""
@@ -418,10 +473,10 @@ class Formulation:
         pad = np.zeros(self.n_extra)
         return np.concatenate([angles, pad]), np.concatenate([fractions, pad])
 
-    def param_vector(self, problem, targets: dict, samples, fractions, box=None) -> np.ndarray:
+    def param_vector(self, problem, targets: dict, samples, fractions, box=None, caps=None) -> np.ndarray:
         """p from the problem's fixed values and bound values (in the NLP's terms), the targets, the sample angles
-        and working-arc fractions, and the box sides' coordinates (from ``box``, a BoundingBox of the design the
-        solve is at)."""
+        and working-arc fractions, the box sides' coordinates (from ``box``, a BoundingBox of the design the
+        solve is at) and ``caps`` (``Formulation.caps``; default loose)."""
         bounds = [criteria.bounds()[k].to_nlp(problem.conditions[k], problem.omega2) for k in self.bound_keys]
         return self.p_blocks.join(
             fixed=[problem.fixed[k] for k in self.fixed],
@@ -430,18 +485,41 @@ class Formulation:
             fractions=fractions,
             bounds=bounds,
             select=self._box_select(box),
+            caps=np.ones(sum(self.cap_sizes)) if caps is None else caps,
         )
+
+    def caps(self, w, p) -> np.ndarray:
+        """The capped auxiliary variables' caps after NLP point w (p: its parameters). A cap starts loose (the
+        sum of its expressions: a bar's length is then free above its farthest reach, which is where the optimum
+        puts it whenever a heavier bar does not help, and the NLP stays smooth where two reaches cross); where
+        the point has a variable above its largest expression, its cap becomes that expression (one-hot), and
+        a tight cap follows the largest one from then on."""
+        now = self.p_blocks.split(p)["caps"]
+        if not self.cap_sizes:
+            return now
+        e = np.array(self.caps_fun(w, p)).ravel()
+        z = self.w_blocks.split(w)["z"]
+        out, k = [], 0
+        for i, n in zip(self._capped_index, self.cap_sizes, strict=True):
+            top = e[k : k + n]
+            tight = np.sum(now[k : k + n]) == 1.0
+            one = np.zeros(n)
+            one[int(np.argmax(top))] = 1.0
+            out.append(one if tight or z[i] > np.max(top) * (1 + 1e-7) + 1e-9 else now[k : k + n])
+            k += n
+        return np.concatenate(out)
 
     def epigraph_start(self, w0, p):
         """w0 with z values that make every epigraph row feasible."""
         if not self.nz:
             return w0
-        e = np.array(self.epi_fun(w0, p)).ravel()[: self.epi_index.size]
-        z = np.full(self.nz, -np.inf)
-        np.fmax.at(z, self.epi_index, e)
-        z = np.where(np.isfinite(z), z, 0.0)
         b = self.w_blocks.split(w0)
-        b["z"] = z + 1e-9 * np.maximum(1.0, np.abs(z))
+        for _ in range(2 if self.n_aux else 1):  # the auxiliary variables first: the criteria's rows use them
+            e = np.array(self.epi_fun(self.w_blocks.join(**b), p)).ravel()[: self.epi_index.size]
+            z = np.full(self.nz, -np.inf)
+            np.fmax.at(z, self.epi_index, e)
+            z = np.where(np.isfinite(z), z, b["z"])  # a variable no row bounds (a free counterweight) keeps its value
+            b["z"] = z + 1e-9 * np.maximum(1.0, np.abs(z))
         return self.w_blocks.join(**b)
 
     def bounds(self, problem):

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from qropt.errors import QroptError
 from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import CONVERGED, Status
@@ -41,10 +42,14 @@ class Candidate:
     origin: str = ""
     q: dict | None = None
     pruned: bool = False
+    problem: object = None  # the problem as the design fixes it (a free counterweight chosen); None: the solve's
 
     @property
     def converged(self) -> bool:
         return bool(self.ends) and self.ends[-1] in CONVERGED
+
+    def residuals_over(self, tol: float) -> bool:
+        return max(self.residuals.values(), default=0.0) > tol
 
 
 def _dynamic_key(problem) -> tuple:
@@ -117,13 +122,34 @@ class LocalSolve:
         which the exchange loop stops (the start is pruned)."""
         max_rounds = self.max_rounds if max_rounds is None else max_rounds
         designs = designs or Designs()
+        objective = criteria.of_problem(problem)
+        if (
+            objective is not None
+            and not objective.kinematic
+            and range_target is None
+            and not _meets(problem, values0, branch, targets, designs)
+        ):
+            # a dynamic objective from a design that meets the targets: its forces change fast where the loop nears
+            # a limit, and a start far from the targets leads IPOPT there (a feasibility solve first, measured:
+            # the crank-rocker slider's min_peak_torque went from no design in 23 starts to the optimum)
+            pre = self.run(
+                self._feasibility(problem),
+                values0,
+                branch,
+                targets,
+                orientation=orientation,
+                max_rounds=1,
+                designs=designs,
+            )
+            if pre.converged and not pre.residuals_over(self.tolerances["feasibility"]):
+                values0, orientation = pre.values, pre.orientation
         th0, orientation = starts_.dead_centre_start(
             problem, values0, branch, targets, orientation, range_target, designs
         )
         form = self.formulations.get(problem, branch, orientation, range_target, sense)
         samples, fractions = form.base_samples()
         used = used_f = form.n_base
-        phi, box = form.lifted_start(problem, values0, designs)
+        phi, box = form.lifted_start(form.concrete(problem), values0, designs)
         p = form.param_vector(problem, targets, samples, fractions, box=box)
         w = form.epigraph_start(form.pack(values0, th0, phi=phi, box=box), p)
         lbx, ubx = form.bounds(problem)
@@ -140,8 +166,9 @@ class LocalSolve:
             c.ends.append(run.status)
             pt = form.unpack(w)
             c.values = pt.values
+            c.problem = form.concrete(problem, pt.z)
             m, info, add, frac = certify(
-                problem, form, c.values, branch, pt.theta, pt.z, run.f, gap_tol, feas_tol, designs
+                problem, form, c.values, branch, pt.theta, pt.z, run.f, gap_tol, feas_tol, designs, c.problem
             )
             near = range_target or max(form.violations(g).values(), default=0.0) <= RESTART_VIOLATION
             if run.status is Status.ITERATION_LIMIT and restarts < RESTARTS and near:
@@ -149,7 +176,9 @@ class LocalSolve:
                 continue
             if not run.converged and not range_target:
                 break
-            if not add and not frac:
+            caps = form.caps(w, p)
+            tightened = not np.array_equal(caps, form.p_blocks.split(p)["caps"])
+            if not add and not frac and not tightened:
                 break
             if bound is not None and info.get("ok") and run.f > bound + 1e-9 * max(1.0, abs(bound)):
                 c.pruned = True  # more samples only raise this basin's NLP value: it cannot beat the incumbent
@@ -159,12 +188,19 @@ class LocalSolve:
             if form.n_box and m is not None:  # each box side lifted at the coordinate that reaches it now
                 box = m.bounding_box()
                 w = form.with_box(w, box)
-            p = form.param_vector(problem, targets, samples, fractions, box=box)
+            p = form.param_vector(problem, targets, samples, fractions, box=box, caps=caps)
             w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
         c.mechanism, c.info = m, info
-        c.residuals = residuals(problem, form.violations(g), m, {k: targets[k] for k in form.targets})
+        c.residuals = residuals(c.problem or problem, form.violations(g), m, {k: targets[k] for k in form.targets})
         c.ok = bool(info.get("ok")) and c.converged and self.within(c) and not c.pruned
         return c
+
+    def _feasibility(self, problem):
+        """The problem without its objective (its targets, conditions and bounds), built once per problem."""
+        memo = self.__dict__.setdefault("_feasibility_of", {})
+        if problem not in memo:
+            memo[problem] = problem.replace(objective=None)
+        return memo[problem]
 
     def polish(self, problem, values0, branch, targets, designs=None) -> Candidate:
         """Newton on the target and dead-centre equations from a closed-form point of a square problem (as many
@@ -173,7 +209,7 @@ class LocalSolve:
         th0, orientation = starts_.dead_centre_start(problem, values0, branch, targets, None, None, designs)
         form = self.formulations.get(problem, branch, orientation)
         rows = form.square_rows
-        if rows is None:
+        if rows is None or form.concrete(problem) is not problem:  # a free counterweight: the NLP chooses it
             return self.run(problem, values0, branch, targets, orientation=orientation, designs=designs)
         p = form.param_vector(problem, targets, *form.base_samples())
         w = form.pack(values0, th0)
@@ -219,6 +255,16 @@ class LocalSolve:
     def within(self, c: Candidate) -> bool:
         tol = self.tolerances
         return max(c.residuals.values(), default=0.0) <= tol["feasibility"] and c.info.get("gap", 0.0) <= tol["gap"]
+
+
+def _meets(problem, values, branch, targets, build, tol: float = 1e-9) -> bool:
+    """Whether the design at ``values`` builds and meets the targets (to tol relative)."""
+    try:
+        m = build(problem, values, branch)
+        got = {"time_ratio": m.time_ratio(), "stroke": m.stroke(), "swing": m.stroke()}
+    except QroptError:
+        return False
+    return all(abs(got[k] - v) <= tol * max(1.0, abs(v)) for k, v in targets.items() if k in got)
 
 
 def place(slots, used, new, period, near, base):

@@ -378,6 +378,14 @@ class Problem:
         d.update(changes)
         return Problem(**{k: (dict(v) if isinstance(v, MappingProxyType) else v) for k, v in d.items()})
 
+    def settled(self, result) -> Problem:
+        """The problem as a result's design fixes it: a free counterweight at the one the result chose (the problem
+        itself otherwise). Exact values of that design's dynamics need it."""
+        cw = getattr(result, "counterweight", None)
+        if cw is None or self.masses is None or not self.masses.balancing:
+            return self
+        return self.replace(masses=self.masses.replace(counterweight=cw))
+
     def build(self, values: dict, branch: dict) -> Mechanism:
         """The mechanism (in the problem's unit) with the free parameters at ``values`` on ``branch`` (may raise
         QroptError)."""

@@ -70,7 +70,8 @@ class Result:
     name -> violation (>= 0); certificate: a Certificate; stats: solver statistics and timings (s);
     local_optima: every distinct local optimum found (best first); reachable: target -> (low, high)
     when no design was found; units: the length unit of every length in it (None: its mechanism's, else
-    ``qropt.units.DEFAULT``; always a unit name once built).
+    ``qropt.units.DEFAULT``; always a unit name once built); counterweight: the crank counterweight the solve
+    chose where the problem left it free (``qropt.Counterweight``, SI; its dynamic quantities include it).
     """
 
     status: str
@@ -85,6 +86,7 @@ class Result:
     local_optima: tuple = ()
     reachable: dict = field(default_factory=dict)
     units: str | None = None
+    counterweight: Any = None
 
     def __post_init__(self):
         if self.status not in STATUSES:
@@ -131,12 +133,18 @@ class Result:
                 parts.append(f"{name}{sep}{shown:.10g} {unit}")
         return parts
 
+    def _counterweight_words(self) -> str:
+        cw = self.counterweight
+        return f"{cw.mass:.6g} kg at {cw.radius:g} m, {math.degrees(cw.angle):.4f} deg from the crank pin"
+
     def __repr__(self):
         lines = [f"Result(status={self.status!r}, objective={self.objective!r})", f"  message: {self.message}"]
         if self.params:
             lines.append(f"  params ({self.units}, rad): " + ", ".join(f"{k}={v:.10g}" for k, v in self.params.items()))
         if self.quantities:
             lines.append("  quantities: " + ", ".join(self._quantity_parts("=")))
+        if self.counterweight is not None:
+            lines.append(f"  counterweight: {self._counterweight_words()}")
         if self.certificate is not None:
             c = self.certificate
             lines.append(f"  certificate: gap {c.gap:.1e} after {c.rounds} round(s); {c.local}")
@@ -156,6 +164,8 @@ class Result:
         if self.quantities:
             extra = [self.quantities["grashof"]] if self.quantities.get("grashof") else []
             lines.append("quantities: " + ", ".join(self._quantity_parts(" ") + extra))
+        if self.counterweight is not None:
+            lines.append(f"counterweight: {self._counterweight_words()}")
         if self.certificate is not None:
             c = self.certificate
             obj = "" if c.certified is None else f"objective {c.certified:.12g}"
@@ -188,6 +198,7 @@ class Result:
                 "stats": self.stats,
                 "reachable": {k: list(v) for k, v in self.reachable.items()},
                 "local_optima": [r.to_dict() for r in self.local_optima],
+                **({} if self.counterweight is None else {"counterweight": self.counterweight.to_dict()}),
             }
         )
 
@@ -242,6 +253,13 @@ class Result:
             {},
         )
         local = need("local_optima", lambda v: isinstance(v, (list, tuple)), "a list of Result tables", [])
+        cw = need("counterweight", lambda v: v is None or isinstance(v, Mapping), "null or a table")
+        if cw is not None:
+            from qropt.dynamics.model import Counterweight
+
+            if set(cw) - {"mass", "radius", "angle"} or not {"mass", "radius"} <= set(cw):
+                raise ProblemError(f"counterweight is a table of mass, radius and angle, got {cw!r:.80}")
+            cw = Counterweight(**cw)
         unit = d.get("units")
         if isinstance(unit, Mapping):  # to_dict's table names its length unit; older files: the default
             unit = unit.get("length", units_.DEFAULT)
@@ -264,6 +282,7 @@ class Result:
                 k: (math.nan if lo is None else lo, math.nan if hi is None else hi) for k, (lo, hi) in reach.items()
             },
             units=unit,
+            counterweight=cw,
         )
 
 

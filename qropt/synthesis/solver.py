@@ -208,7 +208,7 @@ class Solver:
         good = [c for c in cands if c.ok]
         if good:
             for c in good:
-                c.q = quantities(problem, c.mechanism)
+                c.q = quantities(c.problem or problem, c.mechanism)
             best_first = sorted(
                 distinct(good),
                 key=lambda c: objective_value(problem, c.q) or 0.0,
@@ -323,6 +323,7 @@ class Solver:
                 "origin": c.origin,
             },
             local_optima=tuple(local),
+            counterweight=c.problem.masses.counterweight if problem.masses and problem.masses.balancing else None,
         )
 
     # ---- reachable range of one target ---------------------------------------------------------------
