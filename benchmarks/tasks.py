@@ -1,0 +1,119 @@
+"""``design()`` over many tasks, not one: a fixed, seeded set of (TR, stroke) spread over TR 1.1-3 and strokes
+0.05-5 m (a scrambled Halton sequence, log-uniform in the stroke), every design row, each objective asked.
+
+For each objective the first task is run twice: its first call is the cold time (the NLPs built), and every task
+after it is timed warm (the same structures, new numbers). Reported per type and objective: the median and the
+worst row time, the statuses, and the median and worst ``design()`` time over the tasks. Writes
+``results/tasks.json`` and ``results/tasks.md``.
+
+Run: ``python -m benchmarks.tasks [--tasks 12] [--objectives max_gamma_min min_peak_accel] [--dynamic]``
+(repository root). ``--dynamic`` adds ``min_peak_torque`` with the default mass model below.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+from scipy.stats import qmc
+
+import qropt
+from benchmarks.report import RESULTS, save
+from qropt import Solver
+from qropt.studies._design import TYPES, design
+
+SEED = 20261124
+MASSES = qropt.Masses.steel(4e-4, ram=20.0)  # steel links of 4 cm^2 (3.14 kg/m), a 20 kg ram
+LOADS = qropt.Loads(1000.0)
+OMEGA2 = 10.0
+
+
+def tasks(n: int, seed: int = SEED) -> list[tuple[float, float]]:
+    """n tasks (TR, stroke m): TR uniform in [1.1, 3], stroke log-uniform in [0.05, 5], from a scrambled Halton
+    sequence (spread over the square, the same every run)."""
+    u = qmc.Halton(d=2, scramble=True, seed=seed).random(n)
+    return [(round(float(1.1 + 1.9 * a), 3), round(float(0.05 * 100**b), 4)) for a, b in u]
+
+
+def run_objective(objective: str, task_list, dynamic: bool) -> dict:
+    solver = Solver()
+    kw = {"masses": MASSES, "loads": LOADS, "omega2": OMEGA2} if dynamic else {}
+    tr, s = task_list[0]
+    t = time.perf_counter()
+    design(tr, s, objective=objective, solver=solver, **kw)
+    cold = time.perf_counter() - t
+    per_task, rows = [], {k: [] for k in TYPES}
+    for tr, s in task_list:
+        t = time.perf_counter()
+        cmp = design(tr, s, objective=objective, solver=solver, **kw)
+        per_task.append(time.perf_counter() - t)
+        for r in cmp.rows:
+            rows[r.type].append((r.result.status, r.result.stats.get("t_total", 0.0), tr, s))
+        print(f"  {objective:16s} TR {tr:5.3f} stroke {s:7.4f} m: {per_task[-1]:6.2f} s", flush=True)
+    types = {}
+    for k, v in rows.items():
+        times = [x[1] for x in v]
+        worst = max(v, key=lambda x: x[1])
+        statuses = {st: sum(1 for x in v if x[0] == st) for st in sorted({x[0] for x in v})}
+        types[k] = {
+            "median_s": statistics.median(times),
+            "worst_s": worst[1],
+            "worst_task": [worst[2], worst[3]],
+            "statuses": statuses,
+        }
+    return {
+        "cold_first_call_s": cold,
+        "design_median_s": statistics.median(per_task),
+        "design_worst_s": max(per_task),
+        "design_s": per_task,
+        "types": types,
+    }
+
+
+def markdown(results: dict, n: int) -> str:
+    lines = [
+        f"`design()` over {n} tasks (TR 1.1-3, stroke 0.05-5 m; warm: the NLPs built by a first call, whose time "
+        "is the cold one):",
+        "",
+        "| objective | design median [s] | design worst [s] | cold first call [s] |",
+        "|---|---|---|---|",
+    ]
+    for obj, r in results.items():
+        lines.append(
+            f"| {obj} | {r['design_median_s']:.2f} | {r['design_worst_s']:.2f} | {r['cold_first_call_s']:.2f} |"
+        )
+    lines += ["", "| type | " + " | ".join(f"{o} median / worst [s]" for o in results) + " |"]
+    lines.append("|---|" + "---|" * len(results))
+    for k in TYPES:
+        cells = []
+        for r in results.values():
+            t = r["types"][k]
+            bad = sum(v for st, v in t["statuses"].items() if st in ("failed",))
+            cells.append(f"{t['median_s']:.2f} / {t['worst_s']:.2f}" + (f" ({bad} failed)" if bad else ""))
+        lines.append(f"| {k} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--tasks", type=int, default=12)
+    ap.add_argument("--objectives", nargs="+", default=["max_gamma_min", "min_peak_accel"])
+    ap.add_argument("--dynamic", action="store_true", help="also min_peak_torque (steel links, 20 kg ram, 1000 N)")
+    args = ap.parse_args(argv)
+    task_list = tasks(args.tasks)
+    print(f"{len(task_list)} tasks: " + ", ".join(f"({a:g}, {b:g})" for a, b in task_list))
+    results = {}
+    for obj in args.objectives:
+        results[obj] = run_objective(obj, task_list, dynamic=False)
+    if args.dynamic:
+        results["min_peak_torque"] = run_objective("min_peak_torque", task_list, dynamic=True)
+    table = markdown(results, len(task_list))
+    print(table)
+    save("tasks.json", {"tasks": task_list, "seed": SEED, "results": results})
+    (RESULTS / "tasks.md").write_text(table)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
