@@ -253,6 +253,8 @@ class _System:
         s._structure(link, name, massive)
         return s
 
+    order = None  # the elimination's row order, found at the first solve of this mechanism
+
     def _structure(self, link, name, massive):
         bodies = list(link.bodies())
         conns = list(link.connections())
@@ -432,7 +434,9 @@ def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
         rows[r] = rows.get(r, 0.0) + np.where(working, loads.follower_torque * np.sign(vel["follower"][1]), 0.0)
     friction = np.zeros(n)
     try:
-        elim = Elimination(entries, s.n, n)
+        elim = Elimination(entries, s.n, n, s.order)  # one mechanism's row order serves each call
+        if s.order is None and not elim.dense and not elim.bad.any():
+            s.order = elim.order
         x = elim.solve(rows)
         if loads.friction and guide_col is not None:
             r = s.rows[out_body.name]
@@ -534,21 +538,9 @@ class Elimination:
     column is solved again by LAPACK with pivoting (np.linalg.solve, which raises LinAlgError where the system is
     singular). The factors are kept, so further right-hand sides (friction's iteration) cost a substitution."""
 
-    def __init__(self, entries: dict, K: int, n: int):
+    def __init__(self, entries: dict, K: int, n: int, order=None):
         self.K, self.n, self.entries = K, n, entries
-        at = n // 3
-        Mk = np.zeros((K, K))
-        for (r, c), v in entries.items():
-            Mk[r, c] = v if np.ndim(v) == 0 else v[at]
-        order, left = [], list(range(K))
-        for j in range(K):  # the row order of partial pivoting at that angle
-            i = max(left, key=lambda r: abs(Mk[r, j]))
-            order.append(i)
-            left.remove(i)
-            if Mk[i, j] != 0:
-                for r in left:
-                    Mk[r] -= Mk[r, j] / Mk[i, j] * Mk[i]
-        self.order = order
+        self.order = order = order or self.pivoting(entries, K, n // 3)
         rows = [{} for _ in range(K)]
         pos = {r: i for i, r in enumerate(order)}
         for (r, c), v in entries.items():
@@ -578,6 +570,22 @@ class Elimination:
                 self.steps.append((i, j, f))
         self.rows, self.bad = rows, bad
 
+    @staticmethod
+    def pivoting(entries: dict, K: int, at: int) -> list:
+        """The row order of partial pivoting of the system at angle index ``at``."""
+        Mk = np.zeros((K, K))
+        for (r, c), v in entries.items():
+            Mk[r, c] = v if np.ndim(v) == 0 else v[at]
+        order, left = [], list(range(K))
+        for j in range(K):
+            i = max(left, key=lambda r: abs(Mk[r, j]))
+            order.append(i)
+            left.remove(i)
+            if Mk[i, j] != 0:
+                for r in left:
+                    Mk[r] -= Mk[r, j] / Mk[i, j] * Mk[i]
+        return order
+
     def solve(self, rhs: dict) -> list:
         """x as K columns, each (n,), for the right-hand sides {row: number or (n,) array} (absent rows zero).
         Columns rather than one (n, K) array: many small arrays keep the allocator from returning memory to the
@@ -596,7 +604,7 @@ class Elimination:
                     acc = acc - v * x[c]
             piv = self.rows[j][j]
             x[j] = acc / (np.where(piv == 0, 1.0, piv) if np.ndim(piv) else (piv or 1.0))
-        x = [np.broadcast_to(v, (n,)).astype(float) for v in x]
+        x = [v if isinstance(v, np.ndarray) and v.shape == (n,) else np.full(n, float(v)) for v in x]
         if self.bad.any():
             fix = self._lapack(rhs, self.bad)
             for j in range(K):
