@@ -28,7 +28,6 @@ class Status(enum.Enum):
 
 
 CONVERGED = (Status.SOLVED, Status.ACCEPTABLE)
-PROVES = (Status.SOLVED, Status.ACCEPTABLE, Status.INFEASIBLE)  # ends that say something of the problem
 
 
 @dataclass(frozen=True)
@@ -178,4 +177,4 @@ class Scipy:
         return Run(w, float(r.fun), gv, status, str(r.message), calls[0], time.perf_counter() - t0)
 
 
-__all__ = ["Status", "CONVERGED", "PROVES", "Run", "Backend", "Ipopt", "Scipy"]
+__all__ = ["Status", "CONVERGED", "Run", "Backend", "Ipopt", "Scipy"]
