@@ -43,8 +43,6 @@ def _problem_check(c, problem) -> str | None:
         return f"{c.objective} needs masses or loads (Problem(..., masses=qropt.Masses..., loads=qropt.Loads(...)))"
     if loads is not None and loads.friction:
         return f"{c.name}: friction on the slide is in the exact analysis, not in the NLP; give friction=0"
-    if loads is not None and isinstance(loads.cutting_force, tuple):
-        return f"{c.name}: a cutting-force table is in the exact analysis, not in the NLP; give a constant force"
     return None
 
 
@@ -252,8 +250,8 @@ class _Symbolic:
         for r, v in rows.items():
             rhs[r] = v
         ram = next((b for b in s.bodies if b.kind in ("ram", "yoke")), None)
-        force = f.loads.cutting_force if f.loads is not None else 0.0
-        if ram is not None and force:  # the cutting force against the ram on the working stroke
+        force = self.cutting_force(out)
+        if ram is not None and not (isinstance(force, (int, float)) and not force):  # against the working stroke
             way = (-1.0 if f.orientation > 0 else 1.0) * math.copysign(1.0, f.omega2)
             rhs[s.rows[ram.name]] -= casadi.if_else(way * out.v * f.omega2 > 0, -force * way, 0.0)
         x = casadi.solve(A, rhs)
@@ -281,12 +279,25 @@ class _Symbolic:
         f, loads = self.f, self.f.loads
         if loads is None:
             return 0
-        force = loads.cutting_force if f.mechanism.OUTPUT == "slider" else loads.follower_torque
-        if not force:
+        force = self.cutting_force(out) if f.mechanism.OUTPUT == "slider" else loads.follower_torque
+        if isinstance(force, (int, float)) and not force:
             return 0
         scale = self.k if f.mechanism.OUTPUT == "slider" else 1.0
         way = (-1.0 if f.orientation > 0 else 1.0) * math.copysign(1.0, f.omega2)  # the working direction
         return force * casadi.fmax(0, way * out.v * scale * f.omega2) / f.omega2
+
+    def cutting_force(self, out):
+        """The cutting force's magnitude (N) at the ram's position: the constant, or the table interpolated as
+        ``Loads.force_at`` does (linear between rows, constant beyond them)."""
+        table = self.f.loads.cutting_force if self.f.loads is not None else 0.0
+        if not isinstance(table, tuple):
+            return table
+        xs, fs = [float(r[0]) for r in table], [float(r[1]) for r in table]
+        if len(xs) == 1:
+            return fs[0]
+        if getattr(self, "_table", None) is None:
+            self._table = casadi.interpolant("cutting_force", "linear", [xs], fs)
+        return self._table(casadi.fmin(casadi.fmax(out.x, xs[0]), xs[-1]))
 
     def shaking_squared(self, out):
         """|sum(m a_G)|^2 at constant omega2 (N^2)."""
