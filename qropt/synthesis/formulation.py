@@ -421,6 +421,8 @@ class Formulation:
         if z is None:
             memo = self.__dict__.setdefault("_started", {})
             if problem not in memo:
+                if len(memo) >= 64:  # a formulation serves every problem of its structure
+                    memo.clear()
                 memo[problem] = problem.replace(masses=problem.masses.started())
             return memo[problem]
         i, j = self.aux_index["counterweight moment x"], self.aux_index["counterweight moment y"]

@@ -21,6 +21,7 @@ from qropt.synthesis.formulation import TWO_PI, Formulation
 
 RESTARTS = 2  # runs continued from their last iterate when they hit the iteration limit near a design
 RESTART_VIOLATION = 1e-6  # ... that is, with no constraint violated by more than this
+MEMO = 64  # problems a solver keeps derived problems of (a chart's tiles bring thousands)
 
 
 @dataclass
@@ -199,6 +200,8 @@ class LocalSolve:
         """The problem without its objective (its targets, conditions and bounds), built once per problem."""
         memo = self.__dict__.setdefault("_feasibility_of", {})
         if problem not in memo:
+            if len(memo) >= MEMO:
+                memo.clear()
             memo[problem] = problem.replace(objective=None)
         return memo[problem]
 
