@@ -22,6 +22,19 @@ def _masses(counterweight=None):
     return qropt.Masses.steel(4e-4, 20.0, counterweight=counterweight)
 
 
+def _balancing(kind):
+    """The type's task TR 1.5, stroke 0.3 m by min_shaking_force, its counterweight left to the solve."""
+    return type_problem(
+        kind,
+        1.5,
+        0.3,
+        objective="min_shaking_force",
+        masses=_masses(qropt.Counterweight.balancing(RADIUS, MAX_MASS)),
+        loads=LOADS,
+        omega2=10.0,
+    )
+
+
 def _best_counterweight(m, omega2):
     """The least peak shaking force of design m over every counterweight of at most MAX_MASS at RADIUS: the
     shaking force is S0 + u Su + v Sv in the counterweight's first moment (u, v) (superposition of the exact
@@ -45,15 +58,7 @@ def _best_counterweight(m, omega2):
 
 
 def test_a_balanced_crank_shaper_is_the_best_of_a_family_scan_with_the_best_counterweight_of_each_design():
-    p = type_problem(
-        "crank-shaper",
-        1.5,
-        0.3,
-        objective="min_shaking_force",
-        masses=_masses(qropt.Counterweight.balancing(RADIUS, MAX_MASS)),
-        loads=LOADS,
-        omega2=10.0,
-    )
+    p = _balancing("crank-shaper")
     r = qropt.solve(p)
     assert r.status in ("optimal", "acceptable"), r.message
     cw = r.counterweight
@@ -86,15 +91,7 @@ def test_a_counterweight_balances_the_gravity_torque():
 
 
 def test_the_chosen_counterweight_is_in_the_result_and_its_dictionary():
-    p = type_problem(
-        "slider-crank",
-        1.5,
-        0.3,
-        objective="min_shaking_force",
-        masses=_masses(qropt.Counterweight.balancing(RADIUS, MAX_MASS)),
-        loads=LOADS,
-        omega2=10.0,
-    )
+    p = _balancing("slider-crank")
     r = qropt.solve(p)
     assert r.success, r.message
     back = qropt.Result.from_dict(r.to_dict())

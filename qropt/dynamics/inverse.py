@@ -162,8 +162,7 @@ def body_masses(m, masses: Masses) -> dict[str, BodyMass]:
                 bars = [max(bars)]
             bm = _bars(b, bars, m, masses.density)
         if b.name == "crank" and masses.counterweight is not None and masses.counterweight.mass > 0:
-            cw = masses.counterweight
-            bm = _combined(bm, BodyMass(cw.mass, (cw.radius * math.cos(cw.angle), cw.radius * math.sin(cw.angle))))
+            bm = _combined(bm, BodyMass(*masses.counterweight.part()))
         out[b.name] = bm
     return out
 

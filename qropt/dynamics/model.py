@@ -92,6 +92,10 @@ class Counterweight:
         """Where a solve starts a free counterweight: half its largest mass, opposite the pin (a fixed one: itself)."""
         return Counterweight(self.mass / 2, self.radius, math.pi) if self.free else self
 
+    def part(self) -> tuple:
+        """The crank's part it is: (mass, its point (x, y) in the crank's frame, 0 inertia about itself)."""
+        return (self.mass, (self.radius * math.cos(self.angle), self.radius * math.sin(self.angle)), 0.0)
+
     def with_moment(self, mx: float, my: float) -> Counterweight:
         """The fixed counterweight of first moment (mx, my) kg m in the crank's frame, at this radius."""
         return Counterweight(math.hypot(mx, my) / self.radius, self.radius, math.atan2(my, mx))

@@ -159,13 +159,19 @@ def _certify(problem, form, m, th, z, f, gap_tol, feas_tol):
     return m, info, add, frac
 
 
+def target_values(m) -> dict:
+    """The quantities a target names, exactly: time_ratio, and the travel as stroke and as swing."""
+    travel = m.stroke()
+    return {"time_ratio": m.time_ratio(), "stroke": travel, "swing": travel}
+
+
 def residuals(problem, violations: dict, m, targets) -> dict:
     """Named violations (>= 0): the NLP's rows of the design (``Formulation.violations``), and the targets and
     bound conditions evaluated exactly."""
     res = dict(violations)
     if m is not None:
         try:
-            q = {"time_ratio": m.time_ratio(), "stroke": m.stroke(), "swing": m.stroke()}
+            q = target_values(m)
         except QroptError:  # the output reverses more than once a turn: no target is met
             q = dict.fromkeys(("time_ratio", "stroke", "swing"), math.inf)
         for k, v in targets.items():
@@ -187,4 +193,5 @@ __all__ = [
     "better",
     "certify",
     "residuals",
+    "target_values",
 ]

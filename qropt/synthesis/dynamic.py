@@ -102,9 +102,7 @@ class _Symbolic:
             if b.name == "crank" and masses.balancing:
                 model = self._free_counterweight(model, masses.counterweight.radius)
             elif b.name == "crank" and masses.counterweight is not None and masses.counterweight.mass > 0:
-                cw = masses.counterweight
-                point = (cw.mass, (cw.radius * math.cos(cw.angle), cw.radius * math.sin(cw.angle)), 0.0)
-                model = union(model, point)
+                model = union(model, masses.counterweight.part())
             out_models[b.name] = model
         return out_models
 

@@ -415,7 +415,9 @@ class Formulation:
     def concrete(self, problem, z=None):
         """The problem as the design at epigraph values z fixes it: a free counterweight at the NLP's (at its
         start without z); the problem itself otherwise."""
-        if "counterweight moment x" not in self.aux_index:
+        from qropt.synthesis.dynamic import CW_X, CW_Y
+
+        if CW_X not in self.aux_index:
             return problem
         cw = problem.masses.counterweight
         if z is None:
@@ -425,7 +427,7 @@ class Formulation:
                     memo.clear()
                 memo[problem] = problem.replace(masses=problem.masses.started())
             return memo[problem]
-        i, j = self.aux_index["counterweight moment x"], self.aux_index["counterweight moment y"]
+        i, j = self.aux_index[CW_X], self.aux_index[CW_Y]
         return problem.replace(masses=problem.masses.replace(counterweight=cw.with_moment(z[i], z[j])))
 
     def with_box(self, w, box) -> np.ndarray:

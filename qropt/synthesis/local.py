@@ -16,7 +16,7 @@ from qropt.errors import QroptError
 from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import CONVERGED, Status
-from qropt.synthesis.certificate import Designs, certify, residuals
+from qropt.synthesis.certificate import Designs, certify, residuals, target_values
 from qropt.synthesis.formulation import TWO_PI, Formulation
 
 RESTARTS = 2  # runs continued from their last iterate when they hit the iteration limit near a design
@@ -263,8 +263,7 @@ class LocalSolve:
 def _meets(problem, values, branch, targets, build, tol: float = 1e-9) -> bool:
     """Whether the design at ``values`` builds and meets the targets (to tol relative)."""
     try:
-        m = build(problem, values, branch)
-        got = {"time_ratio": m.time_ratio(), "stroke": m.stroke(), "swing": m.stroke()}
+        got = target_values(build(problem, values, branch))
     except QroptError:
         return False
     return all(abs(got[k] - v) <= tol * max(1.0, abs(v)) for k, v in targets.items() if k in got)
