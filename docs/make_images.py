@@ -94,6 +94,17 @@ def polygons(path):
     m.relative_motion(math.radians(60), 10.0).plot(path)
 
 
+def app_pages(path):
+    """The web app's pages in Chromium, as the browser test leaves them (app_mechanism.png, app_design.png and
+    app_synthesis.png together: the test writes all three)."""
+    import os
+    import subprocess
+
+    env = {**os.environ, "QROPT_SCREENSHOTS": str(path.parent)}
+    test = [sys.executable, "-m", "pytest", "-q", "-n", "0", "-p", "no:cacheprovider", "tests/test_browser.py"]
+    subprocess.run(test, cwd=ROOT, env=env, check=True)
+
+
 PICTURES = {
     "types.png": types,
     "front.png": front,
@@ -106,6 +117,7 @@ PICTURES = {
     "forces.png": forces,
     "polygons.png": polygons,
     "torque_front.png": torque_front,
+    "app_mechanism.png": app_pages,  # and app_design.png, app_synthesis.png
 }
 
 

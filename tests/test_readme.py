@@ -1,10 +1,11 @@
 """Every ``qropt`` command the README and the docs/*.md pages show (each once, the README's first, then the
-pages' in name order), run as a subprocess of the installed executable from a directory
-outside the repository (holding a copy of ``problems/``, which the commands name): exit code 0, and every file
-the command names written and not empty. A command that names a running Dask scheduler runs after the README's
-background lines (those ending in ``&``: the scheduler and its workers) are started as the README shows them.
-``qropt bench`` and the ``python -m benchmarks`` lines are the benchmarks' own (minutes long, run from the
-repository root): they are not run here."""
+pages' in name order), run as a subprocess of the installed executable from a directory outside the repository
+(holding a copy of ``problems/``, which the commands name): exit code 0, and every file the command names written
+and not empty (a folder it names: its files). A command that names a running Dask scheduler runs after the
+README's background lines (those ending in ``&``: the scheduler and its workers) are started as the README shows
+them. ``qropt app`` serves until stopped: it runs until it answers ``/api/health`` at the address it prints (no
+browser opened), then is stopped with Ctrl-C and must exit 0. ``qropt bench`` and the ``python -m benchmarks``
+lines are the benchmarks' own (minutes long, run from the repository root): they are not run here."""
 
 from __future__ import annotations
 
@@ -111,10 +112,35 @@ def test_readme_command_runs(command, workdir):
     shell = command.replace("qropt ", f"{shlex.quote(exe)} ") if command != "qropt" else exe
     if command.startswith("qropt bench"):
         pytest.skip("the benchmark suite runs from the repository root and takes minutes")
+    if command.startswith("qropt app"):
+        return _serves(shell, workdir)
     address = re.search(r"--scheduler (tcp://\S+)", command)
     with services(workdir, address.group(1)) if address else contextlib.nullcontext():
         r = subprocess.run(shell, shell=True, cwd=workdir, capture_output=True, text=True, timeout=240)
     assert r.returncode == 0, (command, r.stdout[-2000:], r.stderr[-2000:])
     for name in outputs(command):
         path = workdir / name
-        assert path.is_file() and path.stat().st_size > 0, (command, name)
+        if path.is_dir():  # a set of files (qropt project --count): every one written
+            files = list(path.iterdir())
+            assert files and all(f.stat().st_size > 0 for f in files), (command, name)
+        else:
+            assert path.is_file() and path.stat().st_size > 0, (command, name)
+
+
+def _serves(shell: str, cwd) -> None:
+    """Run a server command until it answers /api/health at the address it prints, then Ctrl-C it: exit 0."""
+    import json
+    import urllib.request
+
+    env = {**os.environ, "BROWSER": "true"}  # webbrowser.open runs `true`: no browser here
+    p = subprocess.Popen(shlex.split(shell), cwd=cwd, env=env, stdout=subprocess.PIPE, text=True)
+    try:
+        line = p.stdout.readline()
+        url = re.search(r"http://\S+/", line)
+        assert url, line
+        with urllib.request.urlopen(url.group(0) + "api/health", timeout=30) as r:
+            assert json.load(r)["status"] == "ok"
+    finally:
+        p.send_signal(signal.SIGINT)  # Ctrl-C
+        code = p.wait(timeout=30)
+    assert code == 0

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import dataclasses
 import importlib
 import json
 import math
@@ -17,6 +16,7 @@ import numpy as np
 
 from qropt import units as units_
 from qropt.errors import QroptError
+from qropt.io import records
 from qropt.mechanisms import REGISTRY, Mechanism, mechanism_type, type_reference
 from qropt.synthesis import criteria
 
@@ -172,50 +172,6 @@ def build_mechanism(args) -> Mechanism:
     return cls(**mechanism_params(args, cls), units=units or units_.DEFAULT)
 
 
-def analysis_report(m: Mechanism, theta2: float, omega2: float, alpha2: float) -> dict:
-    """Every analysed quantity as plain JSON-ready values (angles in degrees, suffix _deg)."""
-    d, g = m.dead_centres(), m.gamma_min()
-    a, b = m.stroke_angles()
-    mo = m.motion(np.array([theta2]), omega2, alpha2)
-    out = {
-        "type": type_reference(type(m)),
-        "output": m.OUTPUT,
-        "params": dict(m.params),
-        "units": m.units,
-        "time_ratio": m.time_ratio(),
-        "stroke": m.stroke(),
-        "dead_centres": {
-            "theta_max_deg": math.degrees(d.theta_max),
-            "theta_min_deg": math.degrees(d.theta_min),
-            "x_max": d.x_max,
-            "x_min": d.x_min,
-            "reversals": d.reversals,
-        },
-        "stroke_angles_deg": [math.degrees(max(a, b)), math.degrees(min(a, b))],
-        "working_direction": m.working_direction(omega2),
-        "gamma_min": {"value_deg": math.degrees(g.value), "theta2_deg": math.degrees(g.theta2), "joint": g.joint},
-        "state": {
-            "theta2_deg": math.degrees(theta2),
-            "omega2": omega2,
-            "alpha2": alpha2,
-            "x": float(mo.x[0]),
-            "v": float(mo.v[0]),
-            "a": float(mo.a[0]),
-            "links": {
-                k: {
-                    "angle_deg": math.degrees(float(mo.angles[k][0])),
-                    "omega": float(mo.omega[k][0]),
-                    "alpha": float(mo.alpha[k][0]),
-                }
-                for k in mo.angles
-            },
-        },
-    }
-    if hasattr(m, "grashof"):
-        out["grashof"] = m.grashof()._asdict()
-    return out
-
-
 def print_report(r: dict, out=None):
     w = (out or sys.stdout).write
     u = r.get("units", units_.DEFAULT)
@@ -295,7 +251,7 @@ def cmd_analyze(args):
         return polygons(args, m)
     if args.dynamics:
         return dynamics(args, m)
-    r = analysis_report(m, args.theta2, args.omega2, args.alpha2)
+    r = records.analysis(m, args.theta2, args.omega2, args.alpha2)
     if args.json:
         json.dump(r, sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")
@@ -363,21 +319,7 @@ def dynamics(args, m) -> int:
     cd = CycleDynamics(m, args.omega2, args.alpha2, masses, loads)
     ex = cd.extremes()
     fw = cd.flywheel(args.cs) if args.alpha2 == 0 else None
-    out = {
-        "type": type(m).__name__,
-        "omega2": args.omega2,
-        "alpha2": args.alpha2,
-        "masses": masses.to_dict(),
-        "loads": loads.to_dict(),
-        "peak_torque": {"value": ex.peak_torque.value, "theta2_deg": math.degrees(ex.peak_torque.theta2)},
-        "rms_torque": ex.rms_torque,
-        "mean_torque": ex.mean_torque,
-        "peak_forces": {k: {"value": p.value, "theta2_deg": math.degrees(p.theta2)} for k, p in ex.peak_forces.items()},
-        "peak_shaking_force": ex.peak_shaking_force.value,
-        "peak_shaking_moment": ex.peak_shaking_moment.value,
-    }
-    if fw is not None:  # every field of the Flywheel but the speed, given above
-        out["flywheel"] = {k: v for k, v in dataclasses.asdict(fw).items() if k != "omega2"}
+    out = records.dynamics(cd, masses, ex, fw)
     if args.json:
         json.dump(out, sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")

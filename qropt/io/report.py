@@ -337,6 +337,46 @@ def _problem(problem) -> str:
     )
 
 
+def design_page(m, theta2: float = 0.0, omega2: float = 1.0) -> str:
+    """One design's report as a whole HTML page: its parameters and exact cycle quantities, x, v, a over the turn,
+    the velocity and acceleration polygons at theta2 (rad) and omega2 (rad/s) for a type built from dyads, and
+    its forces under the report's assumed masses and load (``FORCES``)."""
+    from qropt.errors import QroptError
+    from qropt.io import plots
+    from qropt.mechanisms.relative_motion import polygon_figure
+
+    u, kinds = m.units, m.kinds()
+    g, d = m.gamma_min(), m.dead_centres()
+    rows = [
+        (
+            {"angle": f"{k} [deg]", "branch": k}.get(kinds.get(k), f"{k} [{u}]"),
+            math.degrees(v) if kinds.get(k) == "angle" else v,
+        )
+        for k, v in m.params.items()
+    ]
+    rows += [("time ratio", m.time_ratio()), (f"stroke [{u}]", m.stroke())]
+    rows += [
+        ("gamma_min [deg]", math.degrees(g.value)),
+        ("theta_max, theta_min [deg]", f"{math.degrees(d.theta_max):.4f}, {math.degrees(d.theta_min):.4f}"),
+    ]
+    rows += [(f"peak acceleration at omega2 = {omega2:g} rad/s [{u}/s^2]", m.peak_acceleration(omega2).value)]
+    body = f"<h1>{html.escape(type(m).__name__)}</h1>" + _table(["quantity", "value"], rows)
+    body += _png(plots.cycle_figure(m, theta2, omega2))
+    try:
+        rm = m.relative_motion(theta2, omega2, 0.0)
+    except QroptError:
+        rm = None
+    if rm is not None:
+        body += f"<h2>Velocity and acceleration polygons at theta2 = {math.degrees(theta2):g} deg</h2>"
+        body += _png(polygon_figure(rm, u))
+    try:
+        body += _forces(m)
+    except QroptError as e:
+        body += f"<p class=bad>No forces: {html.escape(str(e))}</p>"
+    head = f"<meta charset='utf-8'><title>qropt design: {html.escape(type(m).__name__)}</title><style>{CSS}</style>"
+    return f"<!DOCTYPE html><html><head>{head}</head><body>{body}</body></html>\n"
+
+
 def render(problem=None, path=None, progress=None) -> str:
     """The report's HTML (also written to ``path`` if given): the paper's project, or the given problem's design.
 
@@ -365,4 +405,4 @@ def report_path(path) -> Path:
     return output_path(path, (".html", ".htm"), "report")
 
 
-__all__ = ["render", "report_path"]
+__all__ = ["render", "report_path", "design_page"]

@@ -281,6 +281,12 @@ class Chart:
             f"{s['seconds']:.3g} s, {s['scheduler']})"
         )
 
+    def _repr_html_(self) -> str:
+        """The chart in a notebook: a heat map of the objective and a table of cells (HTML)."""
+        from qropt.io.notebook import chart_html
+
+        return chart_html(self)
+
     # ---- files ------------------------------------------------------------------------------------------
     def rows(self) -> list[dict]:
         """One flat dict per cell: axis values, status, how it was solved, objective, parameters, quantities."""

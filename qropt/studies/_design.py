@@ -164,6 +164,12 @@ class Comparison:
                 lines.append(f"  {r.type:20s} no design: {r.reason}")
         return "\n".join(lines)
 
+    def _repr_html_(self) -> str:
+        """The comparison in a notebook: the ranked table and each design's picture (HTML)."""
+        from qropt.io.notebook import comparison_html
+
+        return comparison_html(self)
+
     def markdown(self) -> str:
         """The comparison as a Markdown table, best first: gamma_min in degrees, each criterion in its unit to four
         significant digits, the chosen parameters (lengths in the unit, angles in degrees)."""

@@ -47,6 +47,12 @@ class Front:
             lines.append("  ...")
         return "\n".join(lines)
 
+    def _repr_html_(self) -> str:
+        """The front in a notebook: a scatter of its two criteria and a table (HTML)."""
+        from qropt.io.notebook import front_html
+
+        return front_html(self)
+
     def table(self) -> list[dict]:
         a, b = self.criteria
         return [

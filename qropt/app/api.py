@@ -1,0 +1,250 @@
+"""The web API's work, free of the web framework: a JSON payload in, a JSON-ready dict out, and ``ApiError``
+(status 4xx, one-line reason) for every input the library refuses.
+
+Angles in the payloads are radians (``theta2``), speeds rad/s; the answers give angles in degrees under names ending
+in ``_deg``, as ``qropt analyze --json`` does (``qropt.io.records``). A type is a shipped KIND or class name, or a
+type of the user's loaded at start-up (``qropt app PROBLEM_FILE``): the API never imports a module a request
+names, because a module is code.
+"""
+
+from __future__ import annotations
+
+import math
+from numbers import Real
+
+import numpy as np
+
+from qropt import units as units_
+from qropt.errors import QroptError
+from qropt.io import records
+from qropt.mechanisms import REGISTRY, Mechanism, mechanism_type, type_reference
+
+SAMPLES = 181  # crank angles of the cycle curves (every 2 deg)
+MAX_FRAMES = 360  # frames of an animation in one answer
+OBJECTIVES = ("max_gamma_min", "min_size", "min_peak_accel", "min_peak_torque", "min_rms_torque")
+
+
+class ApiError(QroptError):
+    """A request the API cannot answer: ``status`` 400 (bad input), 404 (no such thing) or 429 (busy)."""
+
+    def __init__(self, message: str, status: int = 400):
+        super().__init__(message)
+        self.status = status
+
+
+def fields(payload, required: tuple, optional: tuple = ()) -> dict:
+    """The payload as a dict with the required fields and no unknown ones."""
+    if not isinstance(payload, dict):
+        raise ApiError(f"the request body is a JSON object, got {type(payload).__name__}")
+    missing = [k for k in required if k not in payload]
+    unknown = sorted(set(payload) - set(required) - set(optional))
+    if missing:
+        raise ApiError(f"missing field(s): {', '.join(missing)}")
+    if unknown:
+        raise ApiError(f"unknown field(s): {', '.join(unknown)}; fields are {', '.join(required + optional)}")
+    return payload
+
+
+def number(d: dict, key: str, default=None, *, low=-math.inf, high=math.inf) -> float:
+    """A finite number field within [low, high]."""
+    v = d.get(key, default)
+    if isinstance(v, bool) or not isinstance(v, Real) or not math.isfinite(v):
+        raise ApiError(f"{key} is a finite number, got {v!r:.60}")
+    if not low <= v <= high:
+        raise ApiError(f"{key} must lie in [{low:g}, {high:g}], got {v:g}")
+    return float(v)
+
+
+def known_type(name) -> type[Mechanism]:
+    """A registered type by its KIND, class name or ``module:Class`` reference; never imports."""
+    if isinstance(name, str) and ":" in name:
+        for cls in list(REGISTRY.values()):
+            if type_reference(cls) == name:
+                return cls
+        raise ApiError(
+            f"unknown mechanism type {name!r:.80}: the app serves {', '.join(types())}; load a type of your own "
+            "at start-up: qropt app PROBLEM_FILE"
+        )
+    try:
+        return mechanism_type(name)
+    except QroptError as e:
+        raise ApiError(str(e)) from None
+
+
+def types() -> list[str]:
+    """Every type the app serves, by the name files use."""
+    return sorted({type_reference(c) for c in list(REGISTRY.values())})
+
+
+def type_info() -> list[dict]:
+    """Each type's name, class, output and parameters (name -> kind), and a valid default design."""
+    from qropt.app.defaults import default_params
+
+    out = []
+    for name in types():
+        cls = known_type(name)
+        out.append(
+            {
+                "type": name,
+                "class": cls.__name__,
+                "output": cls.OUTPUT,
+                "kinds": cls.kinds(),
+                "required": cls.required(),
+                "params": default_params(cls),
+            }
+        )
+    return out
+
+
+def mechanism(d: dict) -> Mechanism:
+    """The mechanism of ``{type, params, units?}``."""
+    cls = known_type(d.get("type"))
+    params = d.get("params")
+    if not isinstance(params, dict):
+        raise ApiError(f"params is an object of parameter values, got {type(params).__name__}")
+    for k, v in params.items():
+        if isinstance(v, bool) or not isinstance(v, Real) or not math.isfinite(v):
+            raise ApiError(f"parameter {k} is a finite number, got {v!r:.60}")
+    units = d.get("units", units_.DEFAULT)
+    try:
+        return cls(**params, units=units)
+    except TypeError as e:
+        raise ApiError(f"{cls.__name__}: {e}") from None
+
+
+def analyze(payload) -> dict:
+    """``POST /api/analyze``: ``{type, params, theta2, omega2}`` (rad, rad/s; optional ``alpha2``, ``units``,
+    ``masses`` (``Masses.to_dict`` form), ``loads`` (``Loads.to_dict`` form), ``frames`` (crank angles of an
+    animation, 0-360), ``polygons`` (bool, default true), ``extremes`` (bool, default true: the exact dynamic
+    extremes and flywheel, about 0.1 s; false while a slider moves)): the state at theta2, the cycle quantities,
+    x, v, a over the turn, the drawing at theta2, the polygons at theta2 and, with masses, the forces."""
+    d = fields(
+        payload,
+        ("type", "params"),
+        ("theta2", "omega2", "alpha2", "units", "masses", "loads", "frames", "polygons", "extremes"),
+    )
+    theta2 = number(d, "theta2", 0.0, low=-1e6, high=1e6)
+    omega2 = number(d, "omega2", 1.0, low=-1e4, high=1e4)
+    alpha2 = number(d, "alpha2", 0.0, low=-1e6, high=1e6)
+    frames = d.get("frames", 0)
+    if isinstance(frames, bool) or not isinstance(frames, int) or not 0 <= frames <= MAX_FRAMES:
+        raise ApiError(f"frames is an integer from 0 to {MAX_FRAMES}, got {frames!r:.40}")
+    if omega2 == 0.0:
+        raise ApiError("omega2 must be nonzero (rad/s; its sign is the crank's sense of rotation)")
+    m = mechanism(d)
+    out = records.analysis(m, theta2, omega2, alpha2)
+    peak = m.peak_acceleration(omega2)
+    out["peak_accel"] = {"value": peak.value, "theta2_deg": math.degrees(peak.theta2)}
+    start, length = m.working_arc(omega2)
+    out["working_arc_deg"] = [math.degrees(start) % 360.0, math.degrees(length)]
+    th = np.linspace(0.0, 2 * math.pi, SAMPLES)
+    mo = m.motion(th, omega2, alpha2)
+    out["cycle"] = {
+        "theta2_deg": np.degrees(th).tolist(),
+        "x": mo.x.tolist(),
+        "v": mo.v.tolist(),
+        "a": mo.a.tolist(),
+        "working": [bool((t - start) % (2 * math.pi) <= length) for t in th],
+    }
+    out["drawing"] = drawing(m, theta2, frames, start, length)
+    if d.get("polygons", True):
+        out["polygons"] = polygons(m, theta2, omega2, alpha2)
+    if d.get("masses") is not None:
+        extremes = d.get("extremes", True)
+        if not isinstance(extremes, bool):
+            raise ApiError(f"extremes is true or false, got {extremes!r:.40}")
+        out["dynamics"] = forces(m, theta2, omega2, alpha2, d["masses"], d.get("loads"), extremes)
+    return out
+
+
+def drawing(m: Mechanism, theta2: float, frames: int, start: float, length: float) -> dict:
+    """The shapes at theta2, the view box of the whole turn, the output's path split into working and return
+    strokes, and ``frames`` evenly spaced frames of the turn (each its crank angle, stroke and shapes)."""
+    from qropt.io import drawing as dr
+
+    sc = dr.scene(m, 121)
+    now = dr.at(sc, theta2)
+    pos = m.positions(np.linspace(0.0, 2 * math.pi, 73)).points
+    turn = [dr.shapes(sc, {k: v[i] for k, v in pos.items()}) for i in range(0, 73, 6)]
+    x0, x1, y0, y1 = dr.bounds([s for f in [now, *turn] for s in f])
+    out = {
+        "view": [x0, y0, x1 - x0, y1 - y0],
+        "shapes": [_shape(s) for s in now if s.part != "path"],
+        "path": None,
+        "frames": [],
+    }
+    if sc.path is not None:
+        th = np.linspace(0.0, 2 * math.pi, sc.path.shape[0])
+        out["path"] = {
+            "points": np.round(sc.path, 12).tolist(),
+            "working": [bool((t - start) % (2 * math.pi) <= length) for t in th],
+        }
+    if frames:
+        th = np.linspace(0.0, 2 * math.pi, frames, endpoint=False)
+        pos = m.positions(th).points
+        for i, t in enumerate(th):
+            shapes = dr.shapes(sc, {k: v[i] for k, v in pos.items()})
+            out["frames"].append(
+                {
+                    "theta2_deg": math.degrees(t),
+                    "working": bool((t - start) % (2 * math.pi) <= length),
+                    "shapes": [_shape(s) for s in shapes if s.part != "path"],
+                }
+            )
+    return out
+
+
+def _shape(s) -> dict:
+    d = {"kind": s.kind, "part": s.part, "name": s.name, "points": [[float(x), float(y)] for x, y in s.points]}
+    if s.kind == "circle":
+        d["radius"] = float(s.radius)
+    return d
+
+
+def polygons(m: Mechanism, theta2: float, omega2: float, alpha2: float) -> list[dict] | None:
+    """The velocity and acceleration equations at theta2, term by term (components and the joint's exact
+    vector), for a type built from dyads; None for a type without a linkage declaration."""
+    try:
+        rm = m.relative_motion(theta2, omega2, alpha2)
+    except QroptError:
+        return None
+    return [
+        {
+            "joint": e.joint,
+            "quantity": e.quantity,
+            "exact": [float(e.exact[0]), float(e.exact[1])],
+            "terms": [
+                {"name": t.name, "kind": t.kind, "vector": [float(t.vector[0]), float(t.vector[1])], "solved": t.solved}
+                for t in e.terms
+            ],
+        }
+        for e in rm.equations
+    ]
+
+
+def forces(m: Mechanism, theta2: float, omega2: float, alpha2: float, masses, loads, extremes: bool = True) -> dict:
+    """With a mass model: the crank torque over the turn, the torque and every joint force at theta2 (N m, N)
+    and, with ``extremes``, the exact dynamic extremes over the turn and the flywheel (``records.dynamics``)."""
+    from qropt.dynamics.cycle import CycleDynamics
+    from qropt.dynamics.model import Loads, Masses
+
+    if not isinstance(masses, dict) or (loads is not None and not isinstance(loads, dict)):
+        raise ApiError("masses and loads are objects in the form of Masses.to_dict and Loads.to_dict")
+    ms = Masses.from_dict(masses)
+    ld = Loads() if loads is None else Loads.from_dict(loads)
+    cd = CycleDynamics(m, omega2, alpha2, ms, ld)
+    if extremes:
+        out = records.dynamics(cd, ms, cd.extremes(), cd.flywheel(0.05) if alpha2 == 0 else None)
+    else:
+        out = {"type": type(m).__name__, "omega2": omega2, "alpha2": alpha2, "masses": ms.to_dict()}
+        out["loads"] = ld.to_dict()
+    th = np.linspace(0.0, 2 * math.pi, SAMPLES)
+    dy = cd.at(th)
+    out["torque"] = {"theta2_deg": np.degrees(th).tolist(), "value": dy.torque.tolist()}
+    now = cd.at(np.array([theta2]))
+    out["at"] = {
+        "theta2_deg": math.degrees(theta2),
+        "torque": float(now.torque[0]),
+        "joint_forces": {k: [float(v[0, 0]), float(v[0, 1])] for k, v in sorted(now.joint_forces.items())},
+    }
+    return out

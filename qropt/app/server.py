@@ -1,0 +1,248 @@
+"""The web application: the pages (one HTML file, its script and style, served from the package: no external
+resources) and the JSON API under ``/api`` (Flask). Every answer to bad input is a 4xx with ``{"error": reason}``
+in one line; nothing a request sends stops the server.
+
+- ``GET /api/health``; ``GET /api/types`` (every type, its parameters and a valid design to open with);
+  ``GET /api/problems`` (the problem files the app was started with)
+- ``POST /api/analyze``: ``{type, params, theta2, omega2}`` -> the analysis (``qropt.app.api.analyze``)
+- ``POST /api/solve``: a problem (``Problem.to_dict``'s form) -> the Result (``Result.to_dict``'s form)
+- ``POST /api/design``: ``{time_ratio, stroke, objective}`` (optional ``bounds``, ``conditions``, ``types``)
+  -> the Comparison (``Comparison.to_json``'s form)
+- ``POST /api/jobs``: ``{kind: solve | design | report, input}`` -> 202 and the job; ``GET /api/jobs/<id>``
+  its state, progress and result; ``DELETE /api/jobs/<id>`` cancels it
+- ``POST /api/export/<dxf|svg|json>``: ``{type, params, units?, theta2?}`` -> the file
+"""
+
+from __future__ import annotations
+
+import math
+import tempfile
+from importlib import resources
+from pathlib import Path
+
+from qropt.app import api
+from qropt.app.defaults import remember
+from qropt.app.jobs import Busy, Jobs
+from qropt.errors import QroptError
+
+MAX_BODY = 1 << 20  # bytes of a request body
+STATIC = {"": ("index.html", "text/html"), "app.js": ("app.js", "text/javascript"), "app.css": ("app.css", "text/css")}
+
+
+def load_file(path: str):
+    """The Problem of a problem file (its type registered by loading it), as ``qropt synth`` reads it."""
+    from qropt.cli import load_problem
+
+    return load_problem(path)
+
+
+def _problem(payload):
+    """A Problem from its JSON form, its type checked first (never imported on a request's word)."""
+    from qropt.synthesis.problem import Problem
+
+    if not isinstance(payload, dict):
+        raise api.ApiError(f"a problem is a JSON object (Problem.to_dict's form), got {type(payload).__name__}")
+    d = dict(payload)
+    d["mechanism"] = api.known_type(d.get("mechanism"))
+    return Problem.from_dict(d)
+
+
+_DESIGN_FIELDS = ("bounds", "conditions", "types", "objective", "omega2", "size", "units", "masses", "loads")
+
+
+def _design_input(payload) -> dict:
+    """``design``'s arguments from a request, checked as far as they can be before a worker runs them."""
+    d = api.fields(payload, ("time_ratio", "stroke"), _DESIGN_FIELDS)
+    out = {"time_ratio": api.number(d, "time_ratio", low=1.0 + 1e-9, high=50.0)}
+    out["stroke"] = api.number(d, "stroke", low=1e-9, high=1e6)
+    if "objective" in d:
+        if d["objective"] not in api.OBJECTIVES:
+            raise api.ApiError(f"objective is one of {', '.join(api.OBJECTIVES)}, got {d['objective']!r:.60}")
+        out["objective"] = d["objective"]
+    if "types" in d:
+        t = d["types"]
+        if not isinstance(t, list) or not t or not all(isinstance(x, str) for x in t):
+            raise api.ApiError("types is a non-empty list of type names")
+        for x in t:
+            api.known_type(x)
+        out["types"] = t
+    for k in ("bounds", "conditions", "masses", "loads"):
+        if d.get(k) is not None:
+            if not isinstance(d[k], dict):
+                raise api.ApiError(f"{k} is an object, got {type(d[k]).__name__}")
+            out[k] = d[k]
+    if "omega2" in d:
+        out["omega2"] = api.number(d, "omega2", low=-1e4, high=1e4)
+    for k in ("size", "units"):
+        if k in d:
+            if not isinstance(d[k], str):
+                raise api.ApiError(f"{k} is a string")
+            out[k] = d[k]
+    if "bounds" in out:
+        out["bounds"] = {k: tuple(v) if isinstance(v, list) else v for k, v in out["bounds"].items()}
+    return out
+
+
+def create_app(files=(), workers: int = 1, queue_size: int = 8, time_limit: float = 300.0):
+    """The Flask application: problem ``files`` loaded (their types served), ``workers`` solver processes, at most
+    ``queue_size`` jobs waiting, each stopped after ``time_limit`` s."""
+    from flask import Flask, Response, jsonify, request
+    from werkzeug.exceptions import HTTPException
+
+    problems = {}
+    for f in files:
+        problems[str(f)] = load_file(f)
+    jobs = Jobs(workers, queue_size, time_limit, files)
+    startup = {name: jobs.submit("solve", p.to_dict()) for name, p in problems.items()}
+    for name, job in startup.items():  # a user type opens with its problem's design
+        job.ended.wait(time_limit)
+        if job.state == "done" and job.result.get("params"):
+            remember(problems[name].mechanism, job.result["params"])
+    app = Flask("qropt", static_folder=None)
+    app.config["MAX_CONTENT_LENGTH"] = MAX_BODY
+    app.json.sort_keys = False  # parameters in their type's order
+    app.extensions["qropt_jobs"] = jobs
+
+    def body():
+        data = request.get_json(silent=True, force=True)
+        if data is None:
+            raise api.ApiError("the request body is not JSON")
+        return data
+
+    @app.errorhandler(api.ApiError)
+    def _api_error(e):
+        return jsonify(error=str(e)), e.status
+
+    @app.errorhandler(QroptError)
+    def _qropt_error(e):
+        return jsonify(error=f"{type(e).__name__}: {e}".replace("\n", " ")), 400
+
+    @app.errorhandler(HTTPException)
+    def _http_error(e):
+        return jsonify(error=f"{e.code} {e.name}: {e.description}"), e.code
+
+    @app.errorhandler(Exception)
+    def _internal(e):  # a bug: said in one line; the server goes on
+        app.logger.exception("internal error")
+        return jsonify(error=f"internal error ({type(e).__name__}): {e}"), 500
+
+    @app.get("/")
+    @app.get("/<name>")
+    def page(name=""):
+        if name not in STATIC:
+            raise api.ApiError(f"no page {name!r}", 404)
+        file, mime = STATIC[name]
+        text = resources.files("qropt.app").joinpath("static", file).read_text()
+        return Response(text, mimetype=mime)
+
+    @app.get("/favicon.ico")
+    def favicon():
+        return Response(status=204)
+
+    @app.get("/api/health")
+    def health():
+        from qropt import __version__
+
+        return jsonify(status="ok", version=__version__, types=api.types(), workers=len(jobs._slots))
+
+    @app.get("/api/types")
+    def types():
+        return jsonify(api.type_info())
+
+    @app.get("/api/problems")
+    def problem_files():
+        out = []
+        for name, p in problems.items():
+            job = startup[name]
+            out.append({"file": name, "problem": p.to_dict(), "job": job.to_dict(result=False)})
+        return jsonify(out)
+
+    @app.post("/api/analyze")
+    def analyze():
+        return jsonify(api.analyze(body()))
+
+    def run(kind, payload):
+        try:
+            job = jobs.submit(kind, payload)
+        except Busy as e:
+            raise api.ApiError(str(e), 429) from None
+        job.ended.wait(jobs.time_limit + 30)
+        if job.state == "done":
+            return job.result
+        if job.state == "timeout":
+            raise api.ApiError(f"the {kind} stopped at the time limit of {jobs.time_limit:g} s", 408)
+        raise api.ApiError(job.error or job.state, 400 if job.error and "internal error" not in job.error else 500)
+
+    @app.post("/api/solve")
+    def solve():
+        return jsonify(run("solve", _problem(body()).to_dict()))
+
+    @app.post("/api/design")
+    def design():
+        return jsonify(run("design", _design_input(body())))
+
+    @app.post("/api/jobs")
+    def submit():
+        d = api.fields(body(), ("kind", "input"))
+        kind, payload = d["kind"], d["input"]
+        if kind == "solve":
+            payload = _problem(payload).to_dict()
+        elif kind == "design":
+            payload = _design_input(payload)
+        elif kind == "pareto":
+            p = api.fields(payload, ("problem", "objectives"), ("n",))
+            prob = _problem(p["problem"])
+            n = p.get("n", 9)
+            ok = isinstance(p["objectives"], list) and len(p["objectives"]) == 2
+            if not ok or not all(o in api.OBJECTIVES for o in p["objectives"]):
+                raise api.ApiError(f"objectives are two of {', '.join(api.OBJECTIVES)}")
+            if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= 50:
+                raise api.ApiError(f"n (points of the front) is an integer from 2 to 50, got {n!r:.20}")
+            payload = {"problem": prob.to_dict(), "objectives": p["objectives"], "n": n}
+        elif kind == "report":
+            api.mechanism(api.fields(payload, ("type", "params"), ("units", "theta2", "omega2")))
+        else:
+            raise api.ApiError(f"kind is solve, design, pareto or report, got {kind!r:.40}")
+        try:
+            job = jobs.submit(kind, payload)
+        except Busy as e:
+            raise api.ApiError(str(e), 429) from None
+        return jsonify(job.to_dict()), 202
+
+    @app.get("/api/jobs/<jid>")
+    def job_state(jid):
+        job = jobs.get(jid)
+        if job is None:
+            raise api.ApiError(f"no job {jid!r:.40}", 404)
+        return jsonify(job.to_dict())
+
+    @app.delete("/api/jobs/<jid>")
+    def job_cancel(jid):
+        job = jobs.cancel(jid)
+        if job is None:
+            raise api.ApiError(f"no job {jid!r:.40}", 404)
+        return jsonify(job.to_dict())
+
+    @app.post("/api/export/<fmt>")
+    def export(fmt):
+        from qropt.io import export as ex
+
+        d = api.fields(body(), ("type", "params"), ("units", "theta2"))
+        if fmt not in ("dxf", "svg", "json"):
+            raise api.ApiError(f"export formats are dxf, svg and json, got {fmt!r:.20}", 404)
+        m = api.mechanism(d)
+        theta2 = api.number(d, "theta2", 0.0, low=-1e6, high=1e6)
+        name = f"{type(m).__name__}.{fmt}"
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / name
+            if fmt == "dxf":
+                ex.to_dxf(m, path, theta2)
+            elif fmt == "svg":
+                ex.to_svg(m, path, theta2)
+            else:
+                ex.save_design(m, path, theta2_deg=math.degrees(theta2))
+            data = path.read_bytes()
+        mime = {"dxf": "application/dxf", "svg": "image/svg+xml", "json": "application/json"}[fmt]
+        return Response(data, mimetype=mime, headers={"Content-Disposition": f'attachment; filename="{name}"'})
+
+    return app

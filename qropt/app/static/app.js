@@ -1,0 +1,652 @@
+// qropt app: the pages over the JSON API (no external resources; SVG drawn here from the API's shapes).
+"use strict";
+
+const $ = (id) => document.getElementById(id);
+const SVGNS = "http://www.w3.org/2000/svg";
+const DEG = Math.PI / 180;
+const COLOURS = { absolute: "#000", relative: "#1565c0", normal: "#2e7d32", tangential: "#ef6c00",
+  sliding: "#6a1b9a", coriolis: "#c62828" };
+const WORK = "#2e7d32", RET = "#e65100";
+
+// The app's state; window.qropt lets a test read what the page shows and how fast it updates.
+const state = {
+  types: {}, type: null, params: {}, units: "m", analysis: null, frames: null, playing: false,
+  inflight: false, pending: false, updates: 0, answers: 0, designRows: [], selected: null, result: null, job: null,
+};
+window.qropt = state;
+
+// ---- the API --------------------------------------------------------------------------------------------
+async function call(method, url, body) {
+  const opts = { method, headers: {} };
+  if (body !== undefined) {
+    opts.headers["Content-Type"] = "application/json";
+    opts.body = JSON.stringify(body);
+  }
+  const r = await fetch(url, opts);
+  const text = await r.text();
+  let data = null;
+  try { data = JSON.parse(text); } catch (e) { data = null; }
+  if (!r.ok) throw new Error((data && data.error) || `${r.status} ${r.statusText}`);
+  return data === null ? text : data;
+}
+
+function say(text) { $("status").textContent = text || ""; }
+
+async function runJob(kind, input, progressEl, cancelBtn) {
+  const job = await call("POST", "/api/jobs", { kind, input });
+  state.job = job.id;
+  const t0 = performance.now();
+  if (cancelBtn) {
+    cancelBtn.disabled = false;
+    cancelBtn.onclick = () => call("DELETE", `/api/jobs/${job.id}`);
+  }
+  try {
+    for (;;) {
+      const s = await call("GET", `/api/jobs/${job.id}`);
+      const p = s.progress, secs = ((performance.now() - t0) / 1000).toFixed(1);
+      if (progressEl) {
+        progressEl.textContent = `${kind}: ${s.state}` + (p.total ? `, ${p.done} of ${p.total}` : "") + ` (${secs} s)`;
+      }
+      if (s.state === "done") return s.result;
+      if (["failed", "cancelled", "timeout"].includes(s.state)) throw new Error(`${kind} ${s.state}: ${s.error}`);
+      await new Promise((ok) => setTimeout(ok, 250));
+    }
+  } finally {
+    if (cancelBtn) cancelBtn.disabled = true;
+    state.job = null;
+  }
+}
+
+// ---- SVG ------------------------------------------------------------------------------------------------
+function el(tag, attrs, parent, text) {
+  const e = document.createElementNS(SVGNS, tag);
+  for (const [k, v] of Object.entries(attrs || {})) e.setAttribute(k, v);
+  if (text !== undefined) e.textContent = text;
+  if (parent) parent.appendChild(e);
+  return e;
+}
+function clear(svg) { while (svg.firstChild) svg.removeChild(svg.firstChild); }
+// The size in drawing units of `px` pixels in an svg whose viewBox is w x h (shown with "meet").
+function unitsPerPixel(svg, w, h, px) {
+  const r = svg.getBoundingClientRect();
+  const scale = Math.min((r.width || 400) / w, (r.height || 300) / h);
+  return px / scale;
+}
+const fmt = (v, d = 4) => (v === null || v === undefined || Number.isNaN(v) ? "-" : Number(v).toPrecision(d));
+const pts = (p) => p.map((q) => `${q[0]},${q[1]}`).join(" ");
+
+const STYLE = {
+  link: { stroke: "#37474f", "stroke-width": 4, fill: "none", "stroke-linecap": "round" },
+  plate: { stroke: "#37474f", "stroke-width": 2, fill: "#b0bec5", "fill-opacity": 0.6 },
+  slot: { stroke: "#37474f", "stroke-width": 1.5, fill: "#fff", "fill-opacity": 0.4 },
+  block: { stroke: "#263238", "stroke-width": 1.5, fill: "#90a4ae" },
+  ram: { stroke: "#263238", "stroke-width": 1.5, fill: "#607d8b" },
+  slide: { stroke: "#9e9e9e", "stroke-width": 1, "stroke-dasharray": "6 4", fill: "none" },
+  pivot: { stroke: "#000", "stroke-width": 1.5, fill: "#ffcc80" },
+  joint: { stroke: "#000", "stroke-width": 1.5, fill: "#fff" },
+};
+
+// A mechanism drawn in an svg: the view of its whole turn, the output's path coloured by stroke, the shapes.
+function drawMechanism(svg, drawing, shapes, label) {
+  clear(svg);
+  const [x, y, w, h] = drawing.view, pad = 0.06 * Math.max(w, h);
+  svg.setAttribute("viewBox", `${x - pad} ${-(y + h) - pad} ${w + 2 * pad} ${h + 2 * pad}`);
+  svg.setAttribute("preserveAspectRatio", "xMidYMid meet");
+  const g = el("g", { transform: "scale(1,-1)" }, svg);
+  if (drawing.path) {
+    const p = drawing.path.points, wk = drawing.path.working;
+    let run = [p[0]];
+    for (let i = 1; i < p.length; i++) {
+      run.push(p[i]);
+      if (i === p.length - 1 || wk[i] !== wk[i - 1]) {
+        el("polyline", { points: pts(run), fill: "none", stroke: wk[i - 1] ? WORK : RET, "stroke-width": 2.5,
+          "vector-effect": "non-scaling-stroke", class: wk[i - 1] ? "path-working" : "path-return" }, g);
+        run = [p[i]];
+      }
+    }
+  }
+  for (const s of shapes) {
+    const a = { ...(STYLE[s.part] || STYLE.link), "vector-effect": "non-scaling-stroke", "data-part": s.part };
+    if (s.kind === "line") {
+      el("line", { ...a, x1: s.points[0][0], y1: s.points[0][1], x2: s.points[1][0], y2: s.points[1][1] }, g);
+    } else if (s.kind === "circle") {
+      el("circle", { ...a, cx: s.points[0][0], cy: s.points[0][1], r: s.radius }, g);
+    } else if (s.kind === "polygon") {
+      el("polygon", { ...a, points: pts(s.points) }, g);
+    } else {
+      el("polyline", { ...a, points: pts(s.points) }, g);
+    }
+  }
+  if (label) {
+    const fs = unitsPerPixel(svg, w + 2 * pad, h + 2 * pad, 13);
+    el("text", { x: x - pad + fs * 0.5, y: -(y + h) - pad + fs * 1.2, "font-size": fs, fill: "#333" }, svg, label);
+  }
+}
+
+// Panels of curves over the crank angle in one svg: each its own y axis and label with units.
+function plotCycle(svg, th, panels, working, mark) {
+  clear(svg);
+  const W = 640, H = 90 * panels.length + 40, L = 70, R = 15, T = 10;
+  svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+  const ph = (H - T - 35) / panels.length;
+  const X = (t) => L + ((W - L - R) * t) / 360;
+  panels.forEach((pnl, k) => {
+    const top = T + k * ph, bottom = top + ph - 12;
+    const lo = Math.min(...pnl.y, 0), hi = Math.max(...pnl.y, 0), span = hi - lo || 1;
+    const Y = (v) => bottom - ((bottom - top) * (v - lo)) / span;
+    if (working) {
+      for (let i = 0; i + 1 < th.length; i++) {
+        if (working[i]) el("rect", { x: X(th[i]), y: top, width: X(th[i + 1]) - X(th[i]) + 0.5, height: bottom - top,
+          fill: "#e8f5e9" }, svg);
+      }
+    }
+    el("rect", { x: L, y: top, width: W - L - R, height: bottom - top, fill: "none", stroke: "#999" }, svg);
+    el("line", { x1: L, x2: W - R, y1: Y(0), y2: Y(0), stroke: "#bbb", "stroke-dasharray": "3 3" }, svg);
+    el("polyline", { points: th.map((t, i) => `${X(t)},${Y(pnl.y[i])}`).join(" "), fill: "none",
+      stroke: pnl.colour || "#1565c0", "stroke-width": 1.6 }, svg);
+    el("text", { x: 4, y: (top + bottom) / 2, "font-size": 11, fill: "#333" }, svg, pnl.label);
+    el("text", { x: L - 4, y: top + 10, "font-size": 9, "text-anchor": "end", fill: "#555" }, svg, fmt(hi, 3));
+    el("text", { x: L - 4, y: bottom, "font-size": 9, "text-anchor": "end", fill: "#555" }, svg, fmt(lo, 3));
+    if (mark !== undefined) {
+      el("line", { x1: X(mark), x2: X(mark), y1: top, y2: bottom, stroke: "#c62828", "stroke-width": 1 }, svg);
+    }
+  });
+  for (let t = 0; t <= 360; t += 60) {
+    el("text", { x: X(t), y: H - 20, "font-size": 10, "text-anchor": "middle", fill: "#333" }, svg, String(t));
+  }
+  el("text", { x: (L + W - R) / 2, y: H - 5, "font-size": 11, "text-anchor": "middle" }, svg,
+    "crank angle theta2 [deg]" + (working ? " (shaded: working stroke)" : ""));
+}
+
+// A velocity or acceleration polygon: each equation's terms head to tail from the pole o, the exact vector dashed.
+function drawPolygon(svg, equations, quantity, unit) {
+  clear(svg);
+  const eqs = equations.filter((e) => e.quantity === quantity);
+  const xs = [0], ys = [0], segs = [];
+  for (const e of eqs) {
+    let hx = 0, hy = 0;
+    for (const t of e.terms) {
+      const tx = hx + t.vector[0], ty = hy + t.vector[1];
+      segs.push({ from: [hx, hy], to: [tx, ty], term: t });
+      xs.push(tx); ys.push(ty);
+      hx = tx; hy = ty;
+    }
+    xs.push(e.exact[0]); ys.push(e.exact[1]);
+  }
+  const x0 = Math.min(...xs), x1 = Math.max(...xs), y0 = Math.min(...ys), y1 = Math.max(...ys);
+  const span = Math.max(x1 - x0, y1 - y0, 1e-12), pad = 0.18 * span;
+  svg.setAttribute("viewBox", `${x0 - pad} ${-y1 - pad} ${x1 - x0 + 2 * pad} ${y1 - y0 + 2 * pad}`);
+  const defs = el("defs", {}, svg);
+  for (const [k, c] of Object.entries(COLOURS)) {
+    const mk = el("marker", { id: `arrow-${quantity}-${k}`, viewBox: "0 0 10 10", refX: 10, refY: 5,
+      markerWidth: 7, markerHeight: 7, orient: "auto-start-reverse" }, defs);
+    el("path", { d: "M 0 0 L 10 5 L 0 10 z", fill: c }, mk);
+  }
+  const fs = unitsPerPixel(svg, x1 - x0 + 2 * pad, y1 - y0 + 2 * pad, 11);
+  const g = el("g", { transform: "scale(1,-1)" }, svg);
+  const drawn = new Set();
+  for (const s of segs) {
+    const key = s.from.concat(s.to).map((v) => Math.round(v / (1e-6 * span))).join(",");
+    if (drawn.has(key) || Math.hypot(s.term.vector[0], s.term.vector[1]) < 1e-12 * span) continue;
+    drawn.add(key);
+    el("line", { x1: s.from[0], y1: s.from[1], x2: s.to[0], y2: s.to[1], stroke: COLOURS[s.term.kind],
+      "stroke-width": 1.8, "vector-effect": "non-scaling-stroke",
+      "marker-end": `url(#arrow-${quantity}-${s.term.kind})` }, g);
+    if (Math.hypot(s.term.vector[0], s.term.vector[1]) < 0.15 * span) continue;  // short terms: no room to name
+    el("text", { x: (s.from[0] + s.to[0]) / 2, y: -(s.from[1] + s.to[1]) / 2, "font-size": fs, fill: COLOURS[s.term.kind],
+      transform: "scale(1,-1)" }, g, s.term.name);
+  }
+  for (const e of eqs) {
+    el("line", { x1: 0, y1: 0, x2: e.exact[0], y2: e.exact[1], stroke: "#777", "stroke-dasharray": "4 3",
+      "vector-effect": "non-scaling-stroke" }, g);
+  }
+  el("circle", { cx: 0, cy: 0, r: 0.012 * span, fill: "#000" }, g);
+  el("text", { x: x0 - pad + fs * 0.4, y: -y1 - pad + fs * 1.3, "font-size": fs * 1.2 }, svg,
+    `${quantity} polygon [${unit}]`);
+}
+
+// A scatter of two criteria whose points open their designs.
+function scatter(svg, pts2, xlabel, ylabel, onPick) {
+  clear(svg);
+  const W = 640, H = 300, L = 70, B = 40, T = 10, R = 15;
+  svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+  const xs = pts2.map((p) => p[0]), ys = pts2.map((p) => p[1]);
+  const xl = Math.min(...xs), xh = Math.max(...xs), yl = Math.min(...ys), yh = Math.max(...ys);
+  const X = (v) => L + ((W - L - R) * (v - xl)) / ((xh - xl) || 1) * 0.9 + 0.05 * (W - L - R);
+  const Y = (v) => H - B - (((H - B - T) * (v - yl)) / ((yh - yl) || 1)) * 0.9 - 0.05 * (H - B - T);
+  el("rect", { x: L, y: T, width: W - L - R, height: H - B - T, fill: "none", stroke: "#999" }, svg);
+  el("polyline", { points: pts2.map((p) => `${X(p[0])},${Y(p[1])}`).join(" "), fill: "none", stroke: "#90caf9" }, svg);
+  pts2.forEach((p, i) => {
+    const c = el("circle", { cx: X(p[0]), cy: Y(p[1]), r: 6, fill: "#1565c0", class: "front-point" }, svg);
+    c.style.cursor = "pointer";
+    el("title", {}, c, `${xlabel} ${fmt(p[0])}, ${ylabel} ${fmt(p[1])}`);
+    c.addEventListener("click", () => onPick(i));
+  });
+  el("text", { x: L, y: H - 22, "font-size": 10 }, svg, fmt(xl));
+  el("text", { x: W - R, y: H - 22, "font-size": 10, "text-anchor": "end" }, svg, fmt(xh));
+  el("text", { x: L - 4, y: H - B, "font-size": 10, "text-anchor": "end" }, svg, fmt(yl));
+  el("text", { x: L - 4, y: T + 10, "font-size": 10, "text-anchor": "end" }, svg, fmt(yh));
+  el("text", { x: (L + W) / 2, y: H - 5, "font-size": 11, "text-anchor": "middle" }, svg, xlabel);
+  el("text", { x: 12, y: (H - B) / 2, "font-size": 11, transform: `rotate(-90 12 ${(H - B) / 2})`,
+    "text-anchor": "middle" }, svg, ylabel);
+}
+
+function table(tbl, head, rows, onPick) {
+  tbl.innerHTML = "";
+  const tr = tbl.insertRow();
+  for (const h of head) { const th = document.createElement("th"); th.textContent = h; tr.appendChild(th); }
+  rows.forEach((r, i) => {
+    const row = tbl.insertRow();
+    for (const c of r) row.insertCell().textContent = c;
+    if (onPick) { row.className = "pick"; row.addEventListener("click", () => onPick(i)); }
+  });
+}
+
+// ---- pages ----------------------------------------------------------------------------------------------
+function route() {
+  const page = (location.hash || "#mechanism").slice(1);
+  for (const p of ["design", "mechanism", "synthesis"]) {
+    $(`page-${p}`).classList.toggle("shown", p === page);
+    $(`tab-${p}`).classList.toggle("active", p === page);
+  }
+}
+
+// Mechanism: a slider and a number box per parameter; every change analysed at once (one request in flight).
+function paramRange(kind, v, all) {
+  const longest = Math.max(0.05, ...Object.entries(all).filter(([k]) => state.types[state.type].kinds[k] === "length")
+    .map(([, x]) => Math.abs(x)));
+  if (kind === "angle") return [-180, 180, 0.1];
+  if (kind === "offset") return [-2 * longest, 2 * longest, longest / 500];
+  const hi = Math.max(2.5 * Math.abs(v), 0.2 * longest);
+  return [hi / 1000, hi, hi / 1000];
+}
+
+function showParams(type, params) {
+  state.type = type;
+  state.params = { ...params };
+  $("m-type").value = type;
+  const box = $("m-params");
+  box.innerHTML = "";
+  const kinds = state.types[type].kinds;
+  for (const [k, kind] of Object.entries(kinds)) {
+    if (!(k in state.params)) continue;
+    const label = document.createElement("label");
+    label.innerHTML = `<span>${k} <span class="unit">${{ angle: "deg", branch: "" }[kind] ?? state.units}</span></span>`;
+    if (kind === "branch") {
+      const s = document.createElement("select");
+      s.id = `p-${k}`;
+      for (const v of [1, -1]) s.add(new Option(v > 0 ? "+1" : "-1", v));
+      s.value = String(state.params[k]);
+      s.addEventListener("change", () => { state.params[k] = Number(s.value); analyze(); });
+      label.appendChild(s);
+    } else {
+      const shown = kind === "angle" ? state.params[k] / DEG : state.params[k];
+      const [lo, hi, step] = paramRange(kind, state.params[k], state.params);
+      const r = document.createElement("input");
+      Object.assign(r, { type: "range", min: lo, max: hi, step, value: shown, id: `p-${k}` });
+      const n = document.createElement("input");
+      Object.assign(n, { type: "number", step: "any", value: +shown.toPrecision(6), id: `n-${k}` });
+      const set = (v) => { state.params[k] = kind === "angle" ? v * DEG : v; analyze(); };
+      r.addEventListener("input", () => { n.value = +Number(r.value).toPrecision(6); set(Number(r.value)); });
+      n.addEventListener("change", () => { if (n.value !== "") { r.value = n.value; set(Number(n.value)); } });
+      label.append(r, n);
+    }
+    box.appendChild(label);
+  }
+  analyze();
+}
+
+function masses() {
+  if (!$("m-dyn").checked) return null;
+  return { masses: { density: Number($("m-density").value), ram: Number($("m-ram").value), block: 0, bodies: {} },
+    loads: { cutting_force: Number($("m-force").value), friction: 0, gravity: Number($("m-gravity").value),
+      follower_torque: 0 } };
+}
+
+// The live request (frames 0: no animation, no exact extremes) and the settled one (the turn's frames and,
+// with a mass model, the exact peaks), sent once the inputs rest.
+function request(frames) {
+  const body = { type: state.type, params: state.params, theta2: Number($("m-theta").value) * DEG,
+    omega2: Number($("m-omega").value), units: state.units, frames, polygons: frames === 0, extremes: frames > 0 };
+  const dyn = masses();
+  if (dyn) Object.assign(body, dyn);
+  return body;
+}
+
+let framesTimer = null;
+async function analyze() {
+  if (state.inflight) { state.pending = true; return; }
+  state.inflight = true;
+  state.pending = false;
+  stopAnimation();
+  try {
+    const a = await call("POST", "/api/analyze", request(0));
+    state.analysis = a;
+    state.updates += 1;
+    state.answers += 1;
+    $("m-error").textContent = "";
+    showAnalysis(a);
+  } catch (e) {
+    state.answers += 1;
+    $("m-error").textContent = e.message;
+  } finally {
+    state.inflight = false;
+    if (state.pending) analyze();
+  }
+  clearTimeout(framesTimer);
+  state.frames = null;
+  framesTimer = setTimeout(loadFrames, 400);
+}
+
+async function loadFrames() {
+  const asked = state.updates;
+  try {
+    const a = await call("POST", "/api/analyze", request(72));
+    if (asked !== state.updates) return;  // the design moved on meanwhile
+    state.frames = a.drawing;
+    if (a.dynamics) showForces(a.dynamics, Number($("m-theta").value), a.cycle.working);
+  } catch (e) { state.frames = null; }
+}
+
+function showAnalysis(a) {
+  const u = a.units, d = a.dead_centres, g = a.gamma_min, th = Number($("m-theta").value);
+  const out = a.output === "follower";
+  table($("m-numbers"), ["quantity", "value"], [
+    ["time ratio", fmt(a.time_ratio, 6)],
+    [out ? "swing [deg]" : `stroke [${u}]`, out ? fmt(a.stroke / DEG, 6) : fmt(a.stroke, 6)],
+    ["gamma_min [deg]", `${fmt(g.value_deg, 5)} at ${(g.theta2_deg % 360).toFixed(2)} deg (${g.joint})`],
+    ["dead centres [deg]", `${d.theta_max_deg.toFixed(2)}, ${d.theta_min_deg.toFixed(2)}`],
+    [`peak acceleration [${out ? "rad" : u}/s²]`, `${fmt(a.peak_accel.value, 5)} at ${a.peak_accel.theta2_deg.toFixed(2)} deg`],
+    [out ? "theta4 [rad]" : `x [${u}]`, fmt(a.state.x, 6)],
+    [out ? "omega4 [rad/s]" : `v [${u}/s]`, fmt(a.state.v, 6)],
+    [out ? "alpha4 [rad/s²]" : `a [${u}/s²]`, fmt(a.state.a, 6)],
+  ]);
+  $("m-numbers").dataset.timeRatio = a.time_ratio;
+  $("m-numbers").dataset.stroke = a.stroke;
+  $("m-numbers").dataset.gammaMin = g.value_deg;
+  const working = a.cycle.working;
+  drawMechanism($("m-svg"), a.drawing, a.drawing.shapes,
+    `theta2 = ${th} deg, ${working[Math.round(th / 2) % working.length] ? "working" : "return"} stroke`);
+  const ou = out ? "rad" : u;
+  plotCycle($("m-plot"), a.cycle.theta2_deg, [
+    { y: a.cycle.x, label: `x [${ou}]`, colour: "#1565c0" },
+    { y: a.cycle.v, label: `v [${ou}/s]`, colour: "#2e7d32" },
+    { y: a.cycle.a, label: `a [${ou}/s²]`, colour: "#c62828" },
+  ], working, th);
+  if (a.polygons) {
+    drawPolygon($("m-vpoly"), a.polygons, "velocity", `${u}/s`);
+    drawPolygon($("m-apoly"), a.polygons, "acceleration", `${u}/s²`);
+  } else {
+    clear($("m-vpoly")); clear($("m-apoly"));
+  }
+  if (a.dynamics) {
+    showForces(a.dynamics, th, working);
+  } else {
+    clear($("m-torque"));
+    $("m-forces").innerHTML = "";
+  }
+}
+
+function showForces(dy, th, working) {
+  plotCycle($("m-torque"), dy.torque.theta2_deg, [{ y: dy.torque.value, label: "torque [N m]", colour: "#6a1b9a" }],
+    working, th);
+  const rows = [
+    ["crank torque [N m]", fmt(dy.at.torque, 5)],
+    ...Object.entries(dy.at.joint_forces).map(([k, f]) => [`force at ${k} [N]`, fmt(Math.hypot(f[0], f[1]), 5)]),
+  ];
+  if (dy.peak_torque) {
+    rows.push(["peak torque [N m]", `${fmt(dy.peak_torque.value, 5)} at ${dy.peak_torque.theta2_deg.toFixed(2)} deg`]);
+    rows.push(["RMS torque [N m]", fmt(dy.rms_torque, 5)]);
+    rows.push(["peak shaking force [N]", fmt(dy.peak_shaking_force, 5)]);
+    if (dy.flywheel) rows.push(["flywheel for Cs 0.05 [kg m²]", fmt(dy.flywheel.inertia, 5)]);
+  } else {
+    rows.push(["peak torque [N m]", "(when the inputs rest)"]);
+  }
+  table($("m-forces"), ["at theta2", "value"], rows);
+}
+
+let animation = null;
+function stopAnimation() {
+  if (animation) cancelAnimationFrame(animation);
+  animation = null;
+  state.playing = false;
+  $("m-play").textContent = "Animate";
+}
+function play() {
+  if (state.playing) return stopAnimation();
+  if (!state.frames || !state.frames.frames.length) { say("the turn is still being computed"); return; }
+  state.playing = true;
+  $("m-play").textContent = "Stop";
+  const f = state.frames.frames, t0 = performance.now();
+  const step = (now) => {
+    const i = Math.floor(((now - t0) / 1000) * 24) % f.length;
+    drawMechanism($("m-svg"), state.frames, f[i].shapes,
+      `theta2 = ${f[i].theta2_deg.toFixed(0)} deg, ${f[i].working ? "working" : "return"} stroke`);
+    if (state.playing) animation = requestAnimationFrame(step);
+  };
+  animation = requestAnimationFrame(step);
+}
+
+function openDesign(type, params) {
+  location.hash = "#mechanism";
+  route();
+  showParams(type, params);
+}
+
+// Design: the task solved for every type in a worker, the rows ranked, each with its picture.
+async function runDesign(ev) {
+  ev.preventDefault();
+  const input = { time_ratio: Number($("d-tr").value), stroke: Number($("d-stroke").value),
+    objective: $("d-objective").value };
+  if ($("d-gamma").value !== "") input.conditions = { gamma_min: Number($("d-gamma").value) * DEG };
+  $("d-run").disabled = true;
+  $("d-table").innerHTML = "";
+  $("d-pictures").innerHTML = "";
+  try {
+    const c = await runJob("design", input, $("d-progress"), $("d-cancel"));
+    state.designRows = c.rows;
+    const u = c.units.length;
+    table($("d-table"), ["#", "type", "status", "gamma_min [deg]", `footprint [${u}²]`, `peak accel [${u}/s²]`, "reason"],
+      c.rows.map((r, i) => [i + 1, r.type, r.status, r.gamma_min === null ? "-" : fmt(r.gamma_min / DEG, 4),
+        fmt(r.footprint), fmt(r.peak_accel), r.reason || ""]),
+      (i) => c.rows[i].mechanism && openDesign(c.rows[i].mechanism, c.rows[i].params));
+    const ok = c.rows.filter((r) => r.mechanism);
+    state.selected = ok.length ? { type: ok[0].mechanism, params: ok[0].params } : null;
+    for (const r of ok) {
+      const card = document.createElement("div");
+      card.className = "card";
+      card.innerHTML = `<strong></strong><br><span></span>`;
+      card.querySelector("strong").textContent = r.type;
+      card.querySelector("span").textContent = `gamma_min ${fmt(r.gamma_min / DEG, 4)} deg, ${r.status}`;
+      const svg = el("svg", { role: "img" }, card);
+      card.addEventListener("click", () => openDesign(r.mechanism, r.params));
+      $("d-pictures").appendChild(card);
+      call("POST", "/api/analyze", { type: r.mechanism, params: r.params, theta2: 0, omega2: 1, polygons: false })
+        .then((a) => drawMechanism(svg, a.drawing, a.drawing.shapes)).catch((e) => { card.title = e.message; });
+    }
+  } catch (e) {
+    $("d-progress").textContent = e.message;
+  } finally {
+    $("d-run").disabled = false;
+  }
+}
+
+// Synthesis: a problem as a form or JSON, solved in a worker: every local optimum and the certificate; a front.
+function synthesisForm(type) {
+  const t = state.types[type], box = $("s-params");
+  box.innerHTML = "";
+  const head = document.createElement("div");
+  head.className = "s-head";
+  for (const h of ["", `value [${state.units}]`, "free", "low", "high"]) {
+    const sp = document.createElement("span");
+    sp.textContent = h;
+    head.appendChild(sp);
+  }
+  box.appendChild(head);
+  for (const [k, kind] of Object.entries(t.kinds)) {
+    if (kind === "branch" || !(k in t.params)) continue;
+    const v = t.params[k], label = document.createElement("label");
+    label.innerHTML = `<span>${k}</span>`;
+    const val = document.createElement("input");
+    Object.assign(val, { type: "number", step: "any", value: +v.toPrecision(5), id: `s-v-${k}` });
+    const free = document.createElement("input");
+    Object.assign(free, { type: "checkbox", id: `s-f-${k}`, title: "free, between the two bounds" });
+    const lo = document.createElement("input"), hi = document.createElement("input");
+    const span = Math.max(Math.abs(v), 0.05);
+    Object.assign(lo, { type: "number", step: "any", value: kind === "length" ? +(span / 5).toPrecision(3) : -+(3 * span).toPrecision(3), id: `s-lo-${k}` });
+    Object.assign(hi, { type: "number", step: "any", value: +(3 * span).toPrecision(3), id: `s-hi-${k}` });
+    label.append(val, free, lo, hi);
+    label.className = "s-row";
+    box.appendChild(label);
+  }
+}
+
+function formProblem() {
+  const type = $("s-type").value, t = state.types[type];
+  const fixed = {}, free = {};
+  for (const [k, kind] of Object.entries(t.kinds)) {
+    if (!(k in t.params)) continue;
+    if (kind === "branch") { fixed[k] = t.params[k]; continue; }
+    if ($(`s-f-${k}`).checked) free[k] = [Number($(`s-lo-${k}`).value), Number($(`s-hi-${k}`).value)];
+    else fixed[k] = Number($(`s-v-${k}`).value);
+  }
+  return { mechanism: type, fixed, free, targets: { time_ratio: Number($("s-tr").value), stroke: Number($("s-stroke").value) },
+    objective: $("s-objective").value };
+}
+
+function problemText() {
+  try { return JSON.parse($("s-json").value); } catch (e) { throw new Error(`the problem is not JSON: ${e.message}`); }
+}
+
+async function runSolve() {
+  $("s-solve").disabled = true;
+  $("s-result").innerHTML = "";
+  $("s-optima").innerHTML = "";
+  try {
+    const problem = problemText();
+    const r = await runJob("solve", problem, $("s-progress"), $("s-cancel"));
+    state.result = { problem, result: r };
+    const div = $("s-result");
+    const h = document.createElement("p");
+    h.innerHTML = `<span class="status-${r.status}"></span> <span></span>`;
+    h.children[0].textContent = r.status;
+    h.children[1].textContent = r.message;
+    div.appendChild(h);
+    if (r.certificate) {
+      const c = document.createElement("p");
+      c.textContent = `certificate: ${r.certificate.global_claim || "local only"}`;
+      c.id = "s-claim";
+      div.appendChild(c);
+    }
+    const type = problem.mechanism;
+    const free = Object.keys(problem.free || {});
+    const opt = r.local_optima && r.local_optima.length ? r.local_optima : (r.params && Object.keys(r.params).length ? [r] : []);
+    table($("s-optima"), ["#", "status", ...free, "gamma_min [deg]", "objective"],
+      opt.map((o, i) => [i + 1, o.status, ...free.map((k) => fmt(o.params[k], 6)),
+        o.quantities && o.quantities.gamma_min !== undefined ? fmt(o.quantities.gamma_min / DEG, 5) : "-", fmt(o.objective, 6)]),
+      (i) => openDesign(type, opt[i].params));
+    if (r.params && Object.keys(r.params).length) state.selected = { type, params: r.params };
+  } catch (e) {
+    $("s-progress").textContent = e.message;
+  } finally {
+    $("s-solve").disabled = false;
+  }
+}
+
+async function runFront() {
+  $("s-front").disabled = true;
+  try {
+    const problem = problemText();
+    const f = await runJob("pareto", { problem, objectives: ["max_gamma_min", "min_peak_accel"], n: 7 },
+      $("s-progress"), $("s-cancel"));
+    const [a, b] = f.criteria;
+    scatter($("s-front-svg"), f.values.map((v) => [a === "gamma_min" ? v[0] / DEG : v[0], v[1]]),
+      a === "gamma_min" ? "gamma_min [deg]" : a, `${b} [${f.units}/s²]`,
+      (i) => openDesign(problem.mechanism, f.points[i].params));
+  } catch (e) {
+    $("s-progress").textContent = e.message;
+  } finally {
+    $("s-front").disabled = false;
+  }
+}
+
+// Export from any page: the page's design as DXF, SVG or JSON, its HTML report; the page's result as JSON.
+function current(page) {
+  if (page === "mechanism") return { type: state.type, params: state.params, units: state.units };
+  return state.selected && { ...state.selected, units: state.units };
+}
+function download(name, data, mime) {
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(new Blob([data], { type: mime }));
+  a.download = name;
+  document.body.appendChild(a);
+  a.click();
+  setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 1000);
+}
+function exportBar(div) {
+  const page = div.dataset.from;
+  for (const fmt2 of ["dxf", "svg", "json", "report"]) {
+    const b = document.createElement("button");
+    b.type = "button";
+    b.textContent = fmt2 === "report" ? "HTML report" : fmt2.toUpperCase();
+    b.id = `export-${page}-${fmt2}`;
+    b.addEventListener("click", async () => {
+      const d = current(page);
+      if (!d) { say("no design on this page yet"); return; }
+      try {
+        const theta2 = Number($("m-theta").value) * DEG;
+        if (fmt2 === "report") {
+          say("writing the report...");
+          const r = await runJob("report", { ...d, theta2, omega2: Number($("m-omega").value) });
+          download(`${d.type}.html`, r.html, "text/html");
+          say("");
+        } else {
+          const r = await fetch(`/api/export/${fmt2}`, { method: "POST", headers: { "Content-Type": "application/json" },
+            body: JSON.stringify({ ...d, theta2 }) });
+          if (!r.ok) throw new Error((await r.json()).error);
+          download(`${d.type}.${fmt2}`, await r.blob(), r.headers.get("Content-Type"));
+        }
+      } catch (e) { say(e.message); }
+    });
+    div.appendChild(b);
+  }
+}
+
+async function start() {
+  window.addEventListener("hashchange", route);
+  route();
+  const info = await call("GET", "/api/types");
+  for (const t of info) {
+    state.types[t.type] = t;
+    $("m-type").add(new Option(`${t.class} (${t.type})`, t.type));
+    $("s-type").add(new Option(`${t.class} (${t.type})`, t.type));
+  }
+  $("m-type").addEventListener("change", () => showParams($("m-type").value, state.types[$("m-type").value].params));
+  $("m-theta").addEventListener("input", () => { $("m-theta-n").value = $("m-theta").value; analyze(); });
+  $("m-theta-n").addEventListener("change", () => { $("m-theta").value = $("m-theta-n").value; analyze(); });
+  for (const id of ["m-omega", "m-dyn", "m-density", "m-ram", "m-force", "m-gravity"]) $(id).addEventListener("change", analyze);
+  $("m-play").addEventListener("click", play);
+  $("design-form").addEventListener("submit", runDesign);
+  $("s-type").addEventListener("change", () => synthesisForm($("s-type").value));
+  $("s-to-json").addEventListener("click", () => { $("s-json").value = JSON.stringify(formProblem(), null, 2); });
+  $("s-solve").addEventListener("click", runSolve);
+  $("s-front").addEventListener("click", runFront);
+  $("s-file").addEventListener("change", async () => {
+    const f = $("s-file").files[0];
+    if (f) $("s-json").value = await f.text();
+  });
+  document.querySelectorAll(".export").forEach(exportBar);
+  const first = info.find((t) => t.type === "drag-link-slider") || info[0];
+  $("s-type").value = first.type;
+  synthesisForm(first.type);
+  const files = await call("GET", "/api/problems");
+  $("s-json").value = JSON.stringify(files.length ? files[0].problem : {
+    mechanism: "drag-link-slider", fixed: { r1: 0.1, r2: 0.225, r4: 0.275, r6: 0.3 },
+    free: { r3: [0.05, 1.0], r5: [0.01, 0.5] }, targets: { time_ratio: 1.5, stroke: 0.3 },
+    conditions: { grashof: "drag-link" }, objective: "max_gamma_min" }, null, 2);
+  const open = files.length ? state.types[files[0].problem.mechanism] : null;
+  showParams((open || first).type, (open || first).params);
+  document.body.dataset.ready = "1";
+}
+
+start().catch((e) => say(e.message));

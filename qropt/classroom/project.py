@@ -1,0 +1,581 @@
+"""One classroom project per seed: the paper's quick-return design and analysis project (Podhorodeski, Nokleby and
+Wittchen, its "Example project requirements"), drawn for one mechanism type.
+
+A project states: a time ratio and a stroke; an existing mechanism of the type (the given links, which stay, and
+the current lengths of the links to find); design requirement 1 (the links to find for the TR and stroke, best
+minimum transmission angle over the turn); design requirement 2 (the travel of one adjustable link: its whole
+working interval, and the part that covers a band of TRs); the four discussion issues; the analysis at a crank
+angle and speed by relative motion (polygons) and by computer; a simulation over a turn.
+
+The draws (numpy ``default_rng(seed)``, in this order each attempt): the TR from the type's range (two decimals),
+the stroke from STROKE_RANGE = 0.1..0.6 m (three decimals), each given link as a multiple of the stroke (three
+decimals), the TR band of requirement 2 (the TR minus 0.1..0.3, at least 1.05, to the TR plus 0.1..0.3), the crank
+angle (a multiple of 15 deg from 15 to 345) and omega2 (an integer from 5 to 20 rad/s). The TR ranges per type
+(``SPECS``): drag-link slider 1.45-1.8, crank-rocker slider 1.1-1.4, slider-crank 1.1-1.4, Whitworth, crank-shaper
+and slot-ram shaper 1.3-2.2 (a crank-rocker or an offset slider-crank gives only modest TRs with fair transmission
+angles; a drag-link with r1 about a third of the stroke no TR below about 1.45). A draw counts when requirement 1
+solves to a certified optimum (``qropt.solve``, status 'optimal') with gamma_min at least 15 deg (MIN_GAMMA),
+requirement 2's band lies on one monotone branch of the adjustable link, and the polygons exist; otherwise the
+next draw of the same generator is taken (at most MAX_DRAWS) and the number of redraws is recorded. Then the
+current lengths of the links to find are drawn (the solution's times 0.75..1.25, three decimals, a mechanism that
+works). Every number comes from the library code behind the command line.
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from qropt.errors import InvalidParameter, QroptError
+from qropt.studies._design import bounds_of
+
+STROKE_RANGE = (0.1, 0.6)  # m
+THETA2_STEP_DEG = 15
+OMEGA2_RANGE = (5, 20)  # rad/s, integers
+MAX_DRAWS = 50
+MIN_GAMMA = math.radians(15.0)  # a design worth building: its gamma_min over the turn at least this
+
+
+@dataclass(frozen=True)
+class Spec:
+    """A type's project: the class, the given links (multiples of the stroke), the links to find, the adjustable
+    link, the TR range, the solve's conditions, each link's name and the four discussion issues."""
+
+    mechanism: str
+    title: str
+    layout: str
+    given: dict
+    find: tuple
+    adjustable: str
+    time_ratio: tuple
+    conditions: dict
+    names: dict
+    issues: tuple
+
+
+_FOUR_BAR_NAMES = {
+    "r1": "distance between the fixed centres O2 and O4",
+    "r2": "crank O2A",
+    "r3": "coupler AB",
+    "r4": "follower O4B",
+    "r5": "pin C on the follower, O4C",
+    "r6": "slider's rod CD",
+}
+_LEVER_ISSUES = (
+    "How many mechanisms providing the specified TR are possible if only the crank radius r2 is varied?",
+    "What is the range of TR that would be possible by adjusting the crank radius r2 (within its bounds)?",
+    "How many feasible mechanism solutions would exist for a given TR if both the centre distance r1 and the "
+    "crank radius r2 could be changed?",
+    "Discuss the issues you would consider in the isolation of a unique mechanism design.",
+)
+
+
+def _four_bar(mechanism, title, grashof, given, tr) -> Spec:
+    return Spec(
+        mechanism,
+        title,
+        f"a {grashof} four-bar O2-A-B-O4 (O4 = (r1, 0)) drives pin C on the follower O4B; a rod CD drives the "
+        "slider D on the line through O2 and O4 (h = 0)",
+        given,
+        ("r3", "r5"),
+        "r3",
+        tr,
+        {"grashof": grashof},
+        _FOUR_BAR_NAMES,
+        (
+            "How many mechanisms providing a specific TR are possible if only r3 is varied?",
+            "What is the range of TR that would be possible by adjusting the length of the coupler?",
+            "How many feasible mechanism solutions would exist for a given TR if both the base length O2O4 and "
+            "the coupler length could be changed?",
+            "Discuss the issues you would consider in the isolation of a unique mechanism design.",
+        ),
+    )
+
+
+SPECS = {
+    "drag-link-slider": _four_bar(
+        "DragLinkSlider",
+        "drag-link-driven slider",
+        "drag-link",
+        {"r1": (0.25, 0.4), "r2": (0.65, 0.85), "r4": (0.85, 1.05), "r6": (0.9, 1.3)},
+        (1.45, 1.8),
+    ),
+    "crank-rocker-slider": _four_bar(
+        "CrankRockerSlider",
+        "crank-rocker-driven slider",
+        "crank-rocker",
+        {"r1": (0.9, 1.2), "r2": (0.25, 0.4), "r4": (0.7, 1.0), "r6": (1.8, 2.4)},
+        (1.1, 1.4),
+    ),
+    "whitworth": Spec(
+        "Whitworth",
+        "Whitworth quick-return",
+        "the crank O2A (O2 at the origin) turns the slotted lever about O4 = (0, -r1), r2 > r1; pin C on the "
+        "lever drives the rod CD and the ram D on the line through O4 (h = 0)",
+        {"r1": (0.15, 0.35), "r6": (1.2, 1.8)},
+        ("r2", "r5"),
+        "r2",
+        (1.3, 2.2),
+        {},
+        {
+            "r1": "distance between the fixed centres O2 and O4",
+            "r2": "crank O2A, the crank pin's radius",
+            "r5": "pin C on the slotted lever, O4C",
+            "r6": "ram's rod CD",
+        },
+        _LEVER_ISSUES,
+    ),
+    "crank-shaper": Spec(
+        "CrankShaper",
+        "crank-shaper",
+        "the crank O2A (O2 at the origin) rocks the slotted lever about O4 = (0, -r1), r2 < r1; pin C on the lever "
+        "at O4C = r4 drives the ram through a yoke (the ram moves with x_C)",
+        {"r1": (0.6, 1.0)},
+        ("r2", "r4"),
+        "r2",
+        (1.3, 2.2),
+        {},
+        {
+            "r1": "distance between the fixed centres O2 and O4",
+            "r2": "crank O2A, the crank pin's radius",
+            "r4": "pin C on the slotted lever, O4C",
+        },
+        _LEVER_ISSUES,
+    ),
+    "slot-ram-shaper": Spec(
+        "SlotRamShaper",
+        "slot-ram shaper",
+        "the crank O2A (O2 at the origin) rocks the slotted lever about O4 = (0, -r1), r2 < r1; the ram's pin D "
+        "rides in the lever's slot on the slide line a height h above O4",
+        {"r1": (0.6, 1.0)},
+        ("r2", "h"),
+        "r2",
+        (1.3, 2.2),
+        {},
+        {
+            "r1": "distance between the fixed centres O2 and O4",
+            "r2": "crank O2A, the crank pin's radius",
+            "h": "height of the slide line above O4",
+        },
+        _LEVER_ISSUES,
+    ),
+    "slider-crank": Spec(
+        "SliderCrank",
+        "offset slider-crank",
+        "the crank O2A (O2 at the origin) drives the slider C through the rod AC on the slide line y = e",
+        {"r3": (0.9, 1.4)},
+        ("r2", "e"),
+        "e",
+        (1.1, 1.4),
+        {},
+        {"r2": "crank O2A", "r3": "connecting rod AC", "e": "offset of the slide line from O2"},
+        (
+            "How many mechanisms providing the specified TR are possible if only the offset e is varied?",
+            "What is the range of TR that would be possible by adjusting the offset e (an adjustable slide)?",
+            "How many feasible mechanism solutions would exist for the given TR and stroke if the rod length r3 "
+            "could be changed too?",
+            "Discuss the issues you would consider in the isolation of a unique mechanism design.",
+        ),
+    ),
+}
+KINDS = tuple(SPECS)
+
+
+@dataclass(frozen=True)
+class Project:
+    """One drawn project and everything its solution needs (computed once, by the library).
+
+    Lengths in ``units`` (m), angles in rad, omega2 in rad/s. ``given``: the links that stay; ``current``: the
+    existing mechanism's lengths of the links to find (None where no drawn one works); ``band``: requirement 2's
+    TRs; ``redraws``: draws rejected before this one; ``problem``/``result``: requirement 1 and its solve;
+    ``reach``/``adjust``: requirement 2 (``qropt.reachable`` and ``Reachable.adjustable``)."""
+
+    kind: str
+    seed: int
+    time_ratio: float
+    stroke: float
+    given: dict
+    current: dict | None
+    find: tuple
+    adjustable: str
+    band: tuple
+    theta2: float
+    omega2: float
+    redraws: int
+    problem: object
+    result: object
+    reach: object
+    adjust: object
+    units: str = "m"
+
+    @property
+    def spec(self) -> Spec:
+        return SPECS[self.kind]
+
+    @property
+    def mechanism(self):
+        """The solved design (requirement 1)."""
+        return self.result.mechanism
+
+    def relative_motion(self):
+        """The solved design's velocity and acceleration equations at the project's theta2, omega2, alpha2 = 0."""
+        return self.mechanism.relative_motion(self.theta2, self.omega2, 0.0)
+
+    def polygon_ram(self) -> tuple[float, float]:
+        """(v, a) of the ram along the slide line from the polygons: the sums of the output joint's terms."""
+        rm, joint = self.relative_motion(), self.mechanism.output_joint()
+        out = {e.quantity: float(sum(t.vector for t in e.terms)[0]) for e in rm.equations if e.joint == joint}
+        return out["velocity"], out["acceleration"]
+
+    def computer_ram(self) -> tuple[float, float]:
+        """(v, a) of the ram from the exact analysis (``Mechanism.motion``, as ``qropt analyze``)."""
+        mo = self.mechanism.motion(np.array([self.theta2]), self.omega2, 0.0)
+        return float(mo.v[0]), float(mo.a[0])
+
+
+def _kind(kind) -> str:
+    if not isinstance(kind, str) or kind not in SPECS:
+        raise InvalidParameter(f"unknown project type {kind!r}; the types are {', '.join(KINDS)}")
+    return kind
+
+
+def _seed(seed) -> int:
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InvalidParameter(f"a project seed is an integer >= 0, got {seed!r}")
+    return int(seed)
+
+
+def _free_bounds(name: str, stroke: float) -> tuple:
+    return bounds_of("offset" if name in ("e", "h") else "length", stroke)
+
+
+def _scan_bounds(p: dict, name: str, stroke: float) -> tuple:
+    """The adjustable link's scanned interval: its bounds in requirement 1, for a slotted lever kept where the TR
+    stays below about 9 (r2 / r1 or r1 / r2 at most 0.95: the TR grows without bound as the ratio nears 1)."""
+    lo, hi = _free_bounds(name, stroke)
+    if name == "r2" and "r1" in p:
+        lo, hi = (max(lo, p["r1"] / 0.95), hi) if p["r2"] > p["r1"] else (lo, min(hi, 0.95 * p["r1"]))
+    return lo, hi
+
+
+def _attempt(kind: str, rng):
+    """One draw: (fields, problem, result, reach, adjust), or None when it is not a solvable project."""
+    from qropt import reachable, solve
+    from qropt.synthesis.problem import Problem
+
+    spec = SPECS[kind]
+    tr = round(float(rng.uniform(*spec.time_ratio)), 2)
+    s = round(float(rng.uniform(*STROKE_RANGE)), 3)
+    given = {k: round(float(rng.uniform(lo, hi)) * s, 3) for k, (lo, hi) in spec.given.items()}
+    band = (round(max(1.05, tr - float(rng.uniform(0.1, 0.3))), 2), round(tr + float(rng.uniform(0.1, 0.3)), 2))
+    theta2 = math.radians(THETA2_STEP_DEG * int(rng.integers(1, 360 // THETA2_STEP_DEG)))
+    omega2 = float(rng.integers(OMEGA2_RANGE[0], OMEGA2_RANGE[1] + 1))
+    fields = {"time_ratio": tr, "stroke": s, "given": given, "band": band, "theta2": theta2, "omega2": omega2}
+    problem = Problem(
+        spec.mechanism,
+        fixed=given,
+        free={k: _free_bounds(k, s) for k in spec.find},
+        targets={"time_ratio": tr, "stroke": s},
+        conditions=dict(spec.conditions),
+        objective="max_gamma_min",
+        name=f"{kind} TR {tr:g} stroke {s:g} m",
+    )
+    result = solve(problem)
+    if result.status != "optimal" or result.mechanism.gamma_min().value < MIN_GAMMA:
+        return None
+    try:
+        m = result.mechanism
+        reach = reachable(m, spec.adjustable, bounds=_scan_bounds(m.params, spec.adjustable, s))
+        low = math.ceil(100 * reach.time_ratio_range.low + 1) / 100  # the band within the reachable TRs
+        band = fields["band"] = (max(band[0], low), band[1])
+        adjust = reach.adjustable(*band)
+        m.relative_motion(theta2, omega2, 0.0)
+    except QroptError:
+        return None
+    return fields, problem, result, reach, adjust
+
+
+def _current(spec: Spec, m, rng) -> dict | None:
+    """The existing mechanism's lengths of the links to find: the solution's times 0.75..1.25 (a working one)."""
+    for _ in range(20):
+        cur = {k: round(m.params[k] * float(rng.uniform(0.75, 1.25)), 3) for k in spec.find}
+        try:
+            c = type(m)(**{**m.params, **cur}, units=m.units)
+            if c.broken_rules(spec.conditions.get("grashof")) or c.dead_centres().reversals != 1:
+                continue
+            c.time_ratio()
+        except QroptError:
+            continue
+        return cur
+    return None
+
+
+def project(kind: str, seed: int) -> Project:
+    """The project of this type and seed (see the module docstring for the draws and the ranges); the same seed
+    gives the same project. InvalidParameter for an unknown type or a bad seed, or when no draw of MAX_DRAWS is
+    solvable."""
+    kind, seed = _kind(kind), _seed(seed)
+    rng = np.random.default_rng(seed)
+    for attempt in range(MAX_DRAWS):
+        got = _attempt(kind, rng)
+        if got is not None:
+            fields, problem, result, reach, adjust = got
+            current = _current(SPECS[kind], result.mechanism, rng)
+            spec = SPECS[kind]
+            return Project(
+                kind=kind,
+                seed=seed,
+                current=current,
+                find=spec.find,
+                adjustable=spec.adjustable,
+                redraws=attempt,
+                problem=problem,
+                result=result,
+                reach=reach,
+                adjust=adjust,
+                **fields,
+            )
+    raise InvalidParameter(f"no solvable {kind} project in {MAX_DRAWS} draws of seed {seed}")
+
+
+# ---------------------------------------------------------------------------------------------------------- render
+
+
+def _f(v, digits=4) -> str:
+    return f"{v:.{digits}f}"
+
+
+def _link_rows(p: Project, values: dict, what: str) -> list:
+    return [(f"{k} [{p.units}]", p.spec.names[k], values[k], what) for k in values]
+
+
+def _statement(p: Project) -> str:
+    from qropt.io.report import _png
+
+    spec, u = p.spec, p.units
+    deg = math.degrees(p.theta2)
+    rows = _link_rows(p, p.given, "given: stays")
+    if p.current is not None:
+        rows += _link_rows(p, p.current, "current: to be redesigned")
+    finds = " and ".join(f"{k} ({spec.names[k]})" for k in p.find)
+    parts = [
+        f"<h1>Quick-return project: {html.escape(spec.title)} (seed {p.seed})</h1>",
+        "<h2>Background</h2>",
+        f"<p>An application requires a quick-return mechanism with a time ratio TR = {p.time_ratio:.3f} and a "
+        f"stroke of {p.stroke:.4f} {u}. Currently a {html.escape(spec.title)} exists: "
+        f"{html.escape(spec.layout)}. Its lengths:</p>",
+        _text_table(["link", "what", "length", ""], rows),
+    ]
+    if p.current is not None:
+        parts.append(_png(_current_figure(p)))
+    parts += [
+        f"<p>The given links are expensive to modify and stay. It is proposed to redesign {html.escape(finds)} so "
+        f"that the mechanism performs the task. Furthermore, {p.adjustable} ({html.escape(spec.names[p.adjustable])}"
+        ") should be adjustable for future modification to other TRs.</p>",
+        "<h2>Design</h2><ol>",
+        f"<li>Determine {html.escape(' and '.join(p.find))} satisfying TR = {p.time_ratio:.3f} and stroke = "
+        f"{p.stroke:.4f} {u} while keeping the given links; where several designs do it, choose the one with the "
+        "largest minimum transmission angle over the whole turn (gamma_min).</li>",
+        f"<li>Determine the range of {p.adjustable} the adjustable link should accommodate to allow the maximum "
+        f"number of TRs, and the travel of {p.adjustable} that covers every TR from {p.band[0]:.2f} to "
+        f"{p.band[1]:.2f}.</li></ol>",
+        "<h2>Discussion issues</h2><ol>" + "".join(f"<li>{html.escape(q)}</li>" for q in spec.issues) + "</ol>",
+        f"<h2>Analysis</h2><p>For the mechanism with TR = {p.time_ratio:.3f} and stroke = {p.stroke:.4f} {u}:</p><ol>",
+        f"<li>Evaluate the velocity and acceleration of the slider when theta2 = {deg:.0f} deg, using relative "
+        f"motion analysis (polygons). Use omega2 = {p.omega2:g} rad/s (counter-clockwise) and alpha2 = 0 "
+        "rad/s^2.</li>",
+        "<li>Check this result by computer (e.g. <code>qropt analyze</code>).</li>",
+        "<li>Simulate the mechanism for a complete revolution of the input crank: slider position, velocity and "
+        "acceleration against the crank angle.</li></ol>",
+        f"<p><small>Conventions: x to the right, y up, O2 at the origin, theta2 counter-clockwise from +x; "
+        f"TR = slow / fast crank interval between the dead centres. Drawn from numpy's default_rng({p.seed}): "
+        f"TR in {spec.time_ratio[0]}..{spec.time_ratio[1]}, stroke in {STROKE_RANGE[0]}..{STROKE_RANGE[1]} m, "
+        "given links as multiples of the stroke ("
+        + ", ".join(f"{k} {lo}..{hi}" for k, (lo, hi) in spec.given.items())
+        + f"), theta2 a multiple of {THETA2_STEP_DEG} deg, omega2 an integer in {OMEGA2_RANGE[0]}..{OMEGA2_RANGE[1]}"
+        f" rad/s; {p.redraws} draw(s) rejected as not solvable before this one.</small></p>",
+    ]
+    return "".join(parts)
+
+
+def _text_table(head, rows) -> str:
+    """``qropt.io.report._table`` with its text columns left-aligned."""
+    from qropt.io.report import _table
+
+    return _table(head, rows).replace("<table>", "<table class=text>", 1)
+
+
+def _current_figure(p: Project):
+    from qropt.io import plots
+
+    m = p.mechanism
+    cur = type(m)(**{**m.params, **p.current}, units=m.units)
+    fig, ax = plots.plt.subplots(figsize=(8, 4))
+    x0, x1, y0, y1 = plots.draw_mechanism(ax, cur, p.theta2)
+    fig.set_size_inches(8, min(7.0, max(3.0, 1.2 + 6.5 * (y1 - y0) / max(x1 - x0, 1e-300))))  # no empty bands
+    ax.set_title(f"the existing {p.spec.title} at theta2 = {math.degrees(p.theta2):.0f} deg (current lengths)")
+    ax.set_xlabel(f"x [{p.units}]")
+    ax.set_ylabel(f"y [{p.units}]")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def _solution(p: Project) -> str:
+    from qropt.io import plots
+    from qropt.io.report import _png, _table
+    from qropt.mechanisms.relative_motion import polygon_figure
+
+    spec, u, r, m = p.spec, p.units, p.result, p.mechanism
+    g = m.gamma_min()
+    c = r.certificate
+    rows = [(f"{k} [{u}]", spec.names.get(k, ""), m.params[k]) for k in p.find]
+    rows += [
+        ("time ratio [-]", "target " + f"{p.time_ratio:.3f}", m.time_ratio()),
+        (f"stroke [{u}]", "target " + f"{p.stroke:.4f}", m.stroke()),
+        ("gamma_min [deg]", f"at theta2 = {math.degrees(g.theta2):.2f} deg, joint {g.joint}", math.degrees(g.value)),
+    ]
+    optima = [
+        (o.status, *(o.params[k] for k in p.find), math.degrees(o.quantities["gamma_min"])) for o in r.local_optima
+    ]
+    parts = [
+        "<hr><h1>Worked solution</h1>",
+        "<h2>Design requirement 1</h2>",
+        f"<p>Solved by qropt (the same solve as <code>qropt synth</code>): status <b>{html.escape(r.status)}</b>. "
+        f"{html.escape(r.message)}</p>",
+        _table(["quantity", "", "value"], rows),
+        f"<p>Certificate: exact gamma_min over the whole turn {math.degrees(c.certified):.4f} deg, the NLP's value "
+        f"agreeing to {c.gap:.2g} rad after {c.rounds} exchange round(s); local: {html.escape(c.local)}; "
+        f"global: {html.escape(c.global_claim)}.</p>",
+        "<p>Every certified local optimum (best first):</p>",
+        _table(["status", *(f"{k} [{u}]" for k in p.find), "gamma_min [deg]"], optima),
+    ]
+    reach, adj = p.reach, p.adjust
+    t = reach.time_ratio_range
+    ivs = ", ".join(f"[{a:.4f}, {b:.4f}]" for a, b in reach.intervals)
+    scan = _scan_bounds(m.params, p.adjustable, p.stroke)
+    parts += [
+        "<h2>Design requirement 2: the adjustable link</h2>",
+        f"<p>With the other links as solved, {p.adjustable} works for {p.adjustable} in {ivs} {u} (scanned within "
+        f"{scan[0]:.4g}..{scan[1]:.4g} "
+        f"{u}): an adjustable link over this range allows the maximum number of TRs, from {t.low:.4f} "
+        f"({p.adjustable} = {t.low_at:.4f} {u}) to {t.high:.4f} ({p.adjustable} = {t.high_at:.4f} {u}). "
+        f"For TR {p.band[0]:.2f} to {p.band[1]:.2f}: {html.escape(adj.explanation)}.</p>",
+        _png(plots.reachable_figure(reach, p.band)),
+        "<h2>Discussion issues</h2><ol>",
+    ]
+    sols = reach.solutions(p.time_ratio)
+    parts += [
+        f"<li>{len(sols)} value(s) of {p.adjustable} give TR = {p.time_ratio:.3f} with the other links kept: "
+        + ", ".join(f"{x:.4f} {u}" for x in sols)
+        + f" (the TR against {p.adjustable} is the figure above: zero, one or more crossings of a level).</li>",
+        f"<li>Adjusting {p.adjustable} over its working range gives {t.low:.4f} &lt;= TR &lt;= {t.high:.4f}.</li>",
+        f"<li>{html.escape(_issue3(p))}</li>",
+        f"<li>{html.escape(_issue4(p))}</li></ol>",
+    ]
+    rm = p.relative_motion()
+    (vp, ap), (vc, ac) = p.polygon_ram(), p.computer_ram()
+    deg = math.degrees(p.theta2)
+    order = sorted(rm.table(), key=lambda e: e["quantity"] != "velocity")  # the velocity polygon first
+    every = [
+        (
+            e["quantity"],
+            e["joint"],
+            e["term"],
+            e["kind"],
+            e["magnitude"],
+            e["direction_deg"],
+            "solved" if e["solved"] else "known",
+        )
+        for e in order
+    ]
+    check = [
+        (f"slider velocity v [{u}/s]", vp, vc, vp - vc),
+        (f"slider acceleration a [{u}/s^2]", ap, ac, ap - ac),
+    ]
+    for e in sorted(rm.equations, key=lambda e: e.quantity != "velocity"):
+        polygon = float(np.hypot(*sum(t.vector for t in e.terms)))
+        exact = float(np.hypot(*e.exact))
+        unit = f"{u}/s^2" if e.quantity == "acceleration" else f"{u}/s"
+        terms = " + ".join(t.name for t in e.terms)
+        check.append((f"|{e.quantity} of {e.joint}| = |{terms}| [{unit}]", polygon, exact, polygon - exact))
+    parts += [
+        f"<h2>Analysis 1: relative motion at theta2 = {deg:.0f} deg, omega2 = {p.omega2:g} rad/s, alpha2 = 0</h2>",
+        "<p>The vector equations written dyad by dyad in the order the mechanism is built (directions "
+        "counter-clockwise from +x; 'known' from what came before or from a link's rate and length, 'solved' from "
+        "the polygon):</p>",
+        _table(["equation", "joint", "term", "kind", "magnitude", "direction [deg]", ""], every),
+        _png(polygon_figure(rm, u)),
+        "<h2>Analysis 2: the polygons checked by computer</h2>",
+        f"<p>The sums of each equation's terms (polygons) beside the exact analysis (<code>{html.escape(_command(p))}"
+        "</code> prints the same state):</p>",
+        _table(["quantity", "polygons", "computer (exact)", "difference"], check),
+        f"<h2>Analysis 3: a complete revolution at omega2 = {p.omega2:g} rad/s</h2>",
+        _png(plots.cycle_figure(m, p.theta2, p.omega2)),
+    ]
+    th = np.radians(np.arange(0, 360, 30))
+    mo = m.motion(th, p.omega2, 0.0)
+    rows = [(f"{math.degrees(a):.0f}", x, v, acc) for a, x, v, acc in zip(th, mo.x, mo.v, mo.a, strict=True)]
+    parts.append(_table(["theta2 [deg]", f"x [{u}]", f"v [{u}/s]", f"a [{u}/s^2]"], rows))
+    return "".join(parts)
+
+
+def _command(p: Project) -> str:
+    m = p.mechanism
+    flags = " ".join(f"--{k.replace('_', '-')} {v:.10g}" for k, v in m.params.items() if not (k == "h" and v == 0.0))
+    return f"qropt analyze {p.kind} {flags} --theta2 {math.degrees(p.theta2):.0f}deg --omega2 {p.omega2:g}"
+
+
+def _issue3(p: Project) -> str:
+    if p.kind in ("drag-link-slider", "crank-rocker-slider"):
+        return (
+            "A single infinity of solutions: with both r1 and r3 free the TR is one equation in two unknowns, which "
+            "leaves a curve of (r1, r3) designs (within the Grashof class); the stroke still fixes r5 alone."
+        )
+    if p.kind == "slider-crank":
+        return (
+            "A single infinity: the TR and the stroke are two equations in r2, r3 and e, which leaves a curve of "
+            "designs; each rod length has its crank and offset."
+        )
+    return (
+        "A single infinity: the TR depends on the ratio of r1 and r2 only, so it fixes the ratio and every centre "
+        "distance r1 has its crank r2; the stroke then fixes the remaining link."
+    )
+
+
+def _issue4(p: Project) -> str:
+    r, m = p.result, p.mechanism
+    found = len(r.local_optima)
+    g = math.degrees(m.gamma_min().value)
+    text = (
+        f"The task's equations left {found} certified local optimum(s); the minimum transmission angle over the "
+        f"whole turn (not only at the dead centres) isolates the design: gamma_min = {g:.2f} deg"
+    )
+    text += " (30 to 45 deg is the usual lower limit)." if g >= 30 else ", below the usual 30 to 45 deg limit: a "
+    if g < 30:
+        text += "better design needs other given links."
+    return (
+        text + " Size, the peak acceleration of the ram, the uniformity of the cutting speed and the adjustable "
+        "link's travel are the other issues to weigh."
+    )
+
+
+def render(project: Project, solution: bool = False) -> str:
+    """The project's page (one self-contained HTML document, pictures inline): the statement, and with
+    ``solution`` its worked solution."""
+    from qropt.io.report import CSS
+
+    if not isinstance(project, Project):
+        raise InvalidParameter(f"render takes a classroom Project, got {type(project).__name__}")
+    body = _statement(project) + (_solution(project) if solution else "")
+    what = "solution" if solution else "project"
+    title = f"qropt {what}: {project.kind} seed {project.seed}"
+    style = CSS + ".text td{text-align:left}.text td:nth-child(3){text-align:right}"
+    head = f"<meta charset='utf-8'><title>{html.escape(title)}</title><style>{style}</style>"
+    return f"<!DOCTYPE html><html><head>{head}</head><body>{body}</body></html>\n"
+
+
+__all__ = ["KINDS", "SPECS", "STROKE_RANGE", "Project", "Spec", "project", "render"]

@@ -1,0 +1,284 @@
+"""The web API (``qropt app``): the four documented calls answer what the library computes, jobs run in worker
+processes with progress, cancellation, a time limit and a bounded queue, and every bad input gets a 4xx with a
+one-line reason while the server keeps serving."""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+
+import numpy as np
+import pytest
+
+pytest.importorskip("flask")
+
+import qropt
+from qropt.app import create_app
+from qropt.app.defaults import SHIPPED, default_params
+from qropt.dynamics.cycle import CycleDynamics
+from qropt.dynamics.model import Loads, Masses
+from qropt.examples import paper_mechanism
+from qropt.io.export import load_design
+from qropt.mechanisms import mechanism_type
+
+PAPER = {"r1": 0.1, "r2": 0.225, "r3": 0.2504281217548, "r4": 0.275, "r5": 0.15, "r6": 0.3}
+README_PROBLEM = {
+    "mechanism": "DragLinkSlider",
+    "fixed": {"r1": 0.1, "r2": 0.225, "r4": 0.275, "r6": 0.3},
+    "free": {"r3": [0.05, 1.0], "r5": [0.01, 0.5]},
+    "targets": {"time_ratio": 1.5, "stroke": 0.3},
+    "conditions": {"grashof": "drag-link"},
+    "objective": "max_gamma_min",
+}
+
+
+@pytest.fixture(scope="module")
+def client():
+    app = create_app(["problems/user_watt_sixbar.py"], workers=1, time_limit=120)
+    yield app.test_client()
+    app.extensions["qropt_jobs"].close()
+
+
+def _wait(client, jid, timeout=120):
+    end = time.time() + timeout
+    while time.time() < end:
+        s = client.get(f"/api/jobs/{jid}").get_json()
+        if s["state"] not in ("queued", "running"):
+            return s
+        time.sleep(0.05)
+    raise AssertionError(f"job {jid} did not end in {timeout} s")
+
+
+def test_health_and_types(client):
+    h = client.get("/api/health").get_json()
+    assert h["status"] == "ok" and "drag-link-slider" in h["types"]
+    info = {t["type"]: t for t in client.get("/api/types").get_json()}
+    assert "problems.user_watt_sixbar:WattSixBarShaper" in info  # the problem file's type, served
+    for name, t in info.items():
+        m = mechanism_type(name)(**t["params"])  # every type opens with a valid design
+        assert m.stroke() > 0
+        if name in SHIPPED and name != "four-bar":
+            assert m.time_ratio() == pytest.approx(1.5, abs=2e-3) and m.stroke() == pytest.approx(0.3, abs=1e-3)
+    watt = info["problems.user_watt_sixbar:WattSixBarShaper"]
+    m = mechanism_type("problems.user_watt_sixbar:WattSixBarShaper")(**watt["params"])
+    from qropt.cli import load_problem
+
+    targets = load_problem("problems/user_watt_sixbar.py").targets  # it opens with its problem's solved design
+    assert m.time_ratio() == pytest.approx(targets["time_ratio"], abs=1e-6)
+    assert m.stroke() == pytest.approx(targets["stroke"], abs=1e-6)
+    assert list(watt["params"]) == [k for k in watt["kinds"] if k in watt["params"]]  # in the type's order
+
+
+def test_analyze_equals_the_library(client):
+    body = {"type": "drag-link-slider", "params": PAPER, "theta2": 1.0, "omega2": 10.0}
+    body |= {"masses": {"density": 1.57, "ram": 20.0}, "loads": {"cutting_force": 1000.0, "gravity": 9.81}}
+    r = client.post("/api/analyze", json=body)
+    assert r.status_code == 200, r.get_json()
+    a = r.get_json()
+    m = paper_mechanism()
+    assert a["time_ratio"] == pytest.approx(m.time_ratio(), rel=1e-12)
+    assert a["stroke"] == pytest.approx(0.3, rel=1e-12)
+    assert a["gamma_min"]["value_deg"] == pytest.approx(27.0082, abs=1e-4)
+    assert a["peak_accel"]["value"] == pytest.approx(m.peak_acceleration(10.0).value, rel=1e-12)
+    mo = m.motion(np.array([1.0]), 10.0)
+    assert a["state"]["v"] == pytest.approx(mo.v[0], rel=1e-12) and a["state"]["a"] == pytest.approx(mo.a[0], rel=1e-12)
+    assert len(a["cycle"]["x"]) == 181 and a["cycle"]["x"][30] == pytest.approx(m.motion(np.radians([60.0])).x[0])
+    # the polygons close on the ram's exact velocity and acceleration
+    for q, exact in (("velocity", mo.v[0]), ("acceleration", mo.a[0])):
+        (eq,) = [e for e in a["polygons"] if e["joint"] == "D" and e["quantity"] == q]
+        total = np.sum([t["vector"] for t in eq["terms"]], axis=0)
+        assert total == pytest.approx([exact, 0.0], abs=1e-9 * max(1.0, abs(exact)))
+    # the forces: the same exact dynamics as the library
+    cd = CycleDynamics(m, 10.0, 0.0, Masses(1.57, 20.0), Loads(1000.0, gravity=9.81))
+    d = cd.at(np.array([1.0]))
+    assert a["dynamics"]["at"]["torque"] == pytest.approx(d.torque[0], rel=1e-12)
+    assert a["dynamics"]["peak_torque"]["value"] == pytest.approx(cd.extremes().peak_torque.value, rel=1e-12)
+    f = d.joint_forces["O4"][0]
+    assert a["dynamics"]["at"]["joint_forces"]["O4"] == pytest.approx(f.tolist(), abs=1e-12 * np.hypot(*f))
+    # the drawing: the ram on the stroke's line, the working stroke the slow one
+    start, length = (math.radians(v) for v in a["working_arc_deg"])
+    assert length > math.pi  # TR 1.5: 216 deg
+    ram = [s for s in a["drawing"]["shapes"] if s["part"] == "joint" and s["name"] == "D"][0]
+    assert ram["points"][0][0] == pytest.approx(mo.x[0] + 0.0, abs=1e-12) or ram["points"][0][0] == pytest.approx(
+        m.positions(np.array([1.0])).points["D"][0][0]
+    )
+
+
+def test_analyze_frames_and_a_user_type(client):
+    info = {t["type"]: t for t in client.get("/api/types").get_json()}
+    name = "problems.user_watt_sixbar:WattSixBarShaper"
+    r = client.post("/api/analyze", json={"type": name, "params": info[name]["params"], "frames": 12})
+    assert r.status_code == 200, r.get_json()
+    d = r.get_json()["drawing"]
+    assert len(d["frames"]) == 12 and [f["theta2_deg"] for f in d["frames"]][:2] == pytest.approx([0.0, 30.0])
+    assert {f["working"] for f in d["frames"]} == {True, False}
+
+
+@pytest.mark.parametrize(
+    "body, status, words",
+    [
+        ("not json", 400, "not JSON"),
+        ([1, 2], 400, "JSON object"),
+        ({"params": {}}, 400, "missing field(s): type"),
+        ({"type": "nope", "params": {}}, 400, "unknown mechanism type 'nope'"),
+        ({"type": "os:system", "params": {}}, 400, "load a type of your own"),
+        ({"type": "slider-crank", "params": {"r2": -1, "r3": 1}}, 400, "r2 must be positive"),
+        ({"type": "slider-crank", "params": {"r2": 0.1}}, 400, "r3"),
+        ({"type": "slider-crank", "params": {"r2": 0.1, "r3": 0.3, "zz": 1}}, 400, "zz"),
+        ({"type": "slider-crank", "params": {"r2": "a", "r3": 0.3}}, 400, "finite number"),
+        ({"type": "slider-crank", "params": {"r2": 0.1, "r3": 0.3}, "omega2": 0}, 400, "omega2 must be nonzero"),
+        ({"type": "slider-crank", "params": {"r2": 0.1, "r3": 0.3}, "theta2": 1e300}, 400, "theta2 must lie"),
+        ({"type": "slider-crank", "params": {"r2": 0.1, "r3": 0.3}, "frames": 10**9}, 400, "frames"),
+        ({"type": "slider-crank", "params": {"r2": 0.1, "r3": 0.3}, "masses": 3}, 400, "masses"),
+        ({"type": "slider-crank", "params": {"r2": 0.1, "r3": 0.05}}, 400, ""),  # does not assemble
+        ({"type": "slider-crank", "params": {"r2": 0.1, "r3": 0.3}, "extra": 1}, 400, "unknown field(s): extra"),
+    ],
+)
+def test_bad_analyze_input_is_a_4xx_with_one_line(client, body, status, words):
+    r = client.post("/api/analyze", data=body if isinstance(body, str) else json.dumps(body))
+    assert r.status_code == status
+    err = r.get_json()["error"]
+    assert words in err and "\n" not in err and "Traceback" not in err
+    assert client.get("/api/health").status_code == 200  # still serving
+
+
+def test_routes_and_limits(client):
+    assert client.get("/api/nothing").status_code == 404
+    assert "error" in client.get("/api/nothing").get_json()
+    assert client.get("/api/analyze").status_code == 405
+    big = {"type": "slider-crank", "params": {"r2": 0.1, "r3": 0.3}, "pad": "x" * (2 << 20)}
+    assert client.post("/api/analyze", json=big).status_code == 413
+    page = client.get("/")
+    assert page.status_code == 200 and b"app.js" in page.data
+    assert b"http://" not in page.data and b"https://" not in page.data  # no external resources
+    for f in ("/app.js", "/app.css"):
+        text = client.get(f).data
+        assert b"https://" not in text and b"http://" not in text.replace(b"http://www.w3.org/2000/svg", b"")
+
+
+def test_solve_equals_the_library(client):
+    r = client.post("/api/solve", json=README_PROBLEM)
+    assert r.status_code == 200, r.get_json()
+    got = r.get_json()
+    want = qropt.solve(qropt.Problem.from_dict(README_PROBLEM))
+    assert got["status"] == want.status == "optimal"
+    assert got["params"]["r3"] == pytest.approx(want.params["r3"], rel=1e-10)
+    assert got["certificate"]["global_claim"] == want.certificate.global_claim
+    assert qropt.Result.from_dict(got).params == pytest.approx(want.params)
+
+
+@pytest.mark.parametrize(
+    "problem, words",
+    [
+        ({**README_PROBLEM, "mechanism": "os:system"}, "load a type of your own"),
+        ({**README_PROBLEM, "free": {"r3": [1.0, 0.5]}}, ""),
+        ({**README_PROBLEM, "objective": "max_happiness"}, "max_happiness"),
+        ({**README_PROBLEM, "colour": "red"}, "colour"),
+        ([1], "JSON object"),
+    ],
+)
+def test_bad_problems(client, problem, words):
+    r = client.post("/api/solve", json=problem)
+    assert r.status_code == 400
+    assert words in r.get_json()["error"]
+
+
+def test_design_equals_the_library(client):
+    body = {"time_ratio": 1.8, "stroke": 0.5, "objective": "max_gamma_min", "types": ["slider-crank", "crank-shaper"]}
+    r = client.post("/api/design", json=body)
+    assert r.status_code == 200, r.get_json()
+    rows = r.get_json()["rows"]
+    want = qropt.design(1.8, 0.5, types=["slider-crank", "crank-shaper"])
+    assert [x["type"] for x in rows] == [x.type for x in want.rows]
+    for got, w in zip(rows, want.rows, strict=True):
+        assert got["gamma_min"] == pytest.approx(w.criteria["gamma_min"], rel=1e-9)
+        assert got["mechanism"] == w.result.mechanism.KIND
+    for bad, words in (
+        ({"time_ratio": 0.5, "stroke": 0.3}, "time_ratio must lie"),
+        ({"time_ratio": 1.5}, "missing field(s): stroke"),
+        ({"time_ratio": 1.5, "stroke": 0.3, "objective": "fastest"}, "objective is one of"),
+        ({"time_ratio": 1.5, "stroke": 0.3, "types": ["nope"]}, "unknown mechanism type"),
+        ({"time_ratio": 1.5, "stroke": 0.3, "bounds": [1]}, "bounds is an object"),
+    ):
+        r = client.post("/api/design", json=bad)
+        assert r.status_code == 400 and words in r.get_json()["error"], (bad, r.get_json())
+
+
+def test_jobs_progress_and_cancel(client):
+    r = client.post("/api/jobs", json={"kind": "design", "input": {"time_ratio": 1.6, "stroke": 0.4}})
+    assert r.status_code == 202
+    jid = r.get_json()["id"]
+    seen = 0
+    for _ in range(400):
+        s = client.get(f"/api/jobs/{jid}").get_json()
+        seen = max(seen, s["progress"]["done"])
+        if seen >= 1:
+            break
+        time.sleep(0.05)
+    assert s["progress"]["total"] == 8 and seen >= 1  # rows report as they finish
+    c = client.delete(f"/api/jobs/{jid}").get_json()
+    assert c["id"] == jid
+    assert _wait(client, jid)["state"] == "cancelled"
+    # the next job runs in a new worker process
+    r = client.post("/api/jobs", json={"kind": "solve", "input": README_PROBLEM})
+    s = _wait(client, r.get_json()["id"])
+    assert s["state"] == "done" and s["result"]["status"] == "optimal"
+    assert client.get("/api/jobs/99999").status_code == 404
+    assert client.delete("/api/jobs/99999").status_code == 404
+    assert client.post("/api/jobs", json={"kind": "shell", "input": {}}).status_code == 400
+
+
+def test_export_and_report(client, tmp_path):
+    d = {"type": "drag-link-slider", "params": PAPER, "theta2": 0.5}
+    dxf = client.post("/api/export/dxf", json=d)
+    assert dxf.status_code == 200 and b"SECTION" in dxf.data
+    svg = client.post("/api/export/svg", json=d)
+    assert svg.status_code == 200 and b"<svg" in svg.data
+    js = client.post("/api/export/json", json=d)
+    (tmp_path / "d.json").write_bytes(js.data)
+    assert load_design(tmp_path / "d.json").params == paper_mechanism().params | {"r3": PAPER["r3"]}
+    assert client.post("/api/export/exe", json=d).status_code == 404
+    r = client.post("/api/jobs", json={"kind": "report", "input": {**d, "omega2": 10.0}})
+    s = _wait(client, r.get_json()["id"])
+    assert s["state"] == "done" and "time ratio" in s["result"]["html"] and "polygons" in s["result"]["html"]
+
+
+def test_time_limit_and_bounded_queue():
+    app = create_app(workers=1, queue_size=1, time_limit=1.0)
+    c = app.test_client()
+    try:
+        slow = {"kind": "design", "input": {"time_ratio": 2.2, "stroke": 1.0, "objective": "min_peak_accel"}}
+        first = c.post("/api/jobs", json=slow).get_json()["id"]
+        for _ in range(200):  # running: the queue is empty again
+            if c.get(f"/api/jobs/{first}").get_json()["state"] == "running":
+                break
+            time.sleep(0.05)
+        second = c.post("/api/jobs", json=slow)
+        assert second.status_code == 202
+        third = c.post("/api/jobs", json=slow)
+        assert third.status_code == 429 and "waiting" in third.get_json()["error"]
+        s = _wait(c, first, 30)
+        assert s["state"] == "timeout" and "time limit of 1 s" in s["error"]
+        c.delete(f"/api/jobs/{second.get_json()['id']}")
+        r = c.post("/api/design", json={"time_ratio": 2.2, "stroke": 1.0, "objective": "min_peak_accel"})
+        assert r.status_code == 408 and "time limit" in r.get_json()["error"]
+    finally:
+        app.extensions["qropt_jobs"].close()
+
+
+def test_cli_app_bad_input(capsys):
+    from qropt.cli import main
+
+    assert main(["app", "--port", "70000", "--no-browser"]) != 0
+    err = capsys.readouterr().err.strip()
+    assert "--port" in err and "\n" not in err
+    assert main(["app", "no_such_problem.py", "--no-browser", "--port", "0"]) != 0
+    assert "no_such_problem.py" in capsys.readouterr().err
+
+
+def test_defaults_follow_the_types():
+    for kind in SHIPPED:
+        cls = mechanism_type(kind)
+        assert set(default_params(cls)) <= set(cls.PARAMS)
+        assert set(cls.required()) <= set(default_params(cls))
