@@ -180,17 +180,34 @@ def test_min_peak_accel_is_global():
 
 
 # ---- infeasible, degenerate, malformed ------------------------------------------------------------------
-def test_unreachable_time_ratio_is_infeasible_with_the_range():
+def test_a_time_ratio_beyond_the_sampled_range_is_said_with_the_range_not_claimed_infeasible():
+    """No closed form applies (r3 free over an interval): the range is sampled, so the answer is 'failed' with
+    the range, never 'infeasible' (a sampled range proves nothing beyond it; the all-free slider-crank's ended
+    at TR 1.545 where a design with TR 2.479 exists, test_a_design_beyond_the_sampled_range_is_found)."""
     p = load("paper_drag_link").replace(free={"r3": (0.15, 0.4), "r5": (0.01, 0.5)}, targets={"time_ratio": 1.2})
     r = solve(p)
-    assert r.status == "infeasible" and not r.success and r.mechanism is None
+    assert r.status == "failed" and not r.success and r.mechanism is None
     lo, hi = r.reachable["time_ratio"]
     # independent: dense scan of the paper's eq. (5) over the Grashof interval
     r3 = np.linspace(0.15 + 1e-9, 0.4 - 1e-9, 200001)
     tr = np.array([analytic.paper_time_ratio(0.1, 0.225, x, 0.275) for x in r3[::100]])
     assert lo == pytest.approx(1.4298489, abs=1e-6) and lo == pytest.approx(tr.min(), abs=1e-6)
     assert hi == pytest.approx(tr.max(), abs=1e-3)
-    assert "time_ratio 1.2 is below the reachable 1.42985" in r.message
+    assert "time_ratio 1.2 is below the sampled range 1.42985" in r.message
+
+
+def test_a_design_beyond_the_sampled_range_is_found():
+    """The all-free slider-crank's sampled TR range ended at 1.545; a design with TR 2.479 exists (gamma_min
+    3.45 deg) and the solve finds it, checked by brute force."""
+    from qropt.studies._design import type_problem
+
+    r = solve(type_problem("slider-crank", 2.479, 0.2952))
+    assert r.status == "optimal", r.message
+    p = {k: r.params[k] for k in ("r2", "r3", "e")} | {"sigma_slider": r.params["sigma_slider"]}
+    th_max, th_min, x_max, x_min = brute.dead_centres("slider-crank", p)
+    assert brute.time_ratio(th_max, th_min) == pytest.approx(2.479, rel=1e-6)
+    assert x_max - x_min == pytest.approx(0.2952, rel=1e-6)
+    assert brute.gamma_min("slider-crank", p) == pytest.approx(r.objective, abs=1e-6)
 
 
 def test_contradictory_targets_are_infeasible():

@@ -4,8 +4,9 @@ In order, each step only where the ones before said nothing:
 1. each bound condition against the best value of its criterion among designs that meet the targets (one solve
    of that criterion, without diagnosis): a bound beyond it is 'infeasible', and that solve's designs that meet
    every bound start one refinement of the problem;
-2. each target against its reachable range (``Solver.target_range``: sampled designs and RANGE_SOLVES local
-   solves): a target outside it is 'infeasible';
+2. each target against its range (``Solver.target_range``: sampled designs and RANGE_SOLVES local solves): a
+   range is sampled, so a target outside it is said, not proved absent ('infeasible' only where a complete
+   closed form gives no design);
 3. a feasibility solve (no objective): a design meeting every target and condition found there starts one
    refinement of the objective, and otherwise makes the answer 'failed' (the optimum was not reached), never
    'infeasible';
@@ -53,22 +54,23 @@ class Diagnosis:
             )
             if r.success:
                 return r
-        # a complete enumeration that gives no design proves there is none: its ranges are sampled only
-        proved = plan.kind == "enumeration" and not plan.analytic and not plan.outside
+        # a complete enumeration that gives no design proves there is none; the ranges are sampled (designs and
+        # local solves): a target beyond them proves nothing (the all-free slider-crank reaches TR 2.479 at
+        # r2 = 0.1386, r3 = 0.1610, e = 0.0222 where its sampled range ended at 1.545), so the search goes on
+        proved = plan.kind == "enumeration" and not plan.analytic  # (every design it gives outside the bounds)
         reach = self.solver.target_ranges(
             problem, targets, list(targets), starts_n=n, seed=seed, solves=RANGE_SOLVES, toward=True
         )
-        msgs = [range_message(problem, k, targets[k], lo, hi) for k, (lo, hi) in reach.items()]
+        msgs = [range_message(problem, k, targets[k], lo, hi, proved) for k, (lo, hi) in reach.items()]
         outside = [  # a target beyond the designs found; none found proves nothing
             m
             for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True)
             if math.isfinite(lo) and not inside(targets[k], lo, hi)
         ]
         if proved:
-            why = f"no design: the closed form that gives every design ({plan.how}) gives none for these targets"
+            where = " inside the bounds" if plan.outside else ""
+            why = f"no design: the closed form that gives every design ({plan.how}) gives none{where} for these targets"
             return done("infeasible", "; ".join([why, *msgs]), reachable=reach)
-        if outside:
-            return done("infeasible", "; ".join(outside), reachable=reach)
         if retry is not None:  # the multi-start's second pass: every space-filling start both ways
             cands = cands + retry()
             if any(c.ok for c in cands):
@@ -104,7 +106,8 @@ class Diagnosis:
                 ends[k] = ends.get(k, 0) + 1
             how = ", ".join(f"{n} {k}" for k, n in sorted(ends.items(), key=lambda kv: -kv[1]))
             msg = f"none of {len(cands)} starts reaches a design meeting the targets and conditions together "
-            msg += f"({self.solver.backend.name}: {how}), though each target alone can be met (" + "; ".join(msgs) + ")"
+            alone = "though each target alone can be met" if not outside else "and the designs sampled for the ranges"
+            msg += f"({self.solver.backend.name}: {how}), {alone} (" + "; ".join(msgs) + ")"
             if found:  # a design meeting every target and condition exists: the objective's solves failed
                 shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
                 msg += (
@@ -171,12 +174,15 @@ def inside(v, lo, hi) -> bool:
     return lo - tol <= v <= hi + tol
 
 
-def range_message(problem, k, v, lo, hi):
+def range_message(problem, k, v, lo, hi, proved: bool = True):
+    """A target against its range: 'the reachable' range where a complete closed form proves it, else the range
+    of the designs sampled (which proves nothing beyond them)."""
     bounds = ", ".join(f"{n} in [{a:g}, {b:g}]" for n, (a, b) in problem.free.items())
     if not math.isfinite(lo):
         return f"no sampled design turns fully and meets the conditions for {bounds}"
     where = "inside" if inside(v, lo, hi) else "below" if v < lo else "above"
-    return f"{k} {v:g} is {where} the reachable {lo:.6g}..{hi:.6g} for {bounds}"
+    reach = "the reachable" if proved else "the sampled range"
+    return f"{k} {v:g} is {where} {reach} {lo:.6g}..{hi:.6g} for {bounds}"
 
 
 def _dead_point_hint(problem) -> str:

@@ -47,6 +47,8 @@ class MultiStart:
                 runs += [("analytic", v, *b) for _, v, *b in self.family_starts(problem, plan, designs)]
             else:
                 runs += [("analytic", v) for v in plan.analytic]
+            if not extra:  # shapes best by the objective among many, on a grid
+                runs += [("shape", v) for v in starts_.shapes(problem, starts_.SHAPES_KEEP, seed)]
             runs += [("multistart", v) for v in starts_.sobol(problem, starts_n, seed, designs)]
         cands += self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
         spread = [r for r in runs if r[0] == "multistart"]

@@ -215,7 +215,10 @@ class Solver:
                 reverse=criteria.maximises(problem.objective),
             )
             k = len(best_first)
-            claim = claim or f"best of {k} distinct local optima from {len(cands)} starts"
+            if not claim:
+                shaped = sum(c.origin == "shape" for c in cands)
+                how = f" ({shaped} chosen by the objective among {starts_.SHAPES} grid shapes)" if shaped else ""
+                claim = f"best of {k} distinct local optima from {len(cands)} starts{how}"
             stats.update(t_total=time.perf_counter() - t0, local_optima=k)
             local = [
                 self._result(problem, c, "local_optimum" if i else None, claim, stats) for i, c in enumerate(best_first)

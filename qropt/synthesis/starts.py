@@ -205,11 +205,7 @@ def grid_cycle(problem, pts: list[dict]) -> tuple[np.ndarray, np.ndarray]:
             rows = min(SCREEN_CHUNK, len(pts) - i)
             loop = cls.loop(NUMPY, theta[None, :], {**base, **problem.fixed, **branch, **part})
             x = np.broadcast_to(loop.x, (rows, theta.size))
-            ok = np.all(np.isfinite(x), axis=1)
-            for _, margin in loop.margins:
-                ok &= np.all(np.broadcast_to(margin, x.shape) >= 0, axis=1)
-            dx = np.diff(x, axis=1, append=x[:, :1])
-            ok &= np.count_nonzero(np.sign(dx) != np.sign(np.roll(dx, 1, axis=1)), axis=1) == 2
+            ok = _turns(loop, x)
             a = (theta[np.argmin(x, axis=1)] - theta[np.argmax(x, axis=1)]) % (2 * np.pi)
             a = np.minimum(a, 2 * np.pi - a)
             ok &= a > 0
@@ -226,6 +222,106 @@ def turning_points(problem, n: int, seed: int) -> list[dict]:
     except (TypeError, ValueError, IndexError):  # a user type's loop that takes one design at a time
         return pts[:n]
     return [pts[i] for i in np.flatnonzero(np.isfinite(tr))[:n].tolist()]
+
+
+SHAPES = 32768  # rule points a shape search draws
+SHAPES_GRID = 64  # its crank angles (dead centres refined by the grid parabola)
+SHAPES_WINDOW = 0.02  # relative: shapes this near the TR target compete on their objective
+SHAPES_KEEP = 4  # starts a shape search gives, best by the grid objective first
+
+
+def shapes(problem, n: int, seed: int) -> list[dict]:
+    """Up to n starts chosen by the objective: SHAPES rule points on a SHAPES_GRID grid in vectorised passes
+    (no mechanism built), those that close everywhere with one output reversal, scaled to the stroke target
+    (TR, gamma_min and the shape do not change with scale) and inside the bounds, within SHAPES_WINDOW of the TR
+    target, best first by the objective's grid value (gamma_min, the peak acceleration at omega2 or the
+    footprint). [] where scaling is not free or the objective has no grid value here. Grid values choose starts;
+    results come from the local solves."""
+    scalable = [k for k, kind in problem.mechanism.kinds().items() if kind in ("length", "offset")]
+    grid_objective = {"max_gamma_min": 0, "min_peak_accel": 1}.get(problem.objective)
+    if problem.objective == "min_size" and problem.size == "footprint":
+        grid_objective = 2
+    target = problem.targets.get("stroke")
+    if grid_objective is None or target is None or "time_ratio" not in problem.targets or n <= 0:
+        return []
+    if any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable):
+        return []
+    cls, branch, names = problem.mechanism, branches(problem)[0], list(problem.free)
+    pts = rule_points(problem, SHAPES, seed, least=SHAPES // 8)
+    cols = {k: np.array([v[k] for v in pts], float) for k in names}
+    given = {**problem.fixed, **branch, **{k: 1.0 for k in names}}
+    base = {k: v for k, v in cls.PARAMS.items() if k not in given and isinstance(v, (int, float))}
+    base.update(cls.completed(given))
+    theta = np.linspace(0.0, 2 * np.pi, SHAPES_GRID, endpoint=False)
+    wave = np.fft.rfftfreq(SHAPES_GRID, 1.0 / SHAPES_GRID) ** 2
+    tr_target, found = problem.targets["time_ratio"], []
+    with np.errstate(all="ignore"):
+        for i in range(0, len(pts), SCREEN_CHUNK):
+            part = {k: c[i : i + SCREEN_CHUNK, None] for k, c in cols.items()}
+            rows = min(SCREEN_CHUNK, len(pts) - i)
+            try:
+                loop = cls.loop(NUMPY, theta[None, :], {**base, **problem.fixed, **branch, **part})
+            except (TypeError, ValueError, IndexError):  # a user type's loop that takes one design at a time
+                return []
+            x = np.broadcast_to(loop.x, (rows, theta.size))
+            ok = _turns(loop, x)
+            (t_hi, x_hi), (t_lo, x_lo) = _vertex(x, np.argmax(x, axis=1)), _vertex(x, np.argmin(x, axis=1))
+            a = (t_lo - t_hi) % (2 * np.pi)
+            tr = np.maximum(a, 2 * np.pi - a) / np.minimum(a, 2 * np.pi - a)
+            scale = target / (x_hi - x_lo)
+            ok &= np.abs(tr / tr_target - 1.0) <= SHAPES_WINDOW
+            for k in names:
+                lo, hi = problem.free[k]
+                v = cols[k][i : i + rows] * (scale if k in scalable else 1.0)
+                ok &= (v >= lo) & (v <= hi)
+            if not ok.any():
+                continue
+            if grid_objective == 0:
+                value = -np.full(rows, np.pi / 2)
+                for lines in loop.transmission.values():
+                    if lines is not None:
+                        g = np.broadcast_to(_acute(lines), x.shape).min(axis=1)
+                        value = np.maximum(value, -g)
+            elif grid_objective == 1:
+                d2 = np.fft.irfft(-wave * np.fft.rfft(x, axis=1), n=theta.size, axis=1)
+                value = np.abs(d2).max(axis=1) * scale * problem.omega2**2
+            else:
+                xs = np.concatenate([np.broadcast_to(q[0], x.shape) for q in loop.points.values()], axis=1)
+                ys = np.concatenate([np.broadcast_to(q[1], x.shape) for q in loop.points.values()], axis=1)
+                value = np.ptp(xs, axis=1) * np.ptp(ys, axis=1) * scale**2
+            ok &= np.isfinite(value)
+            for j in np.flatnonzero(ok).tolist():
+                v = {k: float(cols[k][i + j] * (scale[j] if k in scalable else 1.0)) for k in names}
+                found.append((float(value[j]), v))
+    found.sort(key=lambda f: f[0])
+    return [v for _, v in found[:n]]
+
+
+def _vertex(x, j):
+    """The vertex of the parabola through each row's grid point j of x (n, m) and its neighbours on a uniform
+    grid over a turn: (angle, value)."""
+    r, m = np.arange(x.shape[0]), x.shape[1]
+    a, b, c = x[r, (j - 1) % m], x[r, j], x[r, (j + 1) % m]
+    den = a - 2 * b + c
+    u = np.where(den != 0, 0.5 * (a - c) / np.where(den != 0, den, 1.0), 0.0)
+    return (j + u) * (2 * np.pi / m), b - 0.25 * (a - c) * u
+
+
+def _acute(lines):
+    """The transmission angle (rad, [0, pi/2]) of a joint's two lines, on arrays."""
+    from qropt.kinematics.closures import transmission_angle
+
+    return transmission_angle(NUMPY, lines)
+
+
+def _turns(loop, x) -> np.ndarray:
+    """Which designs of a vectorised loop close at every grid angle and whose output reverses exactly twice."""
+    ok = np.all(np.isfinite(x), axis=1)
+    for _, margin in loop.margins:
+        ok &= np.all(np.broadcast_to(margin, x.shape) >= 0, axis=1)
+    dx = np.diff(x, axis=1, append=x[:, :1])
+    ok &= np.count_nonzero(np.sign(dx) != np.sign(np.roll(dx, 1, axis=1)), axis=1) == 2
+    return ok
 
 
 TR_NEAR = 0.05  # a screened design within 5 % of the TR target (in log) competes on its objective
