@@ -217,10 +217,10 @@ class _Slot(threading.Thread):
         self.conn = parent
 
     def _kill(self) -> None:
-        if self.proc is not None:
-            self.proc.kill()
-            self.proc.join(5)
-        self.proc = self.conn = None
+        proc, self.proc, self.conn = self.proc, None, None
+        if proc is not None and proc.pid is not None:  # (a process still starting is a daemon: it ends with us)
+            proc.kill()
+            proc.join(5)
 
     def stop(self) -> None:
         self._stop.set()
