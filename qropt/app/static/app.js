@@ -419,7 +419,7 @@ function play() {
   $("m-play").textContent = "Stop";
   const f = state.frames.frames, t0 = performance.now();
   const step = (now) => {
-    const i = Math.floor(((now - t0) / 1000) * 24) % f.length;
+    const i = Math.floor((Math.max(0, now - t0) / 1000) * 24) % f.length;  // (a frame's time may precede t0)
     drawMechanism($("m-svg"), state.frames, f[i].shapes,
       `theta2 = ${f[i].theta2_deg.toFixed(0)} deg, ${f[i].working ? "working" : "return"} stroke`);
     if (state.playing) animation = requestAnimationFrame(step);
