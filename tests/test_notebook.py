@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 import qropt
+from problems import chart_crank_rocker
 from qropt import Problem, family, solve
 from qropt.dynamics.model import Counterweight
 from qropt.examples import paper_mechanism, paper_problem
@@ -77,15 +78,7 @@ def front():
 
 
 def chart_problem(name=""):
-    return Problem(
-        mechanism="FourBar",
-        fixed={"r1": 1.0},
-        free={"r2": (0.01, 1.0), "r3": (0.05, 10.0), "r4": (0.05, 10.0)},
-        targets={"time_ratio": 1.5, "swing": math.radians(60)},
-        conditions={"grashof": "crank-rocker"},
-        objective="max_gamma_min",
-        name=name,
-    )
+    return chart_crank_rocker.build().replace(name=name)  # the problems/ file the chart docs use
 
 
 @pytest.fixture(scope="module")

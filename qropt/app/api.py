@@ -144,7 +144,7 @@ def analyze(payload) -> dict:
         "x": mo.x.tolist(),
         "v": mo.v.tolist(),
         "a": mo.a.tolist(),
-        "working": [bool((t - start) % (2 * math.pi) <= length) for t in th],
+        "working": working(th, start, length),
     }
     out["drawing"] = drawing(m, theta2, frames, start, length)
     if d.get("polygons", True):
@@ -177,7 +177,7 @@ def drawing(m: Mechanism, theta2: float, frames: int, start: float, length: floa
         th = np.linspace(0.0, 2 * math.pi, sc.path.shape[0])
         out["path"] = {
             "points": np.round(sc.path, 12).tolist(),
-            "working": [bool((t - start) % (2 * math.pi) <= length) for t in th],
+            "working": working(th, start, length),
         }
     if frames:
         th = np.linspace(0.0, 2 * math.pi, frames, endpoint=False)
@@ -187,11 +187,16 @@ def drawing(m: Mechanism, theta2: float, frames: int, start: float, length: floa
             out["frames"].append(
                 {
                     "theta2_deg": math.degrees(t),
-                    "working": bool((t - start) % (2 * math.pi) <= length),
+                    "working": working([t], start, length)[0],
                     "shapes": [_shape(s) for s in shapes if s.part != "path"],
                 }
             )
     return out
+
+
+def working(theta2, start: float, length: float) -> list[bool]:
+    """Which crank angles (rad) lie on the working stroke, the arc ``start`` + [0, ``length``] (``working_arc``)."""
+    return (((np.asarray(theta2, float) - start) % (2 * math.pi)) <= length).tolist()
 
 
 def _shape(s) -> dict:

@@ -161,11 +161,14 @@ def create_app(files=(), workers: int = 1, queue_size: int = 8, time_limit: floa
     def analyze():
         return jsonify(api.analyze(body()))
 
-    def run(kind, payload):
+    def submit_job(kind, payload):
         try:
-            job = jobs.submit(kind, payload)
+            return jobs.submit(kind, payload)
         except Busy as e:
             raise api.ApiError(str(e), 429) from None
+
+    def run(kind, payload):
+        job = submit_job(kind, payload)
         job.ended.wait(jobs.time_limit + 30)
         if job.state == "done":
             return job.result
@@ -203,11 +206,7 @@ def create_app(files=(), workers: int = 1, queue_size: int = 8, time_limit: floa
             api.mechanism(api.fields(payload, ("type", "params"), ("units", "theta2", "omega2")))
         else:
             raise api.ApiError(f"kind is solve, design, pareto or report, got {kind!r:.40}")
-        try:
-            job = jobs.submit(kind, payload)
-        except Busy as e:
-            raise api.ApiError(str(e), 429) from None
-        return jsonify(job.to_dict()), 202
+        return jsonify(submit_job(kind, payload).to_dict()), 202
 
     @app.get("/api/jobs/<jid>")
     def job_state(jid):

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qropt.errors import QroptError
+from qropt.kinematics.closures import transmission_angle
 from qropt.kinematics.ops import NUMPY
 from qropt.synthesis import analytic
 from qropt.synthesis.formulation import slow_interval
@@ -190,21 +191,13 @@ def grid_cycle(problem, pts: list[dict]) -> tuple[np.ndarray, np.ndarray]:
     """(TR, stroke) of designs (free-parameter dicts, first branch) on a SCREEN_GRID crank-angle grid, in
     vectorised passes with no mechanism built; nan where a design does not close everywhere or its output does
     not reverse exactly once a turn. Grid values: starts and samples, not results."""
-    cls, branch, names = problem.mechanism, branches(problem)[0], list(problem.free)
     tr, stroke = np.full(len(pts), np.nan), np.full(len(pts), np.nan)
     if not pts:
         return tr, stroke
-    cols = {k: np.array([v[k] for v in pts], float) for k in names}
-    given = {**problem.fixed, **branch, **{k: 1.0 for k in names}}
-    base = {k: v for k, v in cls.PARAMS.items() if k not in given and isinstance(v, (int, float))}
-    base.update(cls.completed(given))
     theta = np.linspace(0.0, 2 * np.pi, SCREEN_GRID, endpoint=False)
     with np.errstate(all="ignore"):
-        for i in range(0, len(pts), SCREEN_CHUNK):
-            part = {k: c[i : i + SCREEN_CHUNK, None] for k, c in cols.items()}
-            rows = min(SCREEN_CHUNK, len(pts) - i)
-            loop = cls.loop(NUMPY, theta[None, :], {**base, **problem.fixed, **branch, **part})
-            x = np.broadcast_to(loop.x, (rows, theta.size))
+        for i, _, loop, x in _grid_loops(problem, pts, theta):
+            rows = x.shape[0]
             ok = _turns(loop, x)
             a = (theta[np.argmin(x, axis=1)] - theta[np.argmax(x, axis=1)]) % (2 * np.pi)
             a = np.minimum(a, 2 * np.pi - a)
@@ -246,24 +239,22 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
         return []
     if any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable):
         return []
-    cls, branch, names = problem.mechanism, branches(problem)[0], list(problem.free)
+    names = list(problem.free)
     pts = rule_points(problem, SHAPES, seed, least=SHAPES // 8)
-    cols = {k: np.array([v[k] for v in pts], float) for k in names}
-    given = {**problem.fixed, **branch, **{k: 1.0 for k in names}}
-    base = {k: v for k, v in cls.PARAMS.items() if k not in given and isinstance(v, (int, float))}
-    base.update(cls.completed(given))
     theta = np.linspace(0.0, 2 * np.pi, SHAPES_GRID, endpoint=False)
     wave = np.fft.rfftfreq(SHAPES_GRID, 1.0 / SHAPES_GRID) ** 2
     tr_target, found = problem.targets["time_ratio"], []
+    chunks = _grid_loops(problem, pts, theta)
     with np.errstate(all="ignore"):
-        for i in range(0, len(pts), SCREEN_CHUNK):
-            part = {k: c[i : i + SCREEN_CHUNK, None] for k, c in cols.items()}
-            rows = min(SCREEN_CHUNK, len(pts) - i)
+        while True:
             try:
-                loop = cls.loop(NUMPY, theta[None, :], {**base, **problem.fixed, **branch, **part})
+                chunk = next(chunks, None)
             except (TypeError, ValueError, IndexError):  # a user type's loop that takes one design at a time
                 return []
-            x = np.broadcast_to(loop.x, (rows, theta.size))
+            if chunk is None:
+                break
+            _, cols, loop, x = chunk
+            rows = x.shape[0]
             ok = _turns(loop, x)
             (t_hi, x_hi), (t_lo, x_lo) = _vertex(x, np.argmax(x, axis=1)), _vertex(x, np.argmin(x, axis=1))
             a = (t_lo - t_hi) % (2 * np.pi)
@@ -272,7 +263,7 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
             ok &= np.abs(tr / tr_target - 1.0) <= SHAPES_WINDOW
             for k in names:
                 lo, hi = problem.free[k]
-                v = cols[k][i : i + rows] * (scale if k in scalable else 1.0)
+                v = cols[k] * (scale if k in scalable else 1.0)
                 ok &= (v >= lo) & (v <= hi)
             if not ok.any():
                 continue
@@ -280,7 +271,7 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
                 value = -np.full(rows, np.pi / 2)
                 for lines in loop.transmission.values():
                     if lines is not None:
-                        g = np.broadcast_to(_acute(lines), x.shape).min(axis=1)
+                        g = np.broadcast_to(transmission_angle(NUMPY, lines), x.shape).min(axis=1)
                         value = np.maximum(value, -g)
             elif grid_objective == 1:
                 d2 = np.fft.irfft(-wave * np.fft.rfft(x, axis=1), n=theta.size, axis=1)
@@ -291,7 +282,7 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
                 value = np.ptp(xs, axis=1) * np.ptp(ys, axis=1) * scale**2
             ok &= np.isfinite(value)
             for j in np.flatnonzero(ok).tolist():
-                v = {k: float(cols[k][i + j] * (scale[j] if k in scalable else 1.0)) for k in names}
+                v = {k: float(cols[k][j] * (scale[j] if k in scalable else 1.0)) for k in names}
                 found.append((float(value[j]), v))
     found.sort(key=lambda f: f[0])
     return [v for _, v in found[:n]]
@@ -307,11 +298,22 @@ def _vertex(x, j):
     return (j + u) * (2 * np.pi / m), b - 0.25 * (a - c) * u
 
 
-def _acute(lines):
-    """The transmission angle (rad, [0, pi/2]) of a joint's two lines, on arrays."""
-    from qropt.kinematics.closures import transmission_angle
-
-    return transmission_angle(NUMPY, lines)
+def _grid_loops(problem, pts: list[dict], theta: np.ndarray):
+    """The type's loop over designs ``pts`` (free-parameter dicts, first branch) x crank angles ``theta``, in
+    vectorised passes of SCREEN_CHUNK designs: (first index, the pass's free columns, its Loop, x as (designs,
+    angles)). No mechanism is built; a user type's loop that takes one design at a time raises TypeError,
+    ValueError or IndexError. The caller sets numpy's error state."""
+    cls, branch, names = problem.mechanism, branches(problem)[0], list(problem.free)
+    cols = {k: np.array([v[k] for v in pts], float) for k in names}
+    given = {**problem.fixed, **branch, **{k: 1.0 for k in names}}
+    base = {k: v for k, v in cls.PARAMS.items() if k not in given and isinstance(v, (int, float))}
+    base.update(cls.completed(given))
+    for i in range(0, len(pts), SCREEN_CHUNK):
+        part = {k: c[i : i + SCREEN_CHUNK] for k, c in cols.items()}
+        loop = cls.loop(
+            NUMPY, theta[None, :], {**base, **problem.fixed, **branch, **{k: c[:, None] for k, c in part.items()}}
+        )
+        yield i, part, loop, np.broadcast_to(loop.x, (min(SCREEN_CHUNK, len(pts) - i), theta.size))
 
 
 def _turns(loop, x) -> np.ndarray:
