@@ -17,12 +17,12 @@ numbers, so they are kept per type for the life of the process.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import casadi
 import numpy as np
 
-from qropt.kinematics import cycle
+from qropt.kinematics import cycle, native
 from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle, transmission_cos2
 from qropt.kinematics.ops import CASADI, NUMPY, Jet
 
@@ -31,10 +31,10 @@ TWO_PI = 2.0 * np.pi
 CSE = {"cse": True}  # common subexpressions of the nested derivatives merged: a third of the instructions
 STEP_TOL = 1e-10  # rad: a last Newton step this small means the point is converged (error ~ step^2)
 _KERNELS: dict = {}
+_THREE = np.arange(3)
 
 
-@dataclass(frozen=True)
-class Extremes:
+class Extremes(NamedTuple):
     """Refined local extremes of one quantity: crank angles (rad, [0, 2pi)) and precise values."""
 
     theta: np.ndarray
@@ -52,26 +52,69 @@ def kernel(cls, names: tuple) -> Kernel:
 
 class Batched:
     """A CasADi Function of one column z mapped over K columns, evaluated through CasADi's zero-copy
-    FunctionBuffer (the Python conversions of an ordinary call cost more than the arithmetic here)."""
+    FunctionBuffer (the Python conversions of an ordinary call cost more than the arithmetic here).
 
-    def __init__(self, f: casadi.Function):
+    A K that is used HOT times is compiled to machine code (``native``): the row function mapped over K, or,
+    from WIDE rows up, the mapped function itself as one C loop. ``f`` stays the symbolic Function, for
+    composing larger ones (and a Function made for one problem is never compiled: ``compiled=False``). Buffers
+    are kept for at most KEPT shapes of up to MAX_ROWS rows."""
+
+    HOT = 16  # calls with one K after which that K runs compiled (rarely used shapes stay on CasADi's VM)
+    WIDE = 64  # rows from which the whole map is compiled as one loop
+    MAX_ROWS = 20_000  # a larger K is evaluated in pieces of this many rows
+    KEPT = 64  # shapes whose buffers are kept
+
+    def __init__(self, f: casadi.Function, compiled: bool = True):
         if not f.sparsity_out(0).is_dense():  # the buffer holds nonzeros only: make every entry one
             z = f.mx_in(0)
             f = casadi.Function(f.name() + "_dense", [z], [casadi.densify(f(z))])
         self.f, self.m, self.r = f, f.size1_in(0), f.size1_out(0)
-        self._by_k: dict = {}
+        self._by_k: dict = {}  # K -> [z buffer, out buffer, evaluate, FunctionBuffer, uses when built, native?]
+        self._uses: dict = {}
+        self._native = None
+        self.compiled = compiled  # False: a Function of one problem (its constants in the code): never compiled
+
+    def _compiled(self, k: int) -> tuple[casadi.Function, bool]:
+        """The map over k rows as machine code, and whether it is (False: CasADi's VM, no compiler)."""
+        if k >= self.WIDE:
+            f = self.f.map(k)
+            c = native.compiled(f)
+            return c, c is not f
+        if self._native is None:
+            self._native = native.compiled(self.f)
+        return self._native.map(k), self._native is not self.f
+
+    def _entry(self, k: int) -> list:
+        e = self._by_k.get(k)
+        uses = self._uses.get(k, 0)
+        if e is None or (uses >= self.HOT > e[4]):  # new, or hot now: rebuilt once, compiled
+            if len(self._by_k) >= self.KEPT:
+                self._by_k.clear()
+            fk, is_native = self._compiled(k) if uses >= self.HOT else (self.f.map(k), False)
+            zin, out = np.zeros((k, self.m)), np.zeros((k, self.r))
+            buf, ev = fk.buffer()
+            buf.set_arg(0, memoryview(zin))
+            buf.set_res(0, memoryview(out))
+            e = self._by_k[k] = [zin, out, ev, buf, uses, is_native]
+        return e
+
+    def hot(self, k: int) -> bool:
+        """Counts a use with K rows; whether calls with K rows now run as machine code (a caller with a faster
+        route than CasADi's virtual machine takes its own until then)."""
+        if k > self.MAX_ROWS or not self.compiled:
+            return False
+        uses = self._uses[k] = min(self._uses.get(k, 0) + 1, self.HOT)
+        return uses >= self.HOT and self._entry(k)[5]
 
     def __call__(self, z: np.ndarray) -> np.ndarray:
         """z: (K, m) -> (K, r)."""
         k = z.shape[0]
-        e = self._by_k.get(k)
-        if e is None:
-            zin, out = np.zeros((k, self.m)), np.zeros((k, self.r))
-            buf, ev = self.f.map(k).buffer()
-            buf.set_arg(0, memoryview(zin))
-            buf.set_res(0, memoryview(out))
-            e = self._by_k[k] = (zin, out, ev, buf)
-        zin, out, ev, _ = e
+        if k > self.MAX_ROWS:
+            return np.concatenate([self(z[i : i + self.MAX_ROWS]) for i in range(0, k, self.MAX_ROWS)])
+        uses = self._uses.get(k, 0)
+        if uses < self.HOT and self.compiled:
+            self._uses[k] = uses + 1
+        zin, out, ev = self._entry(k)[:3]
         zin[:] = z
         ev()
         return out.copy()
@@ -87,14 +130,27 @@ class _Quantity:
         z = casadi.SX.sym("z", 1 + n)
         d = casadi.Function("d", [t, P], [q, d1, d2])
         self.derivs = Batched(casadi.Function("dz", [z], [casadi.vertcat(*d(z[0], z[1:]))], CSE))
-        zn = casadi.SX.sym("z", 3 + n)
-        x, lo, hi, pz = zn[0], zn[1], zn[2], zn[3:]
+        # one bracket: the grid samples vm <= v0 > vp (of sign * q) around theta = th, spacing h; the start is the
+        # grid parabola's vertex (no shift where it is not finite or beyond half a step)
+        zn = casadi.SX.sym("z", 6 + n)
+        th, h, vm, v0, vp, sgn, pz = zn[0], zn[1], zn[2], zn[3], zn[4], zn[5], zn[6:]
+        shift = 0.5 * (vm - vp) / (vm - 2.0 * v0 + vp)
+        shift = casadi.if_else(casadi.fabs(shift) <= 0.5, shift, 0.0)
+        lo, hi = th - h, th + h
+        x = th + shift * h
         for _ in range(NEWTON_STEPS):
             _, g1, g2 = d(x, pz)
             x = casadi.fmin(casadi.fmax(x - g1 / g2, lo), hi)
         _, g1, g2 = d(x, pz)
         value = casadi.Function("v", [t, P], [precise])
-        self.newton = Batched(casadi.Function("n", [zn], [casadi.vertcat(x, g1 / g2, g2, value(x, pz))], CSE))
+        # accepted: a last step below STEP_TOL, strictly inside the bracket, with the curvature of its kind
+        ok = casadi.logic_and(
+            casadi.logic_and(casadi.fabs(g1 / g2) <= STEP_TOL, casadi.logic_and(x > lo, x < hi)), sgn * g2 < 0
+        )
+        wrapped = casadi.fmod(x, TWO_PI)
+        wrapped = casadi.if_else(wrapped < 0, wrapped + TWO_PI, wrapped)
+        wrapped = casadi.if_else(wrapped > TWO_PI - 1e-12, 0.0, wrapped)
+        self.newton = Batched(casadi.Function("n", [zn], [casadi.vertcat(wrapped, ok, value(x, pz))], CSE))
         self.value = Batched(casadi.Function("vz", [z], [value(z[0], z[1:])], CSE))
 
     def at(self, theta, p):
@@ -155,15 +211,54 @@ class Kernel:
 
     # ---- grid pass -------------------------------------------------------------------------
     def grid_values(self, params, theta):
-        """Cycle quantities (Q, n) on the crank angles theta, from one numpy evaluation of the loop."""
-        with np.errstate(invalid="ignore", divide="ignore"):
-            lp = self.cls.loop(NUMPY, theta, params)
-            q = [lp.x] + [transmission_cos2(NUMPY, lp.transmission[j]) for j in self.joints]
+        """Cycle quantities (Q, n) on the crank angles theta: x, cos^2 of each varying joint, the margins (the
+        loop compiled, one row per angle)."""
+        f = self._groups.get("grid")
+        if f is None:
+            t, P, lp = self._t, self._P, self._lp
+            q = [lp.x] + [transmission_cos2(CASADI, lp.transmission[j]) for j in self.joints]
             q += [m for _, m in lp.margins]
-        out = np.empty((len(q), theta.size))
-        for i, v in enumerate(q):
-            out[i] = v
-        return out
+            z = casadi.SX.sym("z", 1 + P.numel())
+            fn = casadi.Function("grid", [t, P], [casadi.vertcat(*q)])
+            f = self._groups["grid"] = Batched(casadi.Function("grid_values", [z], [fn(z[0], z[1:])], CSE))
+        theta = np.asarray(theta, float)
+        z = np.empty((theta.size, 1 + len(self.names)))
+        z[:, 0] = theta
+        z[:, 1:] = self.vector(params)
+        return np.ascontiguousarray(f(z).T)
+
+    def rates(self, params, theta, omega2: float, alpha2: float, which: str):
+        """Compiled time rates at crank angles theta (rad), crank rate omega2 (rad/s) and acceleration alpha2
+        (rad/s^2): which = 'x' gives (x, v, a), 'all' gives them and then each link angle, omega, alpha in
+        ``angle_names`` order, as rows of an array (3 q, n); None while these calls are not yet machine code
+        (the jets are faster than CasADi's VM: the caller evaluates them instead)."""
+        key = "rates " + which
+        f = self._groups.get(key)
+        if f is None:
+            t, P, lp = self._t, self._P, self._lp
+            w, al = casadi.SX.sym("w"), casadi.SX.sym("al")
+            out = []
+            for q in [lp.x] if which == "x" else [lp.x, *lp.angles.values()]:
+                q = casadi.SX(q) + 0 * t
+                d1 = casadi.jacobian(q, t)
+                d2 = casadi.jacobian(d1, t)
+                out += [q, d1 * w, d2 * w * w + d1 * al]
+            z = casadi.SX.sym("z", 3 + P.numel())
+            fn = casadi.Function("r", [t, w, al, P], [casadi.vertcat(*out)])
+            f = self._groups[key] = Batched(casadi.Function(f"rates_{which}", [z], [fn(z[0], z[1], z[2], z[3:])], CSE))
+        theta = np.asarray(theta, float)
+        if not f.hot(theta.size):
+            return None
+        z = np.empty((theta.size, 3 + len(self.names)))
+        z[:, 0] = theta
+        z[:, 1] = omega2
+        z[:, 2] = alpha2
+        z[:, 3:] = self.vector(params)
+        return f(z).T
+
+    @property
+    def angle_names(self) -> list[str]:
+        return list(self._lp.angles)
 
     def grid_coords(self, params, theta):
         """Every joint coordinate (2 per joint, x then y) on the crank angles theta: (C, n)."""
@@ -208,36 +303,27 @@ class Kernel:
         v = ext[:, 1:-1]
         np.multiply(grid_q[rows], sgn_col, out=v)
         ext[:, 0], ext[:, -1] = v[:, -1], v[:, 0]
-        prev, nxt = ext[:, :-2], ext[:, 2:]
-        hit = v >= prev  # comparisons with nan are False: a sample next to a nan is never a peak
-        hit &= v > nxt
+        hit = v >= ext[:, :-2]  # comparisons with nan are False: a sample next to a nan is never a peak
+        hit &= v > ext[:, 2:]
         r, i = np.nonzero(hit)
         if not r.size:
             return [Extremes(np.zeros(0), np.zeros(0)) for _ in requests]
-        vm, v0, vp = ext[r, i], ext[r, i + 1], ext[r, i + 2]
-        # grid parabola's vertex: vm <= v0 > vp, so the denominator is negative and |shift| <= 1/2 (nan next to an
-        # infinite sample, which the clip below turns into no shift)
-        with np.errstate(invalid="ignore"):
-            shift = 0.5 * (vm - vp) / (vm - 2.0 * v0 + vp)
-        shift[~(np.abs(shift) <= 0.5)] = 0.0
-        th = h * i
-        z = np.empty((r.size, 4 + p.size))
+        z = np.empty((r.size, 7 + p.size))
         z[:, 0] = rows[r]
-        z[:, 1] = th + shift * h
-        z[:, 2] = lo = th - h
-        z[:, 3] = hi = th + h
-        z[:, 4:] = p
+        z[:, 1] = i
+        z[:, 1] *= h
+        z[:, 2] = h
+        z[:, 3:6] = ext[r[:, None], i[:, None] + _THREE]
+        z[:, 6] = sgn[r]
+        z[:, 7:] = p
         res = self._switch(group)(z)
-        x, val = res[:, 0], res[:, 3]
-        ok = np.abs(res[:, 1]) <= STEP_TOL
-        ok &= x > lo
-        ok &= x < hi
-        ok &= sgn[r] * res[:, 2] < 0
+        x, ok, val = res[:, 0], res[:, 1], res[:, 2]
         keep = None
         if not ok.all():  # rare: flat, narrow or no extremes; the safeguarded iteration
             quantity_of, keep = rows[r], np.ones(r.size, bool)
-            for q in np.unique(quantity_of[~ok]):
-                j = np.flatnonzero(~ok & (quantity_of == q))
+            lo, hi = z[:, 1] - h, z[:, 1] + h
+            for q in np.unique(quantity_of[ok == 0]):
+                j = np.flatnonzero((ok == 0) & (quantity_of == q))
                 quantity = self.group(group)[q]
                 # a true extreme turns the slope inside its bracket; a jump (an angle wrapping at +-pi) does not
                 s = sgn[r[j]]
@@ -245,19 +331,14 @@ class Kernel:
                 keep[j[~turns]] = False
                 j = j[turns]
                 if j.size:
-                    x[j] = self._safeguarded(quantity, lo[j], hi[j], p)
-                    val[j] = quantity.value(np.column_stack([x[j], np.broadcast_to(p, (j.size, p.size))]))[:, 0]
-        x = np.mod(x, TWO_PI)
-        x[x > TWO_PI - 1e-12] = 0.0
-        bounds = np.searchsorted(r, np.arange(rows.size + 1))  # r is sorted: each request's slice
-        out = []
-        for a, b in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
-            if keep is None:
-                out.append(Extremes(x[a:b], val[a:b]))
-            else:
-                k = keep[a:b]
-                out.append(Extremes(x[a:b][k], val[a:b][k]))
-        return out
+                    xj = np.mod(self._safeguarded(quantity, lo[j], hi[j], p), TWO_PI)
+                    xj[xj > TWO_PI - 1e-12] = 0.0
+                    x[j] = xj
+                    val[j] = quantity.value(np.column_stack([xj, np.broadcast_to(p, (j.size, p.size))]))[:, 0]
+        bounds = np.searchsorted(r, np.arange(rows.size + 1)).tolist()  # r is sorted: each request's slice
+        if keep is None:
+            return [Extremes(x[a:b], val[a:b]) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+        return [Extremes(x[a:b][keep[a:b]], val[a:b][keep[a:b]]) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
 
     @staticmethod
     def _safeguarded(quantity, lo, hi, p):

@@ -11,7 +11,7 @@ parameter; metres by default, see ``qropt.units``); theta2 counter-clockwise fro
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 from types import MappingProxyType
 from typing import Any, ClassVar, NamedTuple
@@ -34,6 +34,8 @@ MAX_ANGLES = 10_000_000  # crank angles evaluated in one call
 
 def _finite(name: str, value) -> float:
     """A finite real number from the API, or InvalidParameter naming it."""
+    if type(value) is float and -MAGNITUDE <= value <= MAGNITUDE:  # the common case, checked first
+        return value
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise InvalidParameter(f"{name} must be a number, got {value!r}")
     try:
@@ -138,20 +140,35 @@ class Positions:
     x: np.ndarray
 
 
-@dataclass(frozen=True)
 class Motion:
-    """Output position x, velocity v, acceleration a and every link's angle, omega, alpha.
+    """Output position x, velocity v, acceleration a and every link's angle, omega, alpha (dicts by angle name,
+    computed on first use).
 
     Units: length, length/s, length/s^2, rad, rad/s, rad/s^2 (for FourBar x is theta4 in rad).
     """
 
-    theta2: np.ndarray
-    x: np.ndarray
-    v: np.ndarray
-    a: np.ndarray
-    angles: dict = field(default_factory=dict)
-    omega: dict = field(default_factory=dict)
-    alpha: dict = field(default_factory=dict)
+    def __init__(self, theta2: np.ndarray, x: np.ndarray, v: np.ndarray, a: np.ndarray, links):
+        self.theta2, self.x, self.v, self.a = theta2, x, v, a
+        self._links = links  # () -> (angles, omega, alpha)
+
+    @cached_property
+    def _rates(self) -> tuple[dict, dict, dict]:
+        return self._links()
+
+    @property
+    def angles(self) -> dict:
+        return self._rates[0]
+
+    @property
+    def omega(self) -> dict:
+        return self._rates[1]
+
+    @property
+    def alpha(self) -> dict:
+        return self._rates[2]
+
+    def __repr__(self):
+        return f"Motion({self.theta2.size} crank angles: x, v, a, and {', '.join(self.angles)})"
 
 
 class DeadCentres(NamedTuple):
@@ -452,7 +469,29 @@ class Mechanism:
     def motion(self, theta2, omega2: float = 1.0, alpha2: float = 0.0) -> Motion:
         """Exact output and link rates at theta2 (rad) for crank rate omega2 (rad/s) and alpha2 (rad/s^2)."""
         t = self._angles(theta2)
-        omega2, alpha2 = _finite("omega2", omega2), _finite("alpha2", alpha2)
+        return self._motion(t, _finite("omega2", omega2), _finite("alpha2", alpha2), "all")
+
+    def slider(self, theta2, omega2: float = 1.0, alpha2: float = 0.0) -> Motion:
+        """Slider position x, velocity v, acceleration a at theta2 (the link rates are computed if asked for);
+        see ``motion``."""
+        t = self._angles(theta2)
+        return self._motion(t, _finite("omega2", omega2), _finite("alpha2", alpha2), "x")
+
+    def _motion(self, t, omega2, alpha2, which) -> Motion:
+        k = self._kernel
+        r = k.rates(self.params, t, omega2, alpha2, which)
+        if r is None:  # not (yet) machine code: Taylor jets through the loop
+            (x, v, a), rates = self._jet_motion(t, omega2, alpha2)
+            return Motion(t, x, v, a, lambda: rates)
+        if which == "x":
+            links = lambda: self._motion(t, omega2, alpha2, "all")._rates  # noqa: E731
+            return Motion(t, r[0].copy(), r[1].copy(), r[2].copy(), links)
+        names = k.angle_names
+        rates = tuple({n: r[3 + 3 * i + j].copy() for i, n in enumerate(names)} for j in range(3))
+        return Motion(t, r[0].copy(), r[1].copy(), r[2].copy(), lambda: rates)
+
+    def _jet_motion(self, t, omega2, alpha2):
+        """((x, v, a), (angles, omega, alpha)) by Taylor jets through the loop."""
         lp = self.evaluate(JET, Jet.seed(t, omega2, alpha2))
 
         def parts(j):
@@ -462,21 +501,8 @@ class Mechanism:
                 return [np.broadcast_to(c, t.shape).astype(float) for c in (j.v, j.d1, j.d2)]
             return [np.broadcast_to(float(j), t.shape).astype(float), np.zeros_like(t), np.zeros_like(t)]
 
-        x, v, a = parts(lp.x)
         rates = {k: parts(j) for k, j in lp.angles.items()}
-        return Motion(
-            t,
-            x,
-            v,
-            a,
-            {k: r[0] for k, r in rates.items()},
-            {k: r[1] for k, r in rates.items()},
-            {k: r[2] for k, r in rates.items()},
-        )
-
-    def slider(self, theta2, omega2: float = 1.0, alpha2: float = 0.0) -> Motion:
-        """Slider position x, velocity v, acceleration a (and link rates) at theta2; see ``motion``."""
-        return self.motion(theta2, omega2, alpha2)
+        return parts(lp.x), tuple({k: r[i] for k, r in rates.items()} for i in range(3))
 
     def transmission_angles(self, theta2) -> dict[str, np.ndarray]:
         """Transmission angle (rad, in [0, pi/2]) of every transmitting joint at theta2."""
@@ -512,15 +538,11 @@ class Mechanism:
         k, q = self._kernel, self._grid
         nj, nm = len(k.joints), len(k.margin_names)
         margins_grid = q[1 + nj :]
-        at = margins_grid.argmin(axis=1)  # a row with a nan gives its first nan: the rows' own least below
-        least = margins_grid[np.arange(nm), at].tolist()
-        for m, v in enumerate(least):
-            if v != v:
-                finite = np.isfinite(margins_grid[m])
-                at[m] = np.flatnonzero(finite)[np.argmin(margins_grid[m][finite])] if finite.any() else 0
-                least[m] = float(margins_grid[m, at[m]]) if finite.any() else -np.inf
-        if any(v < -cycle.MARGIN_TOL for v in least):  # cannot assemble: nothing else is defined
-            return {"margins": [(v, 0.0) for v in least]}
+        least = np.fmin.reduce(margins_grid, axis=1, initial=np.inf)  # the least sample of each, nan left out
+        least[least == np.inf] = -np.inf  # no sample closes (every one nan): it cannot assemble anywhere
+        at = (margins_grid == least[:, None]).argmax(axis=1)
+        if (least < -cycle.MARGIN_TOL).any():  # cannot assemble: nothing else is defined
+            return {"margins": [(float(v), 0.0) for v in least]}
         res = k.refine("cycle", q, k.cycle_requests, k.vector(self.params))
         gammas = {j: (res[2 + i].theta, res[2 + i].value) for i, j in enumerate(k.joints)}
         gammas.update({j: (np.zeros(1), np.full(1, math.pi / 2)) for j in k.right_joints})
@@ -530,7 +552,7 @@ class Mechanism:
             if e.value.size and e.value.min() < least[m]:
                 margins.append((float(e.value.min()), float(e.theta[np.argmin(e.value)])))
             else:
-                margins.append((least[m], float(cycle.grid(q.shape[1])[at[m]])))
+                margins.append((float(least[m]), float(cycle.grid(q.shape[1])[at[m]])))
         return {
             "max": (res[0].theta, res[0].value),
             "min": (res[1].theta, res[1].value),

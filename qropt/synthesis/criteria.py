@@ -201,7 +201,7 @@ class GammaMin(Criterion):
         return [("max |cos gamma|", exprs)]
 
     def lifts(self, f, role):  # under a bound, each sampled joint's worst transmission lifted
-        return 2 * len(f.sampled_joints) if role is Role.BOUND else 0
+        return 2 * len(f.sampled_joints)
 
     def lift_terms(self, f, k, phi, out):
         j = len(f.exact_joints) + k // 2

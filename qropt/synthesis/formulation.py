@@ -578,7 +578,9 @@ class Formulation:
 
         z = casadi.SX.sym("z", self.w_sym.numel() + self.p_sym.numel())
         f = casadi.Function(name, [self.w_sym, self.p_sym], [expr])
-        return Batched(casadi.Function(name + "z", [z], [f(z[: self.w_sym.numel()], z[self.w_sym.numel() :])]))
+        return Batched(
+            casadi.Function(name + "z", [z], [f(z[: self.w_sym.numel()], z[self.w_sym.numel() :])]), compiled=False
+        )
 
     def row_kind(self, name: str) -> RowKind | None:
         """The kind of the rows named ``name`` (None for a name that is no row of this NLP)."""

@@ -156,7 +156,7 @@ class LocalSolve:
         lbx, ubx = form.bounds(problem)
         c = Candidate(False, dict(values0), branch, orientation)
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
-        g, info, m, restarts = None, {}, None, 0
+        g, info, m, restarts, polished, polish = None, {}, None, 0, False, None
         while c.rounds < max_rounds:
             c.rounds += 1
             run = self.backend.run(form, w, p, lbx, ubx, warm=c.rounds > 1)
@@ -171,6 +171,11 @@ class LocalSolve:
             m, info, add, frac = certify(
                 problem, form, c.values, branch, pt.theta, pt.z, run.f, gap_tol, feas_tol, designs, c.problem
             )
+            if polish is not None:  # the warm run after an acceptable end: kept only if it is better
+                if not run.converged or not info.get("ok"):
+                    w, g, c.values, c.problem, m, info, c.ends[-1], c.statuses[-1] = polish
+                    break
+                polish = None
             near = range_target or max(form.violations(g).values(), default=0.0) <= RESTART_VIOLATION
             if run.status is Status.ITERATION_LIMIT and restarts < RESTARTS and near:
                 restarts += 1  # the iteration budget ran out on the way to an optimum: go on from there
@@ -180,6 +185,10 @@ class LocalSolve:
             caps = form.caps(w, p)
             tightened = not np.array_equal(caps, form.p_blocks.split(p)["caps"])
             if not add and not frac and not tightened:
+                if run.status is Status.ACCEPTABLE and not polished and c.rounds < max_rounds:
+                    # IPOPT's looser tolerance: once more from there, warm, to its own (the acceptable point kept)
+                    polished, polish = True, (w, g, c.values, c.problem, m, info, run.status, run.message)
+                    continue
                 break
             if bound is not None and info.get("ok") and run.f > bound + 1e-9 * max(1.0, abs(bound)):
                 c.pruned = True  # more samples only raise this basin's NLP value: it cannot beat the incumbent

@@ -1,0 +1,101 @@
+"""Compiled kernels (qropt.kinematics.native): the same numbers as CasADi's virtual machine and the Taylor jets,
+a cache on disk, and a working fallback without a compiler."""
+
+import ast
+import os
+import subprocess
+import sys
+
+import casadi
+import numpy as np
+import pytest
+
+from qropt.kinematics import cycle, native
+from qropt.kinematics.kernel import Batched
+from qropt.mechanisms import TYPES
+from tests.randmech import random_mechanisms
+
+needs_compiler = pytest.mark.skipif(not native.enabled(), reason="no C compiler (the VM is used)")
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("QROPT_CACHE", str(tmp_path))
+    return tmp_path / "kernels"
+
+
+@needs_compiler
+@pytest.mark.parametrize("cls", TYPES, ids=lambda c: c.KIND)
+def test_compiled_kernels_equal_the_vm(cls, cache):
+    """Grid values, the batched Newton refinement and the time rates: compiled (no fused multiply-adds) equal
+    the virtual machine's to the last bit, at a random mechanism of every type."""
+    _, m = random_mechanisms(cls.KIND, 1, seed=23)[0]
+    k = m._kernel
+    p = k.vector(m.params)
+    th = cycle.grid(180)
+    grid = k.grid_values(m.params, th)  # builds the Function
+    vm_grid = Batched(k._groups["grid"].f)
+    z = np.column_stack([th, np.broadcast_to(p, (th.size, p.size))])
+    compiled = native.compiled(k._groups["grid"].f.map(th.size))
+    assert compiled is not k._groups["grid"].f
+    out = np.zeros((th.size, grid.shape[0]))
+    buf, ev = compiled.buffer()
+    zin = np.ascontiguousarray(z)
+    buf.set_arg(0, memoryview(zin))
+    buf.set_res(0, memoryview(out))
+    ev()
+    np.testing.assert_array_equal(out, vm_grid(z))
+    assert list(cache.glob("*.so")), "the shared library is kept in the cache"
+    # the rates through a hot Batched (compiled) against the jets
+    t = np.linspace(0.0, 2 * np.pi, 97, endpoint=False)
+    for _ in range(Batched.HOT + 1):
+        mo = m.motion(t, 7.0, 2.0)
+    assert k._groups["rates all"].hot(t.size)
+    (x, v, a), (ang, om, al) = m._jet_motion(t, 7.0, 2.0)
+    scale = max(1.0, np.abs(a).max())
+    np.testing.assert_allclose(mo.x, x, rtol=0, atol=1e-13 * max(1.0, np.abs(x).max()))
+    np.testing.assert_allclose(mo.v, v, rtol=0, atol=1e-13 * max(1.0, np.abs(v).max()))
+    np.testing.assert_allclose(mo.a, a, rtol=0, atol=1e-12 * scale)
+    for name in ang:
+        np.testing.assert_allclose(mo.omega[name], om[name], rtol=0, atol=1e-12 * max(1.0, np.abs(om[name]).max()))
+        np.testing.assert_allclose(mo.alpha[name], al[name], rtol=0, atol=1e-11 * max(1.0, np.abs(al[name]).max()))
+
+
+def test_slider_gives_link_rates_on_demand():
+    """slider() computes x, v, a; its link rates, asked for, equal motion()'s."""
+    _, m = random_mechanisms("whitworth", 1, seed=4)[0]
+    t = np.linspace(0.0, 2 * np.pi, 131, endpoint=False)
+    for _ in range(Batched.HOT + 2):
+        s, mo = m.slider(t, 3.0, 1.0), m.motion(t, 3.0, 1.0)
+    np.testing.assert_array_equal(s.x, mo.x)
+    np.testing.assert_array_equal(s.a, mo.a)
+    assert set(s.omega) == set(mo.omega)
+    for name in mo.omega:
+        np.testing.assert_array_equal(s.alpha[name], mo.alpha[name])
+
+
+def test_a_compiler_error_falls_back_to_the_vm(cache, monkeypatch):
+    monkeypatch.setitem(native._STATE, "compiler", "/bin/false")
+    x = casadi.SX.sym("x")
+    f = casadi.Function("square_plus_one", [x], [x * x + 1])
+    assert native.compiled(f) is f
+    assert not list(cache.glob("*.so"))
+
+
+def test_analysis_without_a_compiler_is_the_same():
+    """QROPT_NATIVE=0 (no machine code): the paper's mechanism analysed many times gives the same numbers."""
+    code = (
+        "import qropt, numpy as np\n"
+        "from qropt.examples import paper_mechanism\n"
+        "p = dict(paper_mechanism().params)\n"
+        "for _ in range(40): m = qropt.DragLinkSlider(**p); out = (m.time_ratio(), m.stroke(), m.gamma_min().value,"
+        " m.peak_acceleration(10.0).value, float(m.slider(np.linspace(0, 6, 200), 10.0).a.sum()))\n"
+        "print(repr(out))\n"
+    )
+    runs = {}
+    for flag in ("0", "1"):
+        env = {**os.environ, "QROPT_NATIVE": flag}
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
+        assert done.returncode == 0, done.stderr
+        runs[flag] = ast.literal_eval(done.stdout.strip())
+    np.testing.assert_allclose(runs["0"], runs["1"], rtol=1e-13, atol=0)
