@@ -1,7 +1,8 @@
 """The paper's design task, in one run: the closed form alone (the floor), ``solve()`` with its defaults (every
 local optimum, certified), ``solve()`` with the closed-form starts only, and scipy SLSQP on the same formulation
 (the benchmarks' one driver: same CasADi functions, exact derivatives, qropt's starts). Also the exact analysis
-of a new mechanism (construction, TR, stroke, gamma_min), its peak acceleration, and a full-cycle motion.
+of a new mechanism (construction, TR, stroke, gamma_min), its peak acceleration, and a full-cycle motion (the
+slider's x, v, a; and with every link's rates). Times are warm: a kernel used often runs as machine code.
 Prints medians and ratios; writes benchmarks/results/synthesis.json.
 
 Run: ``python -m benchmarks.synthesis``.
@@ -85,6 +86,7 @@ def main(repeat: int = 21):
     m = DragLinkSlider(**params)
     theta = np.linspace(0.0, 2 * math.pi, 3600, endpoint=False)
     t_motion, _ = timed(lambda: m.motion(theta, 10.0), 200)
+    t_slider, _ = timed(lambda: m.slider(theta, 10.0), 200)
     bar.close()
     rows = [
         ("closed form (eqs. 7-13 + exact gamma_min)", t_floor, m_floor.params["r3"], m_floor.gamma_min().value),
@@ -102,6 +104,7 @@ def main(repeat: int = 21):
     print("exact analysis of the paper's mechanism (median of 200)")
     print(f"  construction + TR + stroke + gamma_min      {1e3 * t_ana:9.1f} us")
     print(f"  construction + peak acceleration            {1e3 * t_peak:9.1f} us")
+    print(f"  x, v, a at 3,600 angles (slider)            {1e3 * t_slider:9.1f} us")
     print(f"  x, v, a and link rates at 3,600 angles      {1e3 * t_motion:9.1f} us")
     save(
         "synthesis.json",
@@ -114,6 +117,7 @@ def main(repeat: int = 21):
                 "analysis": t_ana,
                 "peak_acceleration": t_peak,
                 "motion_3600": t_motion,
+                "slider_3600": t_slider,
             },
             "r3": {"closed_form": m_floor.params["r3"], "solve": res.params["r3"], "slsqp": r3_slsqp},
         },
