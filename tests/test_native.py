@@ -3,6 +3,7 @@ a cache on disk, and a working fallback without a compiler."""
 
 import ast
 import os
+import pickle
 import subprocess
 import sys
 
@@ -72,6 +73,9 @@ def test_slider_gives_link_rates_on_demand():
     assert set(s.omega) == set(mo.omega)
     for name in mo.omega:
         np.testing.assert_array_equal(s.alpha[name], mo.alpha[name])
+    back = pickle.loads(pickle.dumps(m.slider(t, 3.0, 1.0)))  # as data, its link rates with it
+    np.testing.assert_array_equal(back.a, mo.a)
+    np.testing.assert_array_equal(back.omega["theta4"], mo.omega["theta4"])
 
 
 def test_a_compiler_error_falls_back_to_the_vm(cache, monkeypatch):

@@ -72,7 +72,7 @@ class Batched:
         self._by_k: dict = {}  # K -> [z buffer, out buffer, evaluate, FunctionBuffer, uses when built, native?]
         self._uses: dict = {}
         self._native = None
-        self.compiled = compiled  # False: a Function of one problem (its constants in the code): never compiled
+        self.may_compile = compiled  # False: a Function of one problem (its constants in the code)
 
     def _compiled(self, k: int) -> tuple[casadi.Function, bool]:
         """The map over k rows as machine code, and whether it is (False: CasADi's VM, no compiler)."""
@@ -101,7 +101,7 @@ class Batched:
     def hot(self, k: int) -> bool:
         """Counts a use with K rows; whether calls with K rows now run as machine code (a caller with a faster
         route than CasADi's virtual machine takes its own until then)."""
-        if k > self.MAX_ROWS or not self.compiled:
+        if k > self.MAX_ROWS or not self.may_compile:
             return False
         uses = self._uses[k] = min(self._uses.get(k, 0) + 1, self.HOT)
         return uses >= self.HOT and self._entry(k)[5]
@@ -112,7 +112,7 @@ class Batched:
         if k > self.MAX_ROWS:
             return np.concatenate([self(z[i : i + self.MAX_ROWS]) for i in range(0, k, self.MAX_ROWS)])
         uses = self._uses.get(k, 0)
-        if uses < self.HOT and self.compiled:
+        if uses < self.HOT and self.may_compile:
             self._uses[k] = uses + 1
         zin, out, ev = self._entry(k)[:3]
         zin[:] = z

@@ -167,8 +167,16 @@ class Motion:
     def alpha(self) -> dict:
         return self._rates[2]
 
+    def __reduce__(self):  # pickled with its link rates computed (the closure that makes them is not data)
+        rates = self._rates
+        return (_motion_of, (self.theta2, self.x, self.v, self.a, rates))
+
     def __repr__(self):
         return f"Motion({self.theta2.size} crank angles: x, v, a, and {', '.join(self.angles)})"
+
+
+def _motion_of(theta2, x, v, a, rates) -> Motion:
+    return Motion(theta2, x, v, a, lambda: rates)
 
 
 class DeadCentres(NamedTuple):

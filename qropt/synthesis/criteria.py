@@ -200,7 +200,7 @@ class GammaMin(Criterion):
             exprs += [s * out.cos[n + j] for j in range(len(f.sampled_joints)) for s in (1, -1)]
         return [("max |cos gamma|", exprs)]
 
-    def lifts(self, f, role):  # under a bound, each sampled joint's worst transmission lifted
+    def lifts(self, f, role):  # each sampled joint's two worst transmission minima, as objective or bound
         return 2 * len(f.sampled_joints)
 
     def lift_terms(self, f, k, phi, out):
