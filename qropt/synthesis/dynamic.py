@@ -363,38 +363,60 @@ class _Squared(_Dynamic):
         return math.sqrt(max(y, 0.0))
 
 
-class PeakTorque(_Dynamic):
-    """The largest |crank torque| over the turn at constant omega2 (N m)."""
+class _LiftedPeak(_Dynamic):
+    """A peak over the turn (of ``quantity`` of the cycle's dynamics) whose largest extremes the NLP lifts
+    (stationary in theta2) and whose exchange adds every extreme above the NLP's value; ``lifted`` gives the
+    NLP's expression of it at one crank angle and the terms it bounds."""
 
-    name, unit, label = "peak_torque", "N m", "peak crank torque"
+    what = ""  # the extreme's name in the NLP's rows
+
+    @staticmethod
+    def quantity(d):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def lifted(self, s, out) -> tuple:  # pragma: no cover - abstract
+        """(the expression whose stationarity a lift states, the epigraph terms it gives)."""
+        raise NotImplementedError
 
     def value(self, problem, m):
-        return _cycle(problem, m).peak(_abs_torque).value
+        return _cycle(problem, m).peak(self.quantity).value
 
     def epigraph(self, f):
         s = _symbolic(f)
-        return [("peak |crank torque|", [sign * s.torque(out) for out in f.sampled for sign in (1, -1)])]
+        return [(self.epigraph_name, [t for out in f.sampled for t in self.lifted(s, out)[1]])]
 
-    def lifts(self, f, role):  # the largest torque extremes, lifted like the peak acceleration's (dT/dtheta2 = 0)
+    def lifts(self, f, role):  # the largest extremes, lifted like the peak acceleration's
         return LIFTS
 
     def lift_terms(self, f, k, phi, out):
-        T = _symbolic(f).torque(out)
-        f.row("lifted torque extreme: stationary", casadi.jacobian(T, phi), 0.0, 0.0, kind="lift")
-        return [T, -T]
+        expr, terms = self.lifted(_symbolic(f), out)
+        f.row(f"lifted {self.what} extreme: stationary", casadi.jacobian(expr, phi), 0.0, 0.0, kind="lift")
+        return terms
 
     def lift_start(self, f, problem, m, n):  # at the largest extremes exactly: the stationarity rows start met
-        return [p.theta2 for p in _cycle(problem, m).peaks(_abs_torque, n)]
+        return [p.theta2 for p in _cycle(problem, m).peaks(self.quantity, n)]
 
     def exchange(self, f, problem, m, z, value_nlp, gap_tol):
-        peaks = _cycle(problem, m).peaks(_abs_torque, EXCHANGE_PEAKS)
-        p = peaks[0]
-        gap = (p.value - z[0]) / max(1.0, p.value)
-        add = [q.theta2 for q in peaks if q.value > z[0]] if gap > gap_tol else []  # every extreme above the bound
-        return Exchange(z[0], p.value, gap, add, [])
+        peaks = _cycle(problem, m).peaks(self.quantity, EXCHANGE_PEAKS)
+        top = self.to_nlp(peaks[0].value, 1.0)
+        gap = (top - z[0]) / max(1.0, top)
+        add = [q.theta2 for q in peaks if self.to_nlp(q.value, 1.0) > z[0]] if gap > gap_tol else []
+        return Exchange(self.from_nlp(z[0], 1.0), peaks[0].value, gap, add, [])
 
     def exceeded(self, problem, m):
-        return [_cycle(problem, m).peak(_abs_torque).theta2], []
+        return [_cycle(problem, m).peak(self.quantity).theta2], []
+
+
+class PeakTorque(_LiftedPeak):
+    """The largest |crank torque| over the turn at constant omega2 (N m)."""
+
+    name, unit, label = "peak_torque", "N m", "peak crank torque"
+    what, epigraph_name = "torque", "peak |crank torque|"
+    quantity = staticmethod(_abs_torque)
+
+    def lifted(self, s, out):
+        T = s.torque(out)
+        return T, [T, -T]
 
 
 GAUSS_NODES = None  # the cycle module's Gauss-Legendre rule, read once
@@ -432,38 +454,16 @@ class RmsTorque(_Squared):
         return Exchange(nlp, exact, gap, [], [])
 
 
-class ShakingForce(_Squared):
+class ShakingForce(_Squared, _LiftedPeak):
     """The largest shaking force |sum(m a_G)| over the turn at constant omega2 (N); the NLP bounds its square."""
 
     name, unit, label = "shaking_force", "N", "peak shaking force"
+    what, epigraph_name = "shaking", "peak |shaking force|^2"
+    quantity = staticmethod(_shaking)
 
-    def value(self, problem, m):
-        return _cycle(problem, m).peak(_shaking).value
-
-    def epigraph(self, f):
-        s = _symbolic(f)
-        return [("peak |shaking force|^2", [s.shaking_squared(out) for out in f.sampled])]
-
-    def lifts(self, f, role):  # its largest extreme, lifted (d|S|^2/dtheta2 = 0)
-        return LIFTS
-
-    def lift_terms(self, f, k, phi, out):
-        s2 = _symbolic(f).shaking_squared(out)
-        f.row("lifted shaking extreme: stationary", casadi.jacobian(s2, phi), 0.0, 0.0, kind="lift")
-        return [s2]
-
-    def lift_start(self, f, problem, m, n):
-        return [p.theta2 for p in _cycle(problem, m).peaks(_shaking, n)]
-
-    def exchange(self, f, problem, m, z, value_nlp, gap_tol):
-        peaks = _cycle(problem, m).peaks(_shaking, EXCHANGE_PEAKS)
-        p = peaks[0]
-        gap = (p.value**2 - z[0]) / max(1.0, p.value**2)
-        add = [q.theta2 for q in peaks if q.value**2 > z[0]] if gap > gap_tol else []
-        return Exchange(self.from_nlp(z[0], 1.0), p.value, gap, add, [])
-
-    def exceeded(self, problem, m):
-        return [_cycle(problem, m).peak(_shaking).theta2], []
+    def lifted(self, s, out):
+        s2 = s.shaking_squared(out)
+        return s2, [s2]
 
 
 class PeakBearingForce(_Squared):
