@@ -202,6 +202,17 @@ def sixbar_cycle(kind, p):
     return t_max, t_min, x_max, x_min, time_ratio(t_max, t_min), x_max - x_min, best
 
 
+SIXBARS = ("coupler-slider", "slot-ram-shaper")  # simulated by sixbar_*, the others by joints()
+
+
+def task_values(kind, p):
+    """(TR, stroke, gamma_min rad) of a design of any simulated type: a six-bar by its own simulation."""
+    if kind in SIXBARS:
+        return sixbar_cycle(kind, p)[4:]
+    t_max, t_min, x_max, x_min = dead_centres(kind, p)
+    return time_ratio(t_max, t_min), x_max - x_min, gamma_min(kind, p)
+
+
 def sixbar_motion(kind, p, th, omega2=1.0, step=1e-3):
     """x, v, a at crank angles th for a constant omega2 by central finite differences (Richardson-extrapolated,
     O(step^4)); truncation ~ step^4 x^(6) and rounding ~ 1e-16 x / step^2: ~1e-11 for v, ~1e-8 for a at 1e-3."""

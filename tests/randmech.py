@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 
 import qropt
+from tests.brute import SIXBARS  # drawn too (their brute force is sixbar_*)
 
 KINDS = ("slider-crank", "crank-shaper", "whitworth", "crank-rocker-slider", "drag-link-slider", "four-bar")
-SIXBARS = ("coupler-slider", "slot-ram-shaper")  # drawn too (their brute force is sixbar_*)
 
 
 def _draw(kind, rng):

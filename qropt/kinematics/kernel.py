@@ -98,22 +98,24 @@ class Batched:
             e = self._by_k[k] = [zin, out, ev, buf, uses, is_native]
         return e
 
+    def _count(self, k: int) -> int:
+        """Counts a use with K rows (up to HOT; none for a Function that is never compiled)."""
+        uses = self._uses.get(k, 0)
+        if uses < self.HOT and self.may_compile:
+            uses = self._uses[k] = uses + 1
+        return uses
+
     def hot(self, k: int) -> bool:
         """Counts a use with K rows; whether calls with K rows now run as machine code (a caller with a faster
         route than CasADi's virtual machine takes its own until then)."""
-        if k > self.MAX_ROWS or not self.may_compile:
-            return False
-        uses = self._uses[k] = min(self._uses.get(k, 0) + 1, self.HOT)
-        return uses >= self.HOT and self._entry(k)[5]
+        return k <= self.MAX_ROWS and self._count(k) >= self.HOT and self._entry(k)[5]
 
     def __call__(self, z: np.ndarray) -> np.ndarray:
         """z: (K, m) -> (K, r)."""
         k = z.shape[0]
         if k > self.MAX_ROWS:
             return np.concatenate([self(z[i : i + self.MAX_ROWS]) for i in range(0, k, self.MAX_ROWS)])
-        uses = self._uses.get(k, 0)
-        if uses < self.HOT and self.may_compile:
-            self._uses[k] = uses + 1
+        self._count(k)
         zin, out, ev = self._entry(k)[:3]
         zin[:] = z
         ev()
@@ -221,11 +223,7 @@ class Kernel:
             z = casadi.SX.sym("z", 1 + P.numel())
             fn = casadi.Function("grid", [t, P], [casadi.vertcat(*q)])
             f = self._groups["grid"] = Batched(casadi.Function("grid_values", [z], [fn(z[0], z[1:])], CSE))
-        theta = np.asarray(theta, float)
-        z = np.empty((theta.size, 1 + len(self.names)))
-        z[:, 0] = theta
-        z[:, 1:] = self.vector(params)
-        return np.ascontiguousarray(f(z).T)
+        return np.ascontiguousarray(f(self._rows(theta, params)).T)
 
     def rates(self, params, theta, omega2: float, alpha2: float, which: str):
         """Compiled time rates at crank angles theta (rad), crank rate omega2 (rad/s) and acceleration alpha2
@@ -246,15 +244,19 @@ class Kernel:
             z = casadi.SX.sym("z", 3 + P.numel())
             fn = casadi.Function("r", [t, w, al, P], [casadi.vertcat(*out)])
             f = self._groups[key] = Batched(casadi.Function(f"rates_{which}", [z], [fn(z[0], z[1], z[2], z[3:])], CSE))
-        theta = np.asarray(theta, float)
-        if not f.hot(theta.size):
+        if not f.hot(np.size(theta)):
             return None
-        z = np.empty((theta.size, 3 + len(self.names)))
+        return f(self._rows(theta, params, omega2, alpha2)).T
+
+    def _rows(self, theta, params, *scalars) -> np.ndarray:
+        """The rows z = (theta2, scalars..., parameters) of a compiled call, one per crank angle."""
+        theta = np.asarray(theta, float).ravel()
+        z = np.empty((theta.size, 1 + len(scalars) + len(self.names)))
         z[:, 0] = theta
-        z[:, 1] = omega2
-        z[:, 2] = alpha2
-        z[:, 3:] = self.vector(params)
-        return f(z).T
+        for i, v in enumerate(scalars):
+            z[:, 1 + i] = v
+        z[:, 1 + len(scalars) :] = self.vector(params)
+        return z
 
     @property
     def angle_names(self) -> list[str]:
@@ -322,8 +324,9 @@ class Kernel:
         if not ok.all():  # rare: flat, narrow or no extremes; the safeguarded iteration
             quantity_of, keep = rows[r], np.ones(r.size, bool)
             lo, hi = z[:, 1] - h, z[:, 1] + h
-            for q in np.unique(quantity_of[ok == 0]):
-                j = np.flatnonzero((ok == 0) & (quantity_of == q))
+            failed = ok == 0
+            for q in np.unique(quantity_of[failed]):
+                j = np.flatnonzero(failed & (quantity_of == q))
                 quantity = self.group(group)[q]
                 # a true extreme turns the slope inside its bracket; a jump (an angle wrapping at +-pi) does not
                 s = sgn[r[j]]

@@ -171,7 +171,7 @@ class LocalSolve:
             m, info, add, frac = certify(
                 problem, form, c.values, branch, pt.theta, pt.z, run.f, gap_tol, feas_tol, designs, c.problem
             )
-            if polish is not None:  # the warm run after an acceptable end: kept only if it is better
+            if polish is not None:  # the warm run after an acceptable end: kept if it converges and certifies
                 if not run.converged or not info.get("ok"):
                     w, g, c.values, c.problem, m, info, c.ends[-1], c.statuses[-1] = polish
                     break
