@@ -1,6 +1,7 @@
 """Dynamics, timed against the kinematics in the same run: full-cycle inverse dynamics (torque, every joint force,
-shaking) at 3,600 crank angles against the 3,600-angle motion (x, v, a) of the same mechanism, for random
-mechanisms of every type; and a ``min_peak_torque`` solve against a ``min_peak_accel`` solve of the same problem.
+shaking) at 3,600 crank angles against the 3,600-angle motion (x, v, a and the link rates) of the same mechanism,
+for random mechanisms of every type, in their first calls and once compiled; and a ``min_peak_torque`` solve
+against a ``min_peak_accel`` solve of the same problem.
 
 Medians of repeats; writes ``results/dynamics.json``. Run: ``python -m benchmarks.dynamics`` (repository root).
 """
@@ -15,6 +16,7 @@ import numpy as np
 import qropt
 from benchmarks import analysis
 from benchmarks.report import save
+from qropt.kinematics.kernel import Batched
 from qropt.mechanisms import TYPES
 from qropt.studies._design import type_problem
 from tests.randmech import random_mechanisms
@@ -30,20 +32,46 @@ def median_ms(f, repeat=7):
 
 
 def main() -> int:
+    """Two regimes per mechanism: uncompiled (the jets and numpy, as in a shape's first Batched.HOT calls; the
+    compiled calls held back for the measurement) and compiled (machine code, from Batched.HOT uses on)."""
     th = 2 * np.pi * np.arange(SAMPLES) / SAMPLES
     rows = {}
-    print(f"{'type':20s} {'motion ms':>10s} {'dynamics ms':>12s} {'ratio':>6s}   ({SAMPLES} crank angles)")
+    print(f"{SAMPLES} crank angles, ms: uncompiled (jets, numpy) | compiled")
+    print(f"{'type':20s} {'motion':>8s} {'dynamics':>9s} {'ratio':>6s} | {'motion':>8s} {'dynamics':>9s} {'ratio':>6s}")
     for cls in TYPES:
-        ratios, tm, td = [], [], []
+        out = {"first": ([], [], []), "compiled": ([], [], [])}
         for _, m in random_mechanisms(cls.KIND, 3, seed=21):
-            a = median_ms(lambda m=m: m.motion(th, 10.0))
-            b = median_ms(lambda m=m: m.dynamics(th, 10.0, masses=MASSES, loads=LOADS))
-            tm.append(a)
-            td.append(b)
-            ratios.append(b / a)
-        a, b, r = statistics.median(tm), statistics.median(td), statistics.median(ratios)
-        rows[cls.KIND] = {"motion_ms": a, "dynamics_ms": b, "ratio": ratios}
-        print(f"{cls.KIND:20s} {a:10.3f} {b:12.3f} {r:6.1f}")
+            for regime in ("first", "compiled"):
+                hot = Batched.HOT
+                if regime == "compiled":
+                    for _ in range(hot):
+                        m.motion(th, 10.0)
+                        m.dynamics(th, 10.0, masses=MASSES, loads=LOADS)
+                else:
+                    Batched.HOT = 10**9  # nothing runs compiled
+                try:
+                    a = median_ms(lambda m=m: m.motion(th, 10.0))
+                    b = median_ms(lambda m=m: m.dynamics(th, 10.0, masses=MASSES, loads=LOADS))
+                finally:
+                    Batched.HOT = hot
+                tm, td, ratios = out[regime]
+                tm.append(a)
+                td.append(b)
+                ratios.append(b / a)
+        rows[cls.KIND] = {
+            regime: {
+                "motion_ms": statistics.median(tm),
+                "dynamics_ms": statistics.median(td),
+                "ratio": statistics.median(r),
+                "ratios": r,
+            }
+            for regime, (tm, td, r) in out.items()
+        }
+        f, c = rows[cls.KIND]["first"], rows[cls.KIND]["compiled"]
+        print(
+            f"{cls.KIND:20s} {f['motion_ms']:8.3f} {f['dynamics_ms']:9.3f} {f['ratio']:6.1f} | "
+            f"{c['motion_ms']:8.3f} {c['dynamics_ms']:9.3f} {c['ratio']:6.1f}"
+        )
     solves = {}
     for kind in ("crank-shaper", "whitworth", "slider-crank"):
         p = type_problem(kind, 1.5, 0.3, objective="min_peak_accel", masses=MASSES, loads=LOADS, omega2=10.0)

@@ -546,6 +546,52 @@ def test_flywheel_against_dense_trapezoid(kind):
     assert abs(fw.return_energy) <= 1e-9 * F * stroke
 
 
+@pytest.mark.parametrize("kind", FLY_KINDS)
+def test_a_joint_force_that_jumps_at_a_dead_centre_peaks_there_on_the_working_side(kind):
+    """Route: a dense grid. The cutting force switches on and off at the dead centres, so the joint forces jump
+    there; the peak force at each joint is the supremum over the turn: the largest of a 200,001-angle grid and of
+    the limits at both dead centres from inside the working stroke (the ram's inertia and the force together),
+    found to 1e-9 and never below it. A large force on light links makes a dead centre the peak of some joint
+    (not on the Whitworth, whose lever amplifies the force mid-stroke)."""
+    from qropt.dynamics.cycle import CycleDynamics
+
+    m = _designs(kind, 1, seed=21)[0]
+    masses, loads = Masses.bars(0.5, 1.0), Loads(cutting_force=5000.0)
+    t = np.linspace(0.0, TWO_PI, 200_001)
+    d = m.dynamics(t, 7.0, masses=masses, loads=loads)
+    dc = m.dead_centres()
+    ends = CycleDynamics(m, 7.0, masses=masses, loads=loads).at([dc.theta_max, dc.theta_min], True)
+    ex = m.dynamic_extremes(7.0, masses=masses, loads=loads)
+    at_ends = 0
+    for j, f in d.joint_forces.items():
+        grid, limit = np.hypot(*f.T).max(), np.hypot(*ends.joint_forces[j].T).max()
+        best = max(grid, limit)
+        at_ends += limit >= grid
+        assert best * (1 - 1e-12) <= ex.peak_forces[j].value <= best * (1 + 1e-9), f"{m!r}: the peak force at {j}"
+    if kind != "whitworth":  # its lever amplifies the force mid-stroke: there every peak is inside the stroke
+        assert at_ends >= 1, f"{m!r}: no joint force peaks at a dead centre: the test checks nothing of the jump"
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_the_force_analysis_eliminates_by_the_structure(kind):
+    """Route: LAPACK. The Newton-Euler system of every type is eliminated in one order fixed by its structure
+    (constant pivots, then single unknowns, then 2x2 blocks: none that vanishes off a singular position); its
+    solution equals numpy's dense solve with partial pivoting at every angle, to 1e-10 of the largest unknown."""
+    from qropt.dynamics.inverse import Elimination, _kinetics, pivots, system_of
+
+    for i, m in enumerate(_designs(kind)):
+        masses, loads, omega2, alpha2 = _case(kind, i, m)
+        s = system_of(m, masses)
+        P, kin, _ = _kinetics(m, s, THETA, omega2, alpha2, 1.0)
+        entries, rhs = s.assemble(P, kin, G0, np.sqrt)
+        steps = pivots(entries, s.n)
+        assert steps is not None and all(len(r) == len(c) <= 2 for r, c in steps), f"{m!r}: {steps}"
+        e = Elimination(entries, s.n, THETA.size)
+        got = np.array(e.solve(rhs))
+        want = e._lapack(rhs, np.ones(THETA.size, bool)).T
+        assert np.max(np.abs(got - want)) <= 1e-10 * np.max(np.abs(want)), f"{m!r}"
+
+
 # ---- 8. bad input --------------------------------------------------------------------------------------------------
 def test_bad_input_is_a_typed_error_naming_the_problem():
     """Route: the error contract. Each bad input raises qropt.InvalidParameter (a QroptError) whose message names

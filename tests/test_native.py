@@ -11,6 +11,7 @@ import casadi
 import numpy as np
 import pytest
 
+import qropt
 from qropt.kinematics import cycle, native
 from qropt.kinematics.kernel import Batched
 from qropt.mechanisms import TYPES
@@ -60,6 +61,41 @@ def test_compiled_kernels_equal_the_vm(cls, cache):
     for name in ang:
         np.testing.assert_allclose(mo.omega[name], om[name], rtol=0, atol=1e-12 * max(1.0, np.abs(om[name]).max()))
         np.testing.assert_allclose(mo.alpha[name], al[name], rtol=0, atol=1e-11 * max(1.0, np.abs(al[name]).max()))
+
+
+@needs_compiler
+@pytest.mark.parametrize("kind", ["slider-crank", "crank-shaper", "whitworth", "four-bar", "coupler-slider"])
+def test_compiled_dynamics_equal_the_jets_route(kind, cache):
+    """The inverse dynamics once compiled (kinematics, bodies, the Newton-Euler elimination in one C call per
+    angle) against the jets and numpy's elimination, for every case of the dynamics tests (a counterweight, a
+    massive block, an offset yoke, gravity, friction's iteration, both senses; a follower torque) and a cutting
+    force table: torque, every joint force and the shaking, to 1e-12 of their largest. Both compiled variants
+    run (a known load in the call; per unit load for a table and friction)."""
+    from qropt.dynamics import compiled
+    from qropt.dynamics.inverse import system_of
+    from tests.test_dynamics import _case, _designs
+
+    t = np.linspace(0.0, 2 * np.pi, 131, endpoint=False) + 0.01
+    used = set()
+    for i, m in enumerate(_designs(kind)):
+        masses, loads, omega2, alpha2 = _case(kind, i, m)
+        if i == 1 and kind != "four-bar":  # a table of the ram's position
+            d = m.dead_centres()
+            loads = qropt.Loads(((d.x_min, 100.0), (d.x_max, 900.0)), gravity=9.81)
+        with pytest.MonkeyPatch.context() as mp:  # the reference: the jets and numpy, whatever is hot
+            mp.setattr(compiled, "parts", lambda *a, **k: None)
+            jets = m.dynamics(t, omega2, alpha2, masses=masses, loads=loads)
+        for _ in range(Batched.HOT + 1):
+            hot = m.dynamics(t, omega2, alpha2, masses=masses, loads=loads)
+        superposed = isinstance(loads.cutting_force, tuple) or bool(loads.friction)
+        f = compiled.kernel(m, system_of(m, masses), superposed)
+        assert f._uses.get(t.size, 0) >= Batched.HOT and f._entry(t.size)[5], "ran compiled"
+        used.add(superposed)
+        for a, b in [(jets.torque, hot.torque), (jets.shaking_force, hot.shaking_force)] + [
+            (jets.joint_forces[j], hot.joint_forces[j]) for j in jets.joint_forces
+        ]:
+            np.testing.assert_allclose(b, a, rtol=0, atol=1e-12 * max(1.0, np.abs(a).max()))
+    assert used == ({False} if kind == "four-bar" else {False, True})
 
 
 def test_slider_gives_link_rates_on_demand():

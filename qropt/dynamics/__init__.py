@@ -1,4 +1,5 @@
-"""Dynamics: the mass model and loads (``model``), exact inverse dynamics (``inverse``), cycle quantities and the
+"""Dynamics: the mass model and loads (``model``), a rigid body's motion from its joints' (``rigid``), exact
+inverse dynamics (``inverse``; compiled once a call shape is hot: ``compiled``), cycle quantities and the
 flywheel (``cycle``), and the crank's motion under a motor (``forward``)."""
 
 from qropt.dynamics.forward import Motor, Simulation, TurnSpeeds, simulate, steady_mean_torque

@@ -1,7 +1,8 @@
 """Cycle quantities of the inverse dynamics: exact extremes (peak torque, peak force at each joint, peak shaking
 force), quadratures over the turn (RMS torque, the energy per stroke) and the flywheel.
 
-Extremes: a grid of the turn, then a bounded scalar search around each grid maximum (to 1e-12 rad). Quadratures:
+Extremes: a grid of the turn (of each stroke, closed at its dead centres, where the loads switch there), then a
+bounded scalar search around the largest grid maxima (to 1e-12 rad). Quadratures:
 Gauss-Legendre on each stroke separately (the cutting force switches at the dead centres, so the integrand is
 smooth only within a stroke). SI units.
 """
@@ -19,6 +20,7 @@ from qropt.dynamics.model import Loads, Masses
 
 GRID = 720  # crank angles of the search grid
 GAUSS = 48  # Gauss-Legendre nodes per piece of a stroke
+REFINED, NEAR = 3, 0.01  # a peak: the grid's local maxima refined, at most 3 and within 1 % of the grid's best
 TWO_PI = 2 * math.pi
 
 
@@ -79,11 +81,14 @@ class CycleDynamics:
         d = m.dead_centres()
         a, _ = m.stroke_angles()
         self.pieces = [(d.theta_max, d.theta_max + a), (d.theta_max + a, d.theta_max + TWO_PI)]
+        first = _first_is_working(m, self.omega2 or 1.0)
+        self.working_pieces = (first, not first)
+        self.switching = _switches(self.loads) and m.working_direction(self.omega2 or 1.0) is not None
 
-    def at(self, theta2):
-        return _solve(
-            self.m, self.system, np.atleast_1d(np.asarray(theta2, float)), self.omega2, self.alpha2, self.loads
-        )
+    def at(self, theta2, working=None):
+        """The dynamics at crank angles theta2 (rad); ``working`` forces the cutting force on or off."""
+        t = np.atleast_1d(np.asarray(theta2, float))
+        return _solve(self.m, self.system, t, self.omega2, self.alpha2, self.loads, working)
 
     def quadrature(self, f, pieces=None):
         """integral of f(Dynamics) over the pieces (default: the two strokes, i.e. a turn), Gauss-Legendre."""
@@ -94,39 +99,45 @@ class CycleDynamics:
             total += 0.5 * (hi - lo) * float(np.dot(w, f(self.at(t % TWO_PI))))
         return total
 
-    def peak(self, f) -> Peak:
-        """The largest f(Dynamics) over the turn: the grid's best, then a bounded search around it."""
-        t = np.linspace(0.0, TWO_PI, GRID, endpoint=False)
-        v = f(self.at(t))
-        i = int(np.argmax(v))
-        h = TWO_PI / GRID
-        r = minimize_scalar(
-            lambda th: -float(f(self.at(th % TWO_PI))[0]),
-            bounds=(t[i] - h, t[i] + h),
-            method="bounded",
-            options={"xatol": 1e-12},
-        )
-        best = -float(r.fun)
-        if best >= v[i]:
-            return Peak(best, float(r.x % TWO_PI))
-        return Peak(float(v[i]), float(t[i]))
+    def peak(self, f, jumps: bool = False) -> Peak:
+        """The largest f(Dynamics) over the turn: the largest of the grid's local maxima within NEAR of its best
+        (a minimax design has several equal peaks), each refined (``peaks``)."""
+        return self.peaks(f, REFINED, NEAR, jumps)[0]
 
-    def peaks(self, f, n: int) -> list[Peak]:
-        """The n largest local maxima of f(Dynamics) over the turn, largest first, each refined like ``peak``."""
-        t = np.linspace(0.0, TWO_PI, GRID, endpoint=False)
-        v = f(self.at(t))
-        h = TWO_PI / GRID
-        tops = [i for i in range(GRID) if v[i] >= v[i - 1] and v[i] >= v[(i + 1) % GRID]]
+    def peaks(self, f, n: int, near: float | None = None, jumps: bool = False) -> list[Peak]:
+        """The n largest local maxima of f(Dynamics) over the turn, largest first (``near``: only those whose grid
+        value is within that fraction of the grid's best), each refined by a bounded search to 1e-12 rad. A
+        quantity that ``jumps`` where the loads switch (a joint force, at the dead centres) is searched over each
+        stroke closed at its ends with its own load: such a quantity may peak at a dead centre, on the working
+        side."""
+        found = []
+        split = jumps and self.switching
+        pieces = zip(self.pieces, self.working_pieces, strict=True) if split else [((0.0, TWO_PI), None)]
+        for (lo, hi), on in pieces:
+            k = max(8, math.ceil(GRID * (hi - lo) / TWO_PI))
+            closed = on is not None
+            t = np.linspace(lo, hi, k + 1) if closed else np.linspace(lo, hi, k, endpoint=False)
+            v = f(self.at(t % TWO_PI, on))
+            last = t.size - 1
+            for i in range(t.size):
+                left = v[i - 1] if i > 0 or not closed else -np.inf
+                right = v[i + 1] if i < last else (-np.inf if closed else v[0])
+                if v[i] >= left and v[i] >= right:
+                    found.append((float(v[i]), float(t[i]), lo, hi, (hi - lo) / k, closed, on))
+        found.sort(key=lambda c: -c[0])
+        if near is not None:
+            found = [c for c in found if c[0] >= found[0][0] - near * abs(found[0][0])]
         out = []
-        for i in sorted(tops, key=lambda i: -v[i])[:n]:
+        for value, t0, lo, hi, h, closed, on in found[:n]:
+            a, b = (max(lo, t0 - h), min(hi, t0 + h)) if closed else (t0 - h, t0 + h)
             r = minimize_scalar(
-                lambda th: -float(f(self.at(th % TWO_PI))[0]),
-                bounds=(t[i] - h, t[i] + h),
+                lambda th, on=on: -float(f(self.at(th % TWO_PI, on))[0]),
+                bounds=(a, b),
                 method="bounded",
                 options={"xatol": 1e-12},
             )
-            out.append(Peak(-float(r.fun), float(r.x % TWO_PI)) if -r.fun >= v[i] else Peak(float(v[i]), float(t[i])))
-        return out
+            out.append(Peak(-float(r.fun), float(r.x % TWO_PI)) if -r.fun >= value else Peak(value, t0 % TWO_PI))
+        return sorted(out, key=lambda p: -p.value)
 
     def extremes(self) -> DynamicExtremes:
         t = np.linspace(0.0, TWO_PI, GRID, endpoint=False)
@@ -137,7 +148,7 @@ class CycleDynamics:
             peak_torque=self.peak(lambda d: np.abs(d.torque)),
             rms_torque=rms,
             mean_torque=mean,
-            peak_forces={j: self.peak(lambda d, j=j: np.hypot(*d.joint_forces[j].T)) for j in joints},
+            peak_forces={j: self.peak(lambda d, j=j: np.hypot(*d.joint_forces[j].T), jumps=True) for j in joints},
             peak_shaking_force=self.peak(lambda d: np.hypot(*d.shaking_force.T)),
             peak_shaking_moment=self.peak(lambda d: np.abs(d.shaking_moment)),
         )
@@ -180,6 +191,12 @@ class CycleDynamics:
         w, r = sense * w, sense * r
         inertia = delta / (cs * self.omega2**2)
         return Flywheel(cs, self.omega2, delta, inertia, mean, sense * TWO_PI * mean, w, r)
+
+
+def _switches(loads: Loads) -> bool:
+    """Whether a cutting force or a follower's load torque acts (they switch on and off at the dead centres)."""
+    f = loads.cutting_force
+    return bool(loads.follower_torque or (np.any(np.array(f)[:, 1] != 0) if isinstance(f, tuple) else f))
 
 
 def _first_is_working(m, omega2) -> bool:

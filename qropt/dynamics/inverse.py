@@ -16,10 +16,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import casadi
 import numpy as np
 
 from qropt import units as units_
+from qropt.dynamics import compiled
 from qropt.dynamics.model import BodyMass, Loads, Masses, slender_bar, union
+from qropt.dynamics.rigid import body_motion
 from qropt.errors import DegenerateMechanism, InvalidParameter
 from qropt.kinematics.ops import JET, Jet
 
@@ -74,22 +77,9 @@ def _jet3(j, k: float = 1.0) -> tuple:
     return (float(j) * k, 0.0, 0.0)
 
 
-def _com_motion(b, bm, pts, shape, k):
-    """Body b's centre of mass from the loop's jets (``pts``: joint -> (x, y) jets), in metres (k: metres per
-    the mechanism's unit): its position, velocity and acceleration (each (x, y), arrays or numbers) and the body's
-    (cos phi, sin phi, phi', phi''). r_G = o + R(phi) c: velocity o' + phi' J R c, acceleration
-    o'' + phi'' J R c - phi'^2 R c."""
-    origin, rot = _frame(b, pts)
-    ox, oy = (_jet3(c, k) for c in origin)
-    cx, cy = bm.com
-    if cx == 0.0 and cy == 0.0:
-        return (ox[0], oy[0]), (ox[1], oy[1]), (ox[2], oy[2]), rot
-    c, sn, w, al = rot
-    rx, ry = (c * cx, sn * cx) if cy == 0.0 else (c * cx - sn * cy, sn * cx + c * cy)
-    w2 = w * w
-    v = (ox[1] - w * ry, oy[1] + w * rx)
-    a = (ox[2] - al * ry - w2 * rx, oy[2] + al * rx - w2 * ry)
-    return (ox[0] + rx, oy[0] + ry), v, a, rot
+def _triples(lp, k) -> dict:
+    """joint -> ((x, x', x''), (y, y', y'')) in metres (k: metres per the mechanism's unit) from the loop's jets."""
+    return {j: (_jet3(x, k), _jet3(y, k)) for j, (x, y) in lp.points.items()}
 
 
 def linkage_of(m):
@@ -101,32 +91,6 @@ def linkage_of(m):
             "(qropt.mechanisms.builder.Linkage); this type's loop is hand-written"
         )
     return link
-
-
-def _frame(body, pts):
-    """A body's frame: (origin (x, y) jets, (cos phi, sin phi, phi', phi'')), origin at its first joint and x
-    along the body (a block: along its slot's line from the pivot to the pin; a ram or yoke does not turn)."""
-    first = pts[body.joints[0]]
-    if body.kind in ("ram",):
-        return first, (1.0, 0.0, 0.0, 0.0)
-    if body.kind == "yoke":
-        return (first[0], 0.0), (1.0, 0.0, 0.0, 0.0)
-    if body.kind == "block":
-        pin, pivot = pts[body.joints[0]], pts[body.joints[1]]
-        return pin, _rotation(pin[0] - pivot[0], pin[1] - pivot[1])
-    second = pts[body.joints[1]]
-    return first, _rotation(second[0] - first[0], second[1] - first[1])
-
-
-def _rotation(dx, dy) -> tuple:
-    """(cos phi, sin phi, phi', phi'') of the direction (dx, dy) (jets or numbers), without an arctangent:
-    phi' = (x y' - y x') / r^2, phi'' = (x y'' - y x'' - 2 phi' (x x' + y y')) / r^2."""
-    (x0, x1, x2), (y0, y1, y2) = _jet3(dx), _jet3(dy)
-    r2 = x0 * x0 + y0 * y0
-    inv = 1.0 / r2
-    r = np.sqrt(r2)
-    w = (x0 * y1 - y0 * x1) * inv
-    return x0 / r, y0 / r, w, (x0 * y2 - y0 * x2 - 2.0 * w * (x0 * x1 + y0 * y1)) * inv
 
 
 def body_masses(m, masses: Masses) -> dict[str, BodyMass]:
@@ -252,7 +216,13 @@ class _System:
         s._structure(link, name, massive)
         return s
 
-    order = None  # the elimination's row order, found at the first solve of this mechanism
+    def pivots(self, entries: dict):
+        """The elimination's pivots for these entries (``pivots``), kept per structure: which entries are numbers."""
+        key = tuple((rc, v if isinstance(v, (int, float)) else None) for rc, v in entries.items())
+        cache = self.__dict__.setdefault("_pivots", {})
+        if key not in cache:
+            cache[key] = pivots(entries, self.n)
+        return cache[key]
 
     def _structure(self, link, name, massive):
         bodies = list(link.bodies())
@@ -294,6 +264,14 @@ class _System:
                 "analysis needs a linkage whose every body is held by pins, slots and the ram's guide"
             )
         self.n = n
+
+    def load_row(self) -> int | None:
+        """The row a known load enters: the output body's x force (a cutting force), else the follower's moment
+        (a follower's load torque); None for neither."""
+        out = next((b for b in self.bodies if b.kind in ("ram", "yoke")), None)
+        if out is not None:
+            return self.rows[out.name]
+        return self.rows["follower"] + 2 if "follower" in self.rows else None
 
     def kind(self, body: str) -> str:
         return next(b.kind for b in self.bodies if b.name == body)
@@ -390,59 +368,51 @@ def _has_load(loads: Loads) -> bool:
     )
 
 
-def _value(j, k):
-    """The value of a jet or a constant, times k (a constant stays a number)."""
-    return j.c[0] * k if isinstance(j, Jet) else float(j) * k
-
-
 def _kinetics(m, s: _System, t, omega2, alpha2, k):
     """From the loop's jets: the joints' positions (m), every body's (G, a_G, alpha, mass, inertia) and the
-    velocities the loads need (the output body's velocity, the follower's angular velocity); the jets themselves
+    velocity friction needs (the output body's); the jets themselves
     are dropped on return, which keeps the solve's memory small."""
-    lp = m.evaluate(JET, Jet.seed(t, omega2, alpha2))
-    pts = {j: (xy[0], xy[1]) for j, xy in lp.points.items()}
-    P = {j: (_value(x, k), _value(y, k)) for j, (x, y) in pts.items()}
+    pts = _triples(m.evaluate(JET, Jet.seed(t, omega2, alpha2)), k)
+    P = {j: (x[0], y[0]) for j, (x, y) in pts.items()}
     kin, vel = {}, {}
     for b in s.bodies:
         bm = s.props[b.name]
-        G, v, a, ph = _com_motion(b, bm, pts, t.shape, k)
+        G, v, a, ph = body_motion(b, bm.com, pts)
         kin[b.name] = (G, a, ph[3], bm.mass, bm.inertia)
-        if b.kind in ("ram", "yoke") or b.name == "follower":
+        if b.kind in ("ram", "yoke"):
             vel[b.name] = (v, ph[2])
     return P, kin, vel
 
 
-def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
+def _solve(m, s: _System, t, omega2, alpha2, loads, working=None) -> Dynamics:
+    """``working``: the cutting force's state at every angle (True on, False off; None: by the stroke)."""
     k = units_.to_metres(m.units)
-    shape = t.shape
     n = t.size
-    P, kin, vel = _kinetics(m, s, t, omega2, alpha2, k)
-    entries, rows = s.assemble(P, kin, loads.gravity, np.sqrt)
-    guide_col = next((col for c, col, _ in s.cols if c.kind == "guide"), None)
+    working = _working(m, t, omega2) if working is None else np.full(t.shape, bool(working))
+    way = m.working_direction(omega2 or 1.0)  # the load resists the working stroke's motion, its ends included
+    way = 0.0 if way is None else (1.0 if way == "+x" else -1.0)
     out_body = next((b for b in s.bodies if b.kind in ("ram", "yoke")), None)
-    rows = dict(rows)  # the known applied forces move to the right-hand side: cutting force, follower torque
-    working = _working(m, t, omega2)
-    if out_body is not None:
-        v_sign = -np.sign(vel[out_body.name][0][0])
-        x_out = P[m.output_joint()][0] / k if m.output_joint() else kin[out_body.name][0][0] / k
-        r = s.rows[out_body.name]
-        # along x, through the ram's point (no moment about a yoke's centre on its line)
-        rows[r] = rows.get(r, 0.0) - np.where(working, loads.force_at(x_out), 0.0) * v_sign
-    elif loads.follower_torque and m.OUTPUT == "follower":
-        r = s.rows["follower"] + 2
-        rows[r] = rows.get(r, 0.0) + np.where(working, loads.follower_torque * np.sign(vel["follower"][1]), 0.0)
-    friction = np.zeros(n)
+    guide_col = next((col for c, col, _ in s.cols if c.kind == "guide"), None)
+    sliding = bool(loads.friction) and guide_col is not None
+    table = out_body is not None and isinstance(loads.cutting_force, tuple)
+    known = None  # a load that does not depend on the motion (a table does: on the ram's position)
+    if out_body is not None and not table and loads.cutting_force:
+        known = np.where(working, loads.cutting_force * way, 0.0)
+    elif out_body is None and loads.follower_torque and m.OUTPUT == "follower":
+        known = np.where(working, loads.follower_torque * way, 0.0)
     try:
-        elim = Elimination(entries, s.n, n, s.order)  # one mechanism's row order serves each call
-        if s.order is None and not elim.dense and not elim.bad.any():
-            s.order = elim.order
-        x = elim.solve(rows)
+        a = compiled.parts(m, s, t, omega2, alpha2, loads.gravity, k, known, table or sliding)
+        if a is None:
+            a = _numpy_parts(m, s, t, omega2, alpha2, loads.gravity, k, known)
+        # along x, through the ram's point (no moment about a yoke's centre on its line)
+        load = np.where(working, loads.force_at(a.x_out), 0.0) * way if table else None
+        x = a.solve(load)
+        friction = np.zeros(n)
         if loads.friction and guide_col is not None:
-            r = s.rows[out_body.name]
-            base = rows.get(r, 0.0)
+            v_sign = -np.sign(a.v_out)
             for _ in range(FRICTION_ITERATIONS):
                 new = loads.friction * np.abs(x[guide_col]) * v_sign
-                x_new = elim.solve({**rows, r: base - new})
+                x_new = a.solve(-new if load is None else load - new)
                 done = np.max(np.abs(x_new[guide_col] - x[guide_col])) <= FRICTION_TOL * max(
                     1.0, float(np.max(np.abs(x_new[guide_col])))
                 )
@@ -460,20 +430,63 @@ def _solve(m, s: _System, t, omega2, alpha2, loads) -> Dynamics:
             key = f"{c.joint}/block" if s.block_massive and s.kind(c.receiver) == "block" else c.joint
             forces[key] = _pairs(x[col], x[col + 1], n)
         elif c.kind == "slot":
-            nx, ny = s.normal(c, P, np.sqrt)
+            nx, ny = a.normals[c.joint]
             forces[c.joint] = _pairs(x[col] * nx, x[col] * ny, n)
         else:
             forces["slide"] = _pairs(friction, x[col], n)
+    sfx, sfy, sm = a.shaking
+    gm = x[s.guide_moment_col] if s.yoke is not None else None
+    sm = np.broadcast_to(sm, t.shape).astype(float)
+    return Dynamics(t, omega2, alpha2, x[0], forces, _pairs(sfx, sfy, n), sm, gm)
+
+
+def shaking(kin) -> tuple:
+    """(fx, fy, moment about O2) of the shaking: -sum(m a_G), -sum(r_G x m a_G + I alpha) (kin: body -> (G, a_G,
+    alpha, mass, inertia), numbers, arrays or expressions alike)."""
     sfx, sfy, sm = 0.0, 0.0, 0.0
     for (gx, gy), (ax, ay), alpha, mass, inertia in kin.values():
-        if mass:
+        if not _zero(mass):
             sfx, sfy = sfx - mass * ax, sfy - mass * ay
             sm = sm - mass * (gx * ay - gy * ax)
-        if inertia:
+        if not _zero(inertia):
             sm = sm - inertia * alpha
-    gm = x[s.guide_moment_col] if s.yoke is not None else None
-    sm = np.broadcast_to(sm, shape).astype(float)
-    return Dynamics(t, omega2, alpha2, x[0], forces, _pairs(sfx, sfy, n), sm, gm)
+    return sfx, sfy, sm
+
+
+@dataclass
+class _Parts:
+    """What the loads need of one solve at n crank angles: ``solve(extra)`` gives the unknowns (K rows of n) with
+    the known load and ``extra`` (an (n,) array, or None) on the load's row (``_System.load_row``); the output's
+    position (its unit) and velocity (m/s), the slots' unit normals, the shaking (fx, fy, moment)."""
+
+    solve: object
+    x_out: object
+    v_out: object
+    normals: dict
+    shaking: tuple
+
+
+def _numpy_parts(m, s: _System, t, omega2, alpha2, g, k, known=None) -> _Parts:
+    """``_Parts`` from the jets and the elimination in numpy (``known``: the load that does not depend on the
+    motion, (n,) on the load's row, or None)."""
+    P, kin, vel = _kinetics(m, s, t, omega2, alpha2, k)
+    entries, rows = s.assemble(P, kin, g, np.sqrt)
+    elim = Elimination(entries, s.n, t.size, s.pivots(entries))
+    r = s.load_row()
+    if known is not None:
+        rows[r] = rows.get(r, 0.0) + known
+    base = rows.get(r, 0.0) if r is not None else 0.0
+
+    def solve(extra):
+        return elim.solve(rows if extra is None else {**rows, r: base + extra})
+
+    out_body = next((b for b in s.bodies if b.kind in ("ram", "yoke")), None)
+    x_out = v_out = None
+    if out_body is not None:
+        x_out = P[m.output_joint()][0] / k if m.output_joint() else kin[out_body.name][0][0] / k
+        v_out = vel[out_body.name][0][0]
+    normals = {c.joint: s.normal(c, P, np.sqrt) for c, _, _ in s.cols if c.kind == "slot"}
+    return _Parts(solve, x_out, v_out, normals, shaking(kin))
 
 
 def _pairs(a, b, n) -> np.ndarray:
@@ -506,13 +519,13 @@ def generalised(m, theta2, *, masses=None, loads=None, sense: float = 1.0) -> Ge
     s = system_of(m, masses)
     k = units_.to_metres(m.units)
     lp = m.evaluate(JET, Jet.seed(t, 1.0, 0.0))
-    pts = {j: (xy[0], xy[1]) for j, xy in lp.points.items()}
+    pts = _triples(lp, k)
     M = np.zeros(t.shape)
     dM = np.zeros(t.shape)
     Q = np.zeros(t.shape)
     for b in s.bodies:
         bm = s.props[b.name]
-        _, (vx, vy), (ax, ay), ph = _com_motion(b, bm, pts, t.shape, k)  # per unit theta2 (seeded 1, 0)
+        _, (vx, vy), (ax, ay), ph = body_motion(b, bm.com, pts)  # per unit theta2 (seeded 1, 0)
         M += bm.mass * (vx * vx + vy * vy) + bm.inertia * ph[2] ** 2
         dM += 2 * (bm.mass * (vx * ax + vy * ay) + bm.inertia * ph[2] * ph[3])
         Q += bm.mass * loads.gravity * vy
@@ -529,80 +542,172 @@ def generalised(m, theta2, *, masses=None, loads=None, sense: float = 1.0) -> Ge
 PIVOT_TOL = 1e-10  # a pivot below this times its column's largest entry: that angle is solved with pivoting
 
 
+def _constant(v) -> float | None:
+    """An entry's value if it is the same at every angle and design (a number, a constant CasADi expression),
+    else None."""
+    if isinstance(v, (int, float)):
+        return float(v)
+    if isinstance(v, casadi.SX) and v.is_constant():
+        return float(casadi.evalf(v))
+    return None
+
+
+def pivots(entries: dict, K: int) -> list[tuple[tuple, tuple]] | None:
+    """The elimination's steps for a system's structure ({(row, column): value}), each (rows, columns): a nonzero
+    constant entry while one is left (the one with the fewest fill-ins); then a row left with one unknown; then
+    two rows left with the same two unknowns (a dyad's inner pin: a 2x2 block, solved by its determinant). None
+    where the rest is coupled otherwise. Constant pivots never vanish, and a single unknown or a block's
+    determinant vanishes only where the system is singular, so one sequence serves every crank angle and every
+    design of a linkage, with the fill-in of the structure."""
+    rows: dict[int, dict[int, float | None]] = {r: {} for r in range(K)}
+    for (r, c), v in entries.items():
+        value = _constant(v)
+        if value != 0.0:
+            rows[r][c] = value
+    out, left = [], list(range(K))
+    while left:
+        best = None
+        for r in left:
+            for c, v in rows[r].items():
+                if v is not None:
+                    cost = (len(rows[r]) - 1) * (sum(c in rows[q] for q in left) - 1)
+                    if best is None or cost < best[0]:
+                        best = (cost, r, c)
+        if best is not None:
+            step = ((best[1],), (best[2],))
+        else:
+            step = next((((q,), tuple(rows[q])) for q in left if len(rows[q]) == 1), None)
+            if step is None:
+                pairs = [(q, s) for q in left for s in left if q < s and len(set(rows[q]) | set(rows[s])) == 2]
+                if not pairs:
+                    return None
+                q, s = pairs[0]
+                step = ((q, s), tuple(sorted(set(rows[q]) | set(rows[s]))))
+        rs, cs = step
+        if len(rs) == 1:
+            (r,), (c,) = step
+            p = rows[r][c]
+            for q in left:
+                if q != r and c in rows[q]:
+                    f = rows[q].pop(c)
+                    for cc, v in rows[r].items():
+                        if cc != c:
+                            old = rows[q].get(cc, 0.0)
+                            known = p is not None and f is not None and v is not None and old is not None
+                            new = old - f / p * v if known else None
+                            if new == 0.0:
+                                rows[q].pop(cc, None)
+                            else:
+                                rows[q][cc] = new
+        else:  # the fill of a block: expressions
+            for q in left:
+                if q not in rs and any(c in rows[q] for c in cs):
+                    for c in cs:
+                        rows[q].pop(c, None)
+                    for r in rs:
+                        rows[q].update({cc: None for cc in rows[r] if cc not in cs})
+        for r in rs:
+            left.remove(r)
+        out.append(step)
+    return out
+
+
 class Elimination:
     """Gaussian elimination of n small sparse systems A_i x = b_i (one per crank angle) that share a structure,
-    vectorised across the angles. ``entries``: {(row, column): value}, each value a number (the same at every
-    angle: kept a number, so a constant entry costs no array operation) or an (n,) array; absent entries are zero.
-    One row order (partial pivoting at one angle) serves every angle; an angle where a pivot is small for its
-    column is solved again by LAPACK with pivoting (np.linalg.solve, which raises LinAlgError where the system is
-    singular). The factors are kept, so further right-hand sides (friction's iteration) cost a substitution."""
+    vectorised across the angles, in the steps of ``pivots``. ``entries``: {(row, column): value}, each value a
+    number (the same at every angle: kept a number, so a constant entry costs no array operation), an (n,) array,
+    or a CasADi expression (``n`` None: the solution as expressions); absent entries are zero. An angle where a
+    pivot (or a block's determinant) is small for its column is solved again by LAPACK with pivoting
+    (np.linalg.solve, which raises LinAlgError where the system is singular), as is every angle of a structure
+    coupled beyond 2x2 blocks. The factors are kept, so further right-hand sides (friction's iteration) cost a
+    substitution."""
 
-    def __init__(self, entries: dict, K: int, n: int, order=None):
+    def __init__(self, entries: dict, K: int, n: int | None, order=None):
         self.K, self.n, self.entries = K, n, entries
-        self.order = order = order or self.pivoting(entries, K, n // 3)
+        self.order = order = pivots(entries, K) if order is None else order
+        self.dense = order is None
+        self.bad = np.zeros(n or 0, bool)
+        if self.dense:
+            return
         rows = [{} for _ in range(K)]
-        pos = {r: i for i, r in enumerate(order)}
         for (r, c), v in entries.items():
-            rows[pos[r]][c] = v
-        self.steps = []  # (i, j, f): row i -= f * row j
-        bad = np.zeros(n, bool)
-        self.dense = False
-        for j in range(K):
-            piv = rows[j].get(j)
-            if piv is None:
-                self.dense = True
-                return
-            below = [i for i in range(j + 1, K) if j in rows[i]]
-            if np.ndim(piv) > 0:
-                scale = np.abs(piv)
-                for i in below:
-                    scale = np.maximum(scale, np.abs(rows[i][j]))
-                bad |= np.abs(piv) <= PIVOT_TOL * scale
-                inv_p = 1.0 / np.where(piv == 0, 1.0, piv)
-            else:
-                inv_p = 1.0 / piv if piv != 0 else 1.0
-            for i in below:
-                f = rows[i].pop(j) * inv_p
-                for c, v in rows[j].items():
-                    if c != j:
-                        rows[i][c] = rows[i][c] - f * v if c in rows[i] else -f * v
-                self.steps.append((i, j, f))
-        self.rows, self.bad = rows, bad
+            rows[r][c] = v
+        self.steps = []  # (q, r, f): row q -= f * row r
+        self.inverse = {}  # a step's first row -> the inverse of its pivot, or of its 2x2 block (row-major)
+        done = set()
+        for rs, cs in order:
+            done.update(rs)
+            below = [q for q in range(K) if q not in done and any(c in rows[q] for c in cs)]
+            if len(rs) == 1:
+                p = rows[rs[0]][cs[0]]
+                inv = self._reciprocal(p, [p] + [rows[q][cs[0]] for q in below])
+                self.inverse[rs[0]] = (inv,)
+                for q in below:
+                    self._subtract(rows, q, rs[0], rows[q].pop(cs[0]) * inv, cs)
+                continue
+            (r1, r2), (c1, c2) = rs, cs
+            a, b = rows[r1].get(c1, 0.0), rows[r1].get(c2, 0.0)
+            c, d = rows[r2].get(c1, 0.0), rows[r2].get(c2, 0.0)
+            inv = self._reciprocal(a * d - b * c, [a * d, b * c])
+            B = self.inverse[r1] = (d * inv, -b * inv, -c * inv, a * inv)
+            for q in below:
+                f1, f2 = rows[q].pop(c1, 0.0), rows[q].pop(c2, 0.0)
+                self._subtract(rows, q, r1, f1 * B[0] + f2 * B[2], cs)
+                self._subtract(rows, q, r2, f1 * B[1] + f2 * B[3], cs)
+        self.rows = rows
 
-    @staticmethod
-    def pivoting(entries: dict, K: int, at: int) -> list:
-        """The row order of partial pivoting of the system at angle index ``at``."""
-        Mk = np.zeros((K, K))
-        for (r, c), v in entries.items():
-            Mk[r, c] = v if np.ndim(v) == 0 else v[at]
-        order, left = [], list(range(K))
-        for j in range(K):
-            i = max(left, key=lambda r: abs(Mk[r, j]))
-            order.append(i)
-            left.remove(i)
-            if Mk[i, j] != 0:
-                for r in left:
-                    Mk[r] -= Mk[r, j] / Mk[i, j] * Mk[i]
-        return order
+    def _reciprocal(self, p, column):
+        """1/p; an (n,) pivot small against its column's entries marks its angles bad (solved by LAPACK)."""
+        if not isinstance(p, np.ndarray):
+            return 1.0 / p
+        scale = np.abs(column[0])
+        for v in column[1:]:
+            scale = np.maximum(scale, np.abs(v))
+        self.bad |= np.abs(p) <= PIVOT_TOL * scale
+        return 1.0 / np.where(p == 0, 1.0, p)
+
+    def _subtract(self, rows, q, r, f, cs):
+        for cc, v in rows[r].items():
+            if cc not in cs:
+                rows[q][cc] = rows[q][cc] - f * v if cc in rows[q] else -f * v
+        self.steps.append((q, r, f))
 
     def solve(self, rhs: dict) -> list:
-        """x as K columns, each (n,), for the right-hand sides {row: number or (n,) array} (absent rows zero).
-        Columns rather than one (n, K) array: many small arrays keep the allocator from returning memory to the
-        system and faulting it in again at every call (measured 2.5x at 3,600 angles)."""
+        """x as K columns, each (n,) (or an expression), for the right-hand sides {row: number, (n,) array or
+        expression} (absent rows zero). Columns rather than one (n, K) array: many small arrays keep the allocator
+        from returning memory to the system and faulting it in again at every call (measured 2.5x at 3,600
+        angles)."""
         K, n = self.K, self.n
-        if self.dense or self.bad.all():
+        if self.dense:
+            if n is None:
+                A, b = casadi.SX(K, K), casadi.SX(K, 1)
+                for (r, c), v in self.entries.items():
+                    A[r, c] = v
+                for r, v in rhs.items():
+                    b[r] = v
+                x = casadi.solve(A, b)
+                return [x[i] for i in range(K)]
             return list(self._lapack(rhs, np.ones(n, bool)).T)
-        r = [rhs.get(i, 0.0) for i in self.order]
-        for i, j, f in self.steps:
-            r[i] = r[i] - f * r[j]
+        b = [rhs.get(i, 0.0) for i in range(K)]
+        for q, r, f in self.steps:
+            b[q] = b[q] - f * b[r]
         x = [None] * K
-        for j in range(K - 1, -1, -1):
-            acc = r[j]
-            for c, v in self.rows[j].items():
-                if c != j:
-                    acc = acc - v * x[c]
-            piv = self.rows[j][j]
-            x[j] = acc / (np.where(piv == 0, 1.0, piv) if np.ndim(piv) else (piv or 1.0))
+        for rs, cs in reversed(self.order):
+            acc = []
+            for r in rs:
+                a = b[r]
+                for cc, v in self.rows[r].items():
+                    if cc not in cs:
+                        a = a - v * x[cc]
+                acc.append(a)
+            B = self.inverse[rs[0]]
+            if len(rs) == 1:
+                x[cs[0]] = acc[0] * B[0]
+            else:
+                x[cs[0]] = B[0] * acc[0] + B[1] * acc[1]
+                x[cs[1]] = B[2] * acc[0] + B[3] * acc[1]
+        if n is None:
+            return x
         x = [v if isinstance(v, np.ndarray) and v.shape == (n,) else np.full(n, float(v)) for v in x]
         if self.bad.any():
             fix = self._lapack(rhs, self.bad)
@@ -625,7 +730,8 @@ def _working(m, t, omega2) -> np.ndarray:
     """Where the output moves on its working (slow) stroke at these crank angles."""
     a, _ = m.stroke_angles()
     d = m.dead_centres()
-    s = (t - d.theta_max) % (2 * math.pi)
+    s = t - d.theta_max
+    s -= (2 * math.pi) * np.floor(s * (0.5 / math.pi))  # mod 2 pi, a third of np.remainder's time
     down = s < a  # from theta_max to theta_min counter-clockwise: the output decreases for omega2 > 0
     way = m.working_direction(omega2 if omega2 else 1.0)
     if way is None:

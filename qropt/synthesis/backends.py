@@ -24,6 +24,7 @@ class Status(enum.Enum):
     ACCEPTABLE = "acceptable"  # to the backend's looser tolerance
     ITERATION_LIMIT = "iteration limit"
     INFEASIBLE = "infeasible"  # the backend found the constraints locally infeasible
+    STALLED = "stalled"  # steps too small to go on: maybe converged, to a tolerance too tight to show it
     FAILED = "failed"  # invalid numbers, a failed restoration, an error
 
 
@@ -61,14 +62,17 @@ IPOPT_STATUS = {
     "Solved_To_Acceptable_Level": Status.ACCEPTABLE,
     "Maximum_Iterations_Exceeded": Status.ITERATION_LIMIT,
     "Infeasible_Problem_Detected": Status.INFEASIBLE,
+    "Search_Direction_Becomes_Too_Small": Status.STALLED,
 }
 WARM = {"ipopt.bound_push": 1e-8, "ipopt.bound_frac": 1e-8}
+STALLED_KKT = 1e-9  # an IPOPT run stopped short of its tolerance is acceptable at a KKT point to this, relative
 
 
 class Ipopt:
-    """IPOPT through CasADi, one compiled solver per formulation (two: re-solves move a start off a bound by
-    1e-8 only, since IPOPT's default push of 0.01 is absolute and can move a small link across a Grashof or
-    assembly limit, where the loop has no real solution)."""
+    """IPOPT through CasADi, one compiled solver per formulation (two: re-solves, and starts on a bound, move
+    off a bound by 1e-8 only, since IPOPT's default push of 0.01 is absolute and can move a small link across a
+    Grashof or assembly limit, where the loop has no real solution, or a start that meets its targets far from
+    them)."""
 
     name = "ipopt"
 
@@ -84,11 +88,15 @@ class Ipopt:
         return pair[warm]
 
     def run(self, form, w0, p, lbx, ubx, warm: bool = False) -> Run:
-        solver = self.solver(form, warm)
-        r = solver(x0=np.clip(w0, lbx, ubx), p=p, lbx=lbx, ubx=ubx, lbg=form.lbg, ubg=form.ubg)
+        w0 = np.clip(w0, lbx, ubx)
+        on_bound = bool(np.any((w0 == lbx) | (w0 == ubx)))  # a start on a bound (a family's end) stays there
+        solver = self.solver(form, warm or on_bound)
+        r = solver(x0=w0, p=p, lbx=lbx, ubx=ubx, lbg=form.lbg, ubg=form.ubg)
         st = solver.stats()
         word = st.get("return_status", "?")
         status = IPOPT_STATUS.get(word, Status.SOLVED if st.get("success") else Status.FAILED)
+        if status in (Status.STALLED, Status.ITERATION_LIMIT) and self._stationary(form, r, p, lbx, ubx):
+            status, word = Status.ACCEPTABLE, f"{word} (a KKT point to {STALLED_KKT:g} of its own scale)"
         return Run(
             np.array(r["x"]).ravel(),
             float(r["f"]),
@@ -98,6 +106,34 @@ class Ipopt:
             int(st.get("iter_count", 0)),
             float(st.get("t_wall_total", 0.0)),
         )
+
+    def _stationary(self, form, r, p, lbx, ubx) -> bool:
+        """Whether a run that stopped short of IPOPT's tolerance (stalled, or at the iteration limit) ends at a KKT
+        point relative to its own scale: the Lagrangian's gradient (with the bounds' multipliers) within
+        STALLED_KKT of the largest of its terms, each multiplier times its distance to its bound within
+        STALLED_KKT of the objective, and every constraint met to STALLED_KKT of the largest. The dynamic
+        criteria's rows are in N^2, where IPOPT's absolute tolerance can be below the rounding of a converged
+        point."""
+        f = getattr(form, "_kkt_terms", None)
+        if f is None:
+            lam = casadi.SX.sym("lam", form.g_sym.numel())
+            w, g = form.w_sym, form.g_sym
+            grad_f = casadi.gradient(form.f_sym, w)
+            f = form._kkt_terms = casadi.Function("kkt", [w, form.p_sym, lam], [grad_f, casadi.jtimes(g, w, lam, True)])
+        x, g = np.array(r["x"]).ravel(), np.array(r["g"]).ravel()
+        lam_x, lam_g = np.array(r["lam_x"]).ravel(), np.array(r["lam_g"]).ravel()
+        grad_f, jl = (np.array(v).ravel() for v in f(x, p, lam_g))
+        scale = max(1.0, np.max(np.abs(grad_f)), np.max(np.abs(jl), initial=0.0), np.max(np.abs(lam_x), initial=0.0))
+        if np.max(np.abs(grad_f + jl + lam_x)) > STALLED_KKT * scale:
+            return False
+        lbx, ubx = np.broadcast_to(lbx, x.shape), np.broadcast_to(ubx, x.shape)
+        slack = [np.where(lam_x > 0, ubx - x, x - lbx), np.where(lam_g > 0, form.ubg - g, g - form.lbg)]
+        with np.errstate(invalid="ignore"):  # an infinite bound with a zero multiplier: no term
+            comp = [np.where(lam == 0, 0.0, np.abs(lam) * s) for lam, s in zip((lam_x, lam_g), slack, strict=True)]
+        if max(np.max(c, initial=0.0) for c in comp) > STALLED_KKT * max(1.0, abs(float(r["f"]))):
+            return False
+        violation = np.maximum(np.maximum(form.lbg - g, g - form.ubg), 0.0)
+        return bool(np.max(violation, initial=0.0) <= STALLED_KKT * max(1.0, np.max(np.abs(g), initial=0.0)))
 
 
 class Scipy:

@@ -19,12 +19,13 @@ import numpy as np
 
 from qropt import units as units_
 from qropt.dynamics.model import slender_bar, union
+from qropt.dynamics.rigid import body_motion
 from qropt.errors import InvalidParameter
 from qropt.synthesis.criteria import Criterion, Exchange, register
 
 TWO_PI = 2 * math.pi
-LIFTS = 2  # extremes the NLP lifts for the peak torque and the peak shaking force (two: an optimum often has two
-# equal peaks, one of them sharp)
+LIFTS = (2, 4)  # extremes the NLP lifts for the peak torque and the peak shaking force: the design's degrees of
+# freedom + 1 (a minimax optimum equalises that many peaks), at least two (one of two equal peaks is often sharp)
 CW_X, CW_Y = "counterweight moment x", "counterweight moment y"  # a free counterweight's variables (kg m)
 EXCHANGE_PEAKS = 4  # local maxima the exchange loop looks at: each above the NLP's bound becomes a sample angle
 
@@ -170,45 +171,19 @@ class _Symbolic:
             model = part if model is None else union(model, part)
         return model
 
+    def motion(self, out, b, com):
+        """(G, v_G, a_G, (cos phi, sin phi, phi', phi'')) of body b per unit theta2 (SI), by ``body_motion``."""
+        pts = {j: tuple(tuple(self.point(out, j, k)[i] for k in range(3)) for i in (0, 1)) for j in b.joints[:2]}
+        return body_motion(b, com, pts)
+
     def kinematics(self, out, b, com):
         """(v_G, a_G, phi', phi'') of body b per unit theta2 (SI)."""
-        first = b.joints[0]
-        o = [self.point(out, first, k) for k in range(3)]
-        if b.kind in ("ram", "yoke"):
-            if b.kind == "yoke":
-                o = [(p[0], 0.0) for p in o]
-            return o[1], o[2], 0.0, 0.0
-        if b.kind == "block":  # turns with the slot's line pivot -> pin
-            pin, pivot = b.joints[0], b.joints[1]
-            a = [self.point(out, pivot, k) for k in range(3)]
-            s = [self.point(out, pin, k) for k in range(3)]
-        else:
-            a, s = o, [self.point(out, b.joints[1], k) for k in range(3)]
-        dx, dy = s[0][0] - a[0][0], s[0][1] - a[0][1]
-        d1x, d1y = s[1][0] - a[1][0], s[1][1] - a[1][1]
-        d2x, d2y = s[2][0] - a[2][0], s[2][1] - a[2][1]
-        r2 = dx * dx + dy * dy
-        w = (dx * d1y - dy * d1x) / r2
-        al = (dx * d2y - dy * d2x) / r2 - 2 * w * (dx * d1x + dy * d1y) / r2
-        c, sn = dx / casadi.sqrt(r2), dy / casadi.sqrt(r2)
-        rx, ry = c * com[0] - sn * com[1], sn * com[0] + c * com[1]
-        v = (o[1][0] - w * ry, o[1][1] + w * rx)
-        acc = (o[2][0] - al * ry - w * w * rx, o[2][1] + al * rx - w * w * ry)
-        return v, acc, w, al
+        _, v, a, rot = self.motion(out, b, com)
+        return v, a, rot[2], rot[3]
 
     def centre(self, out, b, com):
         """The centre of mass G of body b (SI)."""
-        o = self.point(out, b.joints[0])
-        if b.kind in ("ram", "yoke"):
-            return (o[0] + com[0], (0.0 if b.kind == "yoke" else o[1]) + com[1])
-        if b.kind == "block":
-            a, e = self.point(out, b.joints[1]), o
-        else:
-            a, e = o, self.point(out, b.joints[1])
-        dx, dy = e[0] - a[0], e[1] - a[1]
-        r = casadi.sqrt(dx * dx + dy * dy)
-        c, sn = dx / r, dy / r
-        return (o[0] + c * com[0] - sn * com[1], o[1] + sn * com[0] + c * com[1])
+        return self.motion(out, b, com)[0]
 
     def system(self):
         """The Newton-Euler structure of the linkage (``qropt.dynamics.inverse._System``)."""
@@ -227,9 +202,10 @@ class _Symbolic:
             )
         return self._system
 
-    def bearing_loads(self, out):
+    def bearing_loads(self, out, working=None):
         """joint -> |force|^2 (N^2) at one crank angle at constant omega2: every pin and every block or pin in a
-        slot (what its pin carries), from the Newton-Euler system solved symbolically."""
+        slot (what its pin carries), from the Newton-Euler system solved symbolically; the cutting force on
+        (``working`` True), off (False) or by the ram's velocity (None)."""
         f, s = self.f, self.system()
         w2 = f.omega2**2
         models = self.mass_model(out)
@@ -241,18 +217,18 @@ class _Symbolic:
         P = {j: self.point(out, j) for j in f.joint_index}
         g = f.loads.gravity if f.loads is not None else 0.0
         entries, rows = s.assemble(P, kin, g, casadi.sqrt)
-        A = casadi.SX(s.n, s.n)
-        for (r, c), v in entries.items():
-            A[r, c] = v
-        rhs = casadi.SX(s.n, 1)
-        for r, v in rows.items():
-            rhs[r] = v
+        rhs = dict(rows)
         ram = next((b for b in s.bodies if b.kind in ("ram", "yoke")), None)
         force = self.cutting_force(out)
         if ram is not None and not (isinstance(force, (int, float)) and not force):  # against the working stroke
             way = (-1.0 if f.orientation > 0 else 1.0) * math.copysign(1.0, f.omega2)
-            rhs[s.rows[ram.name]] -= casadi.if_else(way * out.v * f.omega2 > 0, -force * way, 0.0)
-        x = casadi.solve(A, rhs)
+            r = s.rows[ram.name]
+            on = -force * way
+            load = casadi.if_else(way * out.v * f.omega2 > 0, on, 0.0) if working is None else on * working
+            rhs[r] = rhs.get(r, 0.0) - load
+        from qropt.dynamics.inverse import Elimination
+
+        x = Elimination(entries, s.n, None).solve(rhs)  # the structure's sparse elimination: small expressions
         loads = {}
         for c, col, _ in s.cols:
             if c.kind == "pin" and not (s.block_massive and s.kind(c.receiver) == "block"):
@@ -386,7 +362,8 @@ class _LiftedPeak(_Dynamic):
         return [(self.epigraph_name, [t for out in f.sampled for t in self.lifted(s, out)[1]])]
 
     def lifts(self, f, role):  # the largest extremes, lifted like the peak acceleration's
-        return LIFTS
+        free = len(f.free) - len(f.targets) + (2 if f.masses is not None and f.masses.balancing else 0)
+        return min(max(LIFTS[0], free + 1), LIFTS[1])
 
     def lift_terms(self, f, k, phi, out):
         expr, terms = self.lifted(_symbolic(f), out)
@@ -484,26 +461,47 @@ class PeakBearingForce(_Squared):
                 raise InvalidParameter(f"{type(m).__name__} has no joint {self.joint!r}: {sorted(d.joint_forces)}")
             return np.max([np.hypot(*d.joint_forces[k].T) for k in keys], axis=0)
 
-        return _cycle(problem, m).peak(worst)
+        return _cycle(problem, m).peak(worst, jumps=True)
 
     def value(self, problem, m):
         return self._peak(problem, m).value
 
     def epigraph(self, f):
         s = _symbolic(f)
+        if _switching(f.loads):  # the loads jump at the dead centres: each stroke's samples with its own load
+            outs = [(o, True) for o in f.working()] + [(o, False) for o in f.returning()]
+        else:
+            outs = [(o, None) for o in f.sampled]
         exprs = []
-        for out in f.sampled:
-            loads = s.bearing_loads(out)
+        for out, working in outs:
+            loads = s.bearing_loads(out, working)
             exprs += [v for k, v in loads.items() if self.joint is None or k == self.joint]
         return [(f"peak {self.label}^2", exprs)]
 
     def exchange(self, f, problem, m, z, value_nlp, gap_tol):
         p = self._peak(problem, m)
         gap = (p.value**2 - z[0]) / max(1.0, p.value**2)
-        return Exchange(self.from_nlp(z[0], 1.0), p.value, gap, [p.theta2] if gap > gap_tol else [], [])
+        add, frac = self._placed(problem, m, p.theta2) if gap > gap_tol else ([], [])
+        return Exchange(self.from_nlp(z[0], 1.0), p.value, gap, add, frac)
 
     def exceeded(self, problem, m):
-        return [self._peak(problem, m).theta2], []
+        return self._placed(problem, m, self._peak(problem, m).theta2)
+
+    @staticmethod
+    def _placed(problem, m, theta):
+        """Where a sample goes for crank angle theta: the angle itself, or (the loads switching) its fraction of
+        its stroke, which the working and the return samples share."""
+        if not _switching(problem.loads):
+            return [theta], []
+        lo, length = m.working_arc()
+        d = (theta - lo) % TWO_PI
+        return [], [d / length if d <= length else (d - length) / (TWO_PI - length)]
+
+
+def _switching(loads) -> bool:
+    from qropt.dynamics.cycle import _switches
+
+    return loads is not None and _switches(loads)
 
 
 for _c in (PeakTorque(), RmsTorque(), ShakingForce(), PeakBearingForce()):

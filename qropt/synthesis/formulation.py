@@ -178,7 +178,7 @@ class Formulation:
         self.exact = [self.at(a) for a in sorted({a for v in cls.EXACT_TRANSMISSION.values() for a in v})]
         self._start = TH[0] if orientation > 0 else TH[1]
         self._length = (TH[1] - TH[0]) if orientation > 0 else TWO_PI - (TH[1] - TH[0])
-        self._W, self._working, self._strokes = W, None, None
+        self._W, self._working, self._returning, self._strokes = W, None, None, None
         travel, span = self._core_rows(TH, PT)
         self._condition_rows(problem)
 
@@ -282,6 +282,7 @@ class Formulation:
             self.sampled,
             self.exact,
             self._working,
+            self._returning,
             self._strokes,
             self.aux,
             self._capped,
@@ -336,6 +337,13 @@ class Formulation:
         if self._working is None:
             self._working = [self.at(self._start + self._W[k] * self._length) for k in range(self.n_samples)]
         return self._working
+
+    def returning(self) -> list[Kin]:
+        """The outputs at the same fractions of the return arc (the return stroke's samples)."""
+        if self._returning is None:
+            lo, arc = self._start + self._length, TWO_PI - self._length
+            self._returning = [self.at(lo + self._W[k] * arc) for k in range(self.n_samples)]
+        return self._returning
 
     def strokes(self, nodes) -> list[tuple[Kin, float, float]]:
         """(outputs, weight, arc) at Gauss-Legendre ``nodes`` (on [-1, 1]) of the working arc, then of the return

@@ -177,8 +177,8 @@ class LocalSolve:
                     break
                 polish = None
             near = range_target or max(form.violations(g).values(), default=0.0) <= RESTART_VIOLATION
-            if run.status is Status.ITERATION_LIMIT and restarts < RESTARTS and near:
-                restarts += 1  # the iteration budget ran out on the way to an optimum: go on from there
+            if run.status in (Status.ITERATION_LIMIT, Status.STALLED) and restarts < RESTARTS and near:
+                restarts += 1  # the iteration budget ran out, or the steps stalled, near a design: go on from there
                 continue
             if not run.converged and not range_target:
                 break
