@@ -152,7 +152,7 @@ class _Quantity:
         wrapped = casadi.fmod(x, TWO_PI)
         wrapped = casadi.if_else(wrapped < 0, wrapped + TWO_PI, wrapped)
         wrapped = casadi.if_else(wrapped > TWO_PI - 1e-12, 0.0, wrapped)
-        self.newton = Batched(casadi.Function("n", [zn], [casadi.vertcat(wrapped, ok, value(x, pz))], CSE))
+        self.newton = casadi.Function("n", [zn], [casadi.vertcat(wrapped, ok, value(x, pz))], CSE)  # switched (refine)
         self.value = Batched(casadi.Function("vz", [z], [value(z[0], z[1:])], CSE))
 
     def at(self, theta, p):
@@ -277,7 +277,7 @@ class Kernel:
         key = "switch " + group
         f = self._groups.get(key)
         if f is None:
-            fs = [q.newton.f for q in self.group(group)]
+            fs = [q.newton for q in self.group(group)]
             z = casadi.MX.sym("z", 1 + fs[0].size1_in(0))
             sw = casadi.Function.conditional(f"{group}_switch", fs, fs[0])
             f = self._groups[key] = Batched(casadi.Function(f"{group}_newton", [z], [sw(z[0], z[1:])]))
