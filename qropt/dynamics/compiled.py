@@ -16,16 +16,22 @@ import casadi
 import numpy as np
 
 from qropt.dynamics.rigid import body_motion
+from qropt.kinematics import native
 from qropt.kinematics.kernel import CSE, Batched
 from qropt.kinematics.ops import CASADI
 
 _KERNELS: dict = {}
+_CALLS: dict = {}  # (structure, rows) -> calls made before the structure's Function was built
+
+
+def _key(m, s, superposed: bool) -> tuple:
+    return (type(m), tuple(m.params), tuple(b.name for b in s.bodies), s.block_massive, superposed)
 
 
 def kernel(m, s, superposed: bool = False) -> Batched:
     """The compiled dynamics of m's structure (type, parameter names, bodies) under the system s; ``superposed``:
     also the unknowns per unit load (for a load that depends on the motion, or friction's iteration)."""
-    key = (type(m), tuple(m.params), tuple(b.name for b in s.bodies), s.block_massive, superposed)
+    key = _key(m, s, superposed)
     f = _KERNELS.get(key)
     if f is None:
         f = _KERNELS[key] = Batched(_function(m, s, superposed))
@@ -80,8 +86,14 @@ def parts(m, s, t, omega2, alpha2, g, k, known=None, superposed=False):
     """``inverse._Parts`` from the compiled call (``known``: the load that does not depend on the motion, (n,) on
     the load's row, or None), or None while it is not machine code (or where a row is not finite: a singular
     angle, which the numpy route reports)."""
-    f = kernel(m, s, superposed)
     n = t.size
+    key = _key(m, s, superposed)
+    if key not in _KERNELS:  # built (about 15 ms) only once its calls would run compiled
+        calls = _CALLS[key, n] = _CALLS.get((key, n), 0) + 1
+        if calls < Batched.HOT or not native.enabled():
+            return None
+        kernel(m, s, superposed).credit(n, calls - 1)
+    f = kernel(m, s, superposed)
     if not f.hot(n):
         return None
     z = np.empty((n, f.m))

@@ -105,6 +105,12 @@ class Batched:
             uses = self._uses[k] = uses + 1
         return uses
 
+    def credit(self, k: int, uses: int) -> None:
+        """Counts uses with K rows made before this Batched existed (by a caller that builds its Function only
+        once it would be compiled)."""
+        if self.may_compile:
+            self._uses[k] = max(self._uses.get(k, 0), min(uses, self.HOT))
+
     def hot(self, k: int) -> bool:
         """Counts a use with K rows; whether calls with K rows now run as machine code (a caller with a faster
         route than CasADi's virtual machine takes its own until then)."""
