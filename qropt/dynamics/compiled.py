@@ -53,13 +53,13 @@ def _function(m, s, superposed: bool) -> casadi.Function:
 
     pts = {j: (rates(x), rates(y)) for j, (x, y) in lp.points.items()}
     B = casadi.SX.sym("b", 4 * len(s.bodies))
-    kin, v_out, out_body = {}, 0.0, None
+    kin, v_out = {}, 0.0
     for i, b in enumerate(s.bodies):
         mass, cx, cy, inertia = (B[4 * i + j] for j in range(4))
         G, v, a, rot = body_motion(b, (cx, cy), pts)
         kin[b.name] = (G, a, rot[3], mass, inertia)
-        if b.kind in ("ram", "yoke"):
-            out_body, v_out = b, v[0]
+        if b is s.output:
+            v_out = v[0]
     at = {j: (x[0], y[0]) for j, (x, y) in pts.items()}
     entries, rows = s.assemble(at, kin, g, casadi.sqrt)
     elim = Elimination(entries, s.n, None)
@@ -70,7 +70,7 @@ def _function(m, s, superposed: bool) -> casadi.Function:
     if superposed:
         out += list(elim.solve({r: 1.0})) if r is not None else [0.0] * s.n
     joint = m.output_joint()
-    x_out = at[joint][0] / k if joint else (kin[out_body.name][0][0] / k if out_body is not None else 0.0)
+    x_out = at[joint][0] / k if joint else (kin[s.output.name][0][0] / k if s.output is not None else 0.0)
     out += [x_out, v_out, *shaking(kin)]
     for c, _, _ in s.cols:
         if c.kind == "slot":
@@ -88,12 +88,13 @@ def parts(m, s, t, omega2, alpha2, g, k, known=None, superposed=False):
     angle, which the numpy route reports)."""
     n = t.size
     key = _key(m, s, superposed)
-    if key not in _KERNELS:  # built (about 15 ms) only once its calls would run compiled
+    f = _KERNELS.get(key)
+    if f is None:  # built (about 15 ms) only once its calls would run compiled
         calls = _CALLS[key, n] = _CALLS.get((key, n), 0) + 1
         if calls < Batched.HOT or not native.enabled():
             return None
-        kernel(m, s, superposed).credit(n, calls - 1)
-    f = kernel(m, s, superposed)
+        f = kernel(m, s, superposed)
+        f.credit(n, calls - 1)
     if not f.hot(n):
         return None
     z = np.empty((n, f.m))

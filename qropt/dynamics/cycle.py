@@ -83,7 +83,7 @@ class CycleDynamics:
         self.pieces = [(d.theta_max, d.theta_max + a), (d.theta_max + a, d.theta_max + TWO_PI)]
         first = _first_is_working(m, self.omega2 or 1.0)
         self.working_pieces = (first, not first)
-        self.switching = _switches(self.loads) and m.working_direction(self.omega2 or 1.0) is not None
+        self.switching = self.loads.switching and m.working_direction(self.omega2 or 1.0) is not None
 
     def at(self, theta2, working=None):
         """The dynamics at crank angles theta2 (rad); ``working`` forces the cutting force on or off."""
@@ -185,18 +185,11 @@ class CycleDynamics:
         delta = max(energy) - min(energy)
         work = self.quadrature(lambda d: d.torque, [self.pieces[0]])
         back = self.quadrature(lambda d: d.torque, [self.pieces[1]])
-        working_first = self.m.working_direction(self.omega2) is not None and _first_is_working(self.m, self.omega2)
-        w, r = (work, back) if working_first else (back, work)
+        w, r = (work, back) if self.working_pieces[0] else (back, work)
         sense = math.copysign(1.0, self.omega2)  # energy delivered: the integral of T omega2 dt = sign * T dtheta2
         w, r = sense * w, sense * r
         inertia = delta / (cs * self.omega2**2)
         return Flywheel(cs, self.omega2, delta, inertia, mean, sense * TWO_PI * mean, w, r)
-
-
-def _switches(loads: Loads) -> bool:
-    """Whether a cutting force or a follower's load torque acts (they switch on and off at the dead centres)."""
-    f = loads.cutting_force
-    return bool(loads.follower_torque or (np.any(np.array(f)[:, 1] != 0) if isinstance(f, tuple) else f))
 
 
 def _first_is_working(m, omega2) -> bool:

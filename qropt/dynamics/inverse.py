@@ -252,6 +252,7 @@ class _System:
             n += width
         self.cols = cols
         self.yoke = next((b.name for b in bodies if b.kind == "yoke"), None)
+        self.output = next((b for b in bodies if b.kind in ("ram", "yoke")), None)  # the body a cutting force acts on
         if self.yoke is not None:
             self.guide_moment_col = n
             n += 1
@@ -268,9 +269,8 @@ class _System:
     def load_row(self) -> int | None:
         """The row a known load enters: the output body's x force (a cutting force), else the follower's moment
         (a follower's load torque); None for neither."""
-        out = next((b for b in self.bodies if b.kind in ("ram", "yoke")), None)
-        if out is not None:
-            return self.rows[out.name]
+        if self.output is not None:
+            return self.rows[self.output.name]
         return self.rows["follower"] + 2 if "follower" in self.rows else None
 
     def kind(self, body: str) -> str:
@@ -362,10 +362,7 @@ def inverse_dynamics(m, theta2, omega2: float = 1.0, alpha2: float = 0.0, *, mas
 
 
 def _has_load(loads: Loads) -> bool:
-    f = loads.cutting_force
-    return bool(
-        loads.friction or loads.follower_torque or (np.any(np.array(f)[:, 1] > 0) if isinstance(f, tuple) else f)
-    )
+    return bool(loads.friction) or loads.switching
 
 
 def _kinetics(m, s: _System, t, omega2, alpha2, k):
@@ -380,7 +377,7 @@ def _kinetics(m, s: _System, t, omega2, alpha2, k):
         G, v, a, ph = body_motion(b, bm.com, pts)
         kin[b.name] = (G, a, ph[3], bm.mass, bm.inertia)
         if b.kind in ("ram", "yoke"):
-            vel[b.name] = (v, ph[2])
+            vel[b.name] = v
     return P, kin, vel
 
 
@@ -391,7 +388,7 @@ def _solve(m, s: _System, t, omega2, alpha2, loads, working=None) -> Dynamics:
     working = _working(m, t, omega2) if working is None else np.full(t.shape, bool(working))
     way = m.working_direction(omega2 or 1.0)  # the load resists the working stroke's motion, its ends included
     way = 0.0 if way is None else (1.0 if way == "+x" else -1.0)
-    out_body = next((b for b in s.bodies if b.kind in ("ram", "yoke")), None)
+    out_body = s.output
     guide_col = next((col for c, col, _ in s.cols if c.kind == "guide"), None)
     sliding = bool(loads.friction) and guide_col is not None
     table = out_body is not None and isinstance(loads.cutting_force, tuple)
@@ -408,7 +405,7 @@ def _solve(m, s: _System, t, omega2, alpha2, loads, working=None) -> Dynamics:
         load = np.where(working, loads.force_at(a.x_out), 0.0) * way if table else None
         x = a.solve(load)
         friction = np.zeros(n)
-        if loads.friction and guide_col is not None:
+        if sliding:
             v_sign = -np.sign(a.v_out)
             for _ in range(FRICTION_ITERATIONS):
                 new = loads.friction * np.abs(x[guide_col]) * v_sign
@@ -480,11 +477,10 @@ def _numpy_parts(m, s: _System, t, omega2, alpha2, g, k, known=None) -> _Parts:
     def solve(extra):
         return elim.solve(rows if extra is None else {**rows, r: base + extra})
 
-    out_body = next((b for b in s.bodies if b.kind in ("ram", "yoke")), None)
-    x_out = v_out = None
+    out_body, x_out, v_out = s.output, None, None
     if out_body is not None:
         x_out = P[m.output_joint()][0] / k if m.output_joint() else kin[out_body.name][0][0] / k
-        v_out = vel[out_body.name][0][0]
+        v_out = vel[out_body.name][0]
     normals = {c.joint: s.normal(c, P, np.sqrt) for c, _, _ in s.cols if c.kind == "slot"}
     return _Parts(solve, x_out, v_out, normals, shaking(kin))
 

@@ -228,6 +228,12 @@ class Loads:
         object.__setattr__(self, "gravity", _real("gravity (m/s^2)", self.gravity, nonneg=True))
         object.__setattr__(self, "follower_torque", _real("follower_torque (N m)", self.follower_torque, nonneg=True))
 
+    @property
+    def switching(self) -> bool:
+        """Whether a cutting force or a follower's load torque acts: they switch on and off at the dead centres."""
+        f = self.cutting_force
+        return bool(self.follower_torque or (any(r[1] > 0 for r in f) if isinstance(f, tuple) else f))
+
     def force_at(self, x) -> np.ndarray:
         """The cutting force's magnitude (N) at ram positions x (the mechanism's unit)."""
         f = self.cutting_force

@@ -218,7 +218,7 @@ class _Symbolic:
         g = f.loads.gravity if f.loads is not None else 0.0
         entries, rows = s.assemble(P, kin, g, casadi.sqrt)
         rhs = dict(rows)
-        ram = next((b for b in s.bodies if b.kind in ("ram", "yoke")), None)
+        ram = s.output
         force = self.cutting_force(out)
         if ram is not None and not (isinstance(force, (int, float)) and not force):  # against the working stroke
             way = (-1.0 if f.orientation > 0 else 1.0) * math.copysign(1.0, f.omega2)
@@ -468,7 +468,9 @@ class PeakBearingForce(_Squared):
 
     def epigraph(self, f):
         s = _symbolic(f)
-        if _switching(f.loads):  # the loads jump at the dead centres: each stroke's samples with its own load
+        if (
+            f.loads is not None and f.loads.switching
+        ):  # the loads jump at the dead centres: each stroke's samples with its own load
             outs = [(o, True) for o in f.working()] + [(o, False) for o in f.returning()]
         else:
             outs = [(o, None) for o in f.sampled]
@@ -491,17 +493,11 @@ class PeakBearingForce(_Squared):
     def _placed(problem, m, theta):
         """Where a sample goes for crank angle theta: the angle itself, or (the loads switching) its fraction of
         its stroke, which the working and the return samples share."""
-        if not _switching(problem.loads):
+        if problem.loads is None or not problem.loads.switching:
             return [theta], []
         lo, length = m.working_arc()
         d = (theta - lo) % TWO_PI
         return [], [d / length if d <= length else (d - length) / (TWO_PI - length)]
-
-
-def _switching(loads) -> bool:
-    from qropt.dynamics.cycle import _switches
-
-    return loads is not None and _switches(loads)
 
 
 for _c in (PeakTorque(), RmsTorque(), ShakingForce(), PeakBearingForce()):
