@@ -49,6 +49,13 @@ def _finite(name: str, value) -> float:
     return v
 
 
+def working_sign(max_to_min_is_slow: bool, omega2: float) -> float:
+    """-1.0 or +1.0: the way along x the output moves in its slow (working) stroke, where the crank's turn from
+    theta_max to theta_min counter-clockwise is the slow one or not, for the crank's sense (omega2's sign). The one
+    rule of ``Mechanism.working_direction`` and of the synthesis NLP's loads (its TR orientation)."""
+    return -1.0 if bool(max_to_min_is_slow) == (omega2 > 0) else 1.0
+
+
 def crank_angles(theta2) -> np.ndarray:
     """Crank angles (rad) from the API as a 1-D float array: real, finite, at most MAX_ANGLES of them."""
     if (
@@ -283,6 +290,9 @@ class Mechanism:
     # parameters along which, at given targets, the motion and so every kinematic criterion stay the same (the
     # others following): such optima form a continuum, and a solve breaks the tie by the least size
     TIES: ClassVar[tuple[str, ...]] = ()
+    # whether every design of the type that turns has an output reversing exactly once a turn (driven, through
+    # links that each move one way, by a crank that turns once); else the synthesis NLP states it (guard rows)
+    ONE_REVERSAL: ClassVar[bool] = False
     BODIES: ClassVar[tuple[Body, ...]] = ()  # every moving body (see Body): pictures and the mass model read them
     GROUND: ClassVar[tuple[str, ...]] = ()  # the joints fixed to the frame (ground pivots)
     OUTPUT_JOINT: ClassVar[str | None] = None  # the joint whose x is a slider output; None for a follower angle
@@ -622,8 +632,7 @@ class Mechanism:
         a, b = self.stroke_angles()
         if a == b:
             return None
-        minus_is_slow = (a > b) == (omega2 > 0)
-        return "-x" if minus_is_slow else "+x"
+        return "-x" if working_sign(a > b, omega2) < 0 else "+x"
 
     @cached_property
     def _gamma_min(self) -> GammaMin:

@@ -30,6 +30,8 @@ class CrankShaper(Mechanism):
     Without r6 the ram is driven by a yoke and x = x_C (the lab rig of seed 001).
     """
 
+    ONE_REVERSAL = True
+
     KIND = "crank-shaper"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r4": REQUIRED, "r6": None, "h": None, "sigma_slider": 1.0}
     LENGTHS = ("r1", "r2", "r4", "r6")

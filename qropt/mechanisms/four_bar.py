@@ -107,6 +107,8 @@ class FourBar(_FourBarBase):
     time ratio need a crank that turns fully and a follower that rocks.
     """
 
+    ONE_REVERSAL = True
+
     KIND = "four-bar"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r3": REQUIRED, "r4": REQUIRED, "sigma": -1.0}
     REQUIRES_FULL_TURN = False
@@ -131,6 +133,8 @@ class FourBar(_FourBarBase):
 
 class FourBarSlider(_FourBarBase):
     """Four-bar-driven slider: C on ray O4->B at r5, rod r6 from C to D on y = h. Subclasses fix the class."""
+
+    ONE_REVERSAL = True
 
     PARAMS = {
         **{k: REQUIRED for k in ("r1", "r2", "r3", "r4", "r5", "r6")},

@@ -15,6 +15,8 @@ LINKAGE.output("C")
 class SliderCrank(Mechanism):
     """Offset slider-crank (r2 crank, r3 rod, e slide-line offset); the slider is C."""
 
+    ONE_REVERSAL = True
+
     KIND = "slider-crank"
     PARAMS = {"r2": REQUIRED, "r3": REQUIRED, "e": 0.0, "sigma_slider": 1.0}
     LENGTHS = ("r2", "r3")

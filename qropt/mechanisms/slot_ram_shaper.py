@@ -18,6 +18,8 @@ class SlotRamShaper(Mechanism):
     (``qropt.synthesis.analytic``): TR = (pi + 2 asin(r2/r1)) / (pi - 2 asin(r2/r1)),
     stroke = 2 h r2 / sqrt(r1^2 - r2^2), gamma_min = acos(r2/r1) (at D, with the lever at its extremes)."""
 
+    ONE_REVERSAL = True
+
     KIND = "slot-ram-shaper"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "h": REQUIRED}
     LENGTHS = ("r1", "r2")  # h is the slide line's offset (positive by a rule), as the crank-shaper's

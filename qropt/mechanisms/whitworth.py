@@ -12,6 +12,8 @@ LINKAGE = slotted_lever("r5").rrp("D", ("C", "r6"), line_y="-r1 + h", sign="sigm
 class Whitworth(Mechanism):
     """Whitworth (r1 centres, r2 crank, r5 = O4C, rod r6 to the slide line y = -r1 + h)."""
 
+    ONE_REVERSAL = True
+
     KIND = "whitworth"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r5": REQUIRED, "r6": REQUIRED, "h": 0.0, "sigma_slider": 1.0}
     LENGTHS = ("r1", "r2", "r5", "r6")

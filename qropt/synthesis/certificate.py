@@ -9,6 +9,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+import numpy as np
+
 from qropt.errors import AssemblyError, QroptError
 from qropt.synthesis import criteria
 from qropt.synthesis.criteria import better, objective_of, objective_value
@@ -140,9 +142,12 @@ def certify(problem, form, values, branch, th, z, f, gap_tol, feas_tol, build=bu
 def _certify(problem, form, m, th, z, f, gap_tol, feas_tol):
     d = m.dead_centres()
     if angle_gap(d.theta_max, th[0]) > 1e-7 or angle_gap(d.theta_min, th[1]) > 1e-7:
-        return m, {"ok": False, "reason": "the NLP's dead centres are local, not the global extremes"}, [], []
+        why = "the NLP's dead centres are local, not the global extremes"  # the true ones become samples
+        ends = [t for t, nlp in ((d.theta_max, th[0]), (d.theta_min, th[1])) if angle_gap(t, nlp) > 1e-7]
+        return m, {"ok": False, "reason": why, "guard": True}, ends, []
     if d.reversals != 1:
-        return m, {"ok": False, "reason": f"the slider reverses {d.reversals} times a turn"}, [], []
+        why = f"the output reverses {d.reversals} times a turn"
+        return m, {"ok": False, "reason": why, "guard": True, "monotone": wrong_way(m, *th)}, [], []
     info = {"ok": True, "nlp": None, "certified": None, "gap": 0.0}
     add, frac = [], []
     if z is None:  # an enumerated point: the exact value only
@@ -157,6 +162,28 @@ def _certify(problem, form, m, th, z, f, gap_tol, feas_tol):
             angles, fractions = c.exceeded(problem, m)
             add, frac = list(angles) + add, list(fractions) + frac
     return m, info, add, frac
+
+
+WRONG_WAY_GRID = 720  # crank angles where a design that reverses inside a stroke is looked at
+
+
+def wrong_way(m, theta_max, theta_min) -> list[tuple[int, float]]:
+    """(stroke, fraction) where the output moves fastest against its stroke, for dead centres at theta_max and
+    theta_min (the NLP's; where they are local extremes, the output turns back inside a stroke): stroke 0 falls
+    from theta_max to theta_min (ccw), stroke 1 rises on the rest of the turn; fraction: 0..1 along it. One per
+    stroke at most."""
+    th = np.linspace(0.0, TWO_PI, WRONG_WAY_GRID, endpoint=False)
+    v = np.asarray(m.slider(th).v, float)
+    fall = (theta_min - theta_max) % TWO_PI
+    u = (th - theta_max) % TWO_PI
+    falling = u < fall
+    out = []
+    for stroke, inside, sign, start, arc in ((0, falling, 1.0, 0.0, fall), (1, ~falling, -1.0, fall, TWO_PI - fall)):
+        wrong = np.where(inside & np.isfinite(v), sign * v, -np.inf)
+        k = int(np.argmax(wrong))
+        if wrong[k] > 0 and arc > 0:
+            out.append((stroke, float((u[k] - start) / arc)))
+    return out
 
 
 def target_values(m) -> dict:
@@ -194,4 +221,5 @@ __all__ = [
     "certify",
     "residuals",
     "target_values",
+    "wrong_way",
 ]

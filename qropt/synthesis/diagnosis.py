@@ -18,11 +18,13 @@ diagnosis costs at most (bounds + 4) solves and 2 * RANGE_SOLVES local solves pe
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 
 from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
+from qropt.synthesis.atlas import Starts
 from qropt.synthesis.certificate import Designs
 from qropt.synthesis.result import Result
 
@@ -79,7 +81,7 @@ class Diagnosis:
             if any(c.ok for c in cands):
                 return self.solver.best(problem, cands, claim, plan, t0)
         if plan.kind in ("none", "partial") and starts_n > 0:  # the spread starts may have been too few here
-            wide = plan if plan.kind == "none" else starts_.plan(problem, use_analytic=False)
+            wide = dataclasses.replace(plan, atlas=Starts()) if plan.kind == "none" else starts_.plan(problem, False)
             n_wide = starts_.grown(WIDER * starts_n, problem, wide) if plan.kind == "partial" else WIDER * starts_n
             more, how, _ = self.solver.multistart.candidates(
                 problem, wide, [], targets, n_wide, seed + 1, self.solver.max_rounds, Designs(), retry=False

@@ -21,6 +21,7 @@ from qropt import units as units_
 from qropt.dynamics.model import slender_bar, union
 from qropt.dynamics.rigid import body_motion
 from qropt.errors import InvalidParameter
+from qropt.mechanisms.base import working_sign
 from qropt.synthesis.criteria import Criterion, Exchange, register
 
 TWO_PI = 2 * math.pi
@@ -221,7 +222,7 @@ class _Symbolic:
         ram = s.output
         force = self.cutting_force(out)
         if ram is not None and not (isinstance(force, (int, float)) and not force):  # against the working stroke
-            way = (-1.0 if f.orientation > 0 else 1.0) * math.copysign(1.0, f.omega2)
+            way = working_sign(f.orientation > 0, f.omega2)
             r = s.rows[ram.name]
             on = -force * way
             load = casadi.if_else(way * out.v * f.omega2 > 0, on, 0.0) if working is None else on * working
@@ -257,7 +258,7 @@ class _Symbolic:
         if isinstance(force, (int, float)) and not force:
             return 0
         scale = self.k if f.mechanism.OUTPUT == "slider" else 1.0
-        way = (-1.0 if f.orientation > 0 else 1.0) * math.copysign(1.0, f.omega2)  # the working direction
+        way = working_sign(f.orientation > 0, f.omega2)
         return force * casadi.fmax(0, way * out.v * scale * f.omega2) / f.omega2
 
     def cutting_force(self, out):

@@ -31,6 +31,8 @@ from qropt.synthesis.criteria import Role
 TWO_PI = 2.0 * math.pi
 BASE_SAMPLES = 8  # uniform sample angles of the epigraphs; the exchange loop adds what binds
 EXTRA_SAMPLES = 8  # slots for the exchange loop's angles
+EXTREME_SLACK = 1e-6  # of the travel: how far the output may pass a dead centre's in the NLP (the certifier: 0)
+MONOTONE = 2  # crank angles per stroke where the output's velocity keeps the stroke's sign (placed by the certifier)
 BOX_SIDES = ("x_max", "-x_min", "y_max", "-y_min")  # the footprint's epigraph order (BoundingBox order differs)
 
 
@@ -146,8 +148,10 @@ class Formulation:
         sense: int = 1,
         base_samples: int = BASE_SAMPLES,
         extra_samples: int = EXTRA_SAMPLES,
+        guarded: bool = False,
     ):
         cls = self.mechanism = problem.mechanism
+        self.guarded = guarded  # with rows that keep the output's reversals at its dead centres (``_guard_rows``)
         self.branch, self.orientation = dict(branch), orientation
         self.range_target, self.sense, self.accel_over = range_target, sense, problem.accel_over
         self.free, self.fixed = list(problem.free), list(problem.fixed)
@@ -179,7 +183,10 @@ class Formulation:
         self._start = TH[0] if orientation > 0 else TH[1]
         self._length = (TH[1] - TH[0]) if orientation > 0 else TWO_PI - (TH[1] - TH[0])
         self._W, self._working, self._returning, self._strokes = W, None, None, None
+        MONO = casadi.SX.sym("mono", 2 * MONOTONE if guarded else 0)  # fractions of the falling, rising strokes
         travel, span = self._core_rows(TH, PT)
+        if guarded:
+            self._guard_rows(TH, MONO)
         self._condition_rows(problem)
 
         # auxiliary variables first (the epigraph groups may use them), each above its expressions
@@ -264,8 +271,10 @@ class Formulation:
             bounds=len(self.bound_keys),
             select=n_box * self.n_coords,
             caps=CAP.numel(),
+            monotone=MONO.numel(),
         )
-        self.w_sym, self.p_sym = casadi.vertcat(X, TH, Z, PHI, PSI), casadi.vertcat(PF, PT, S, W, PB, SEL, CAP)
+        self.w_sym = casadi.vertcat(X, TH, Z, PHI, PSI)
+        self.p_sym = casadi.vertcat(PF, PT, S, W, PB, SEL, CAP, MONO)
         self.caps_fun = casadi.Function("caps", [self.w_sym, self.p_sym], [self._capped])
         self.g_sym, self.f_sym = casadi.vertcat(*[r.expr for r in self.rows]), f
         self.design_sym = casadi.vertcat(X, TH)  # the free parameters and the dead centres
@@ -380,6 +389,22 @@ class Formulation:
                 self.row(k, travel - tgt[k], 0.0, 0.0, RowKind.TARGET)
         return travel, span
 
+    def _guard_rows(self, TH, MONO):
+        """Rows a solve adds where the certifier found the output reversing away from the NLP's dead centres: at
+        every sample angle the output is below its maximum and above its minimum (the certifier's extremes are
+        sampled), and at the fractions MONO of the falling stroke (theta_max to theta_min, ccw) then of the rising
+        one its velocity keeps the stroke's sign."""
+        (x_max, *_), (x_min, *_) = self.dead
+        slack = EXTREME_SLACK * (x_max - x_min)  # a sample at a dead centre: not an active row without a gradient
+        for k, out in enumerate(self.sampled):
+            self.row(f"sample {k}: output below its maximum", x_max - out.x + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
+            self.row(f"sample {k}: output above its minimum", out.x - x_min + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
+        fall = TH[1] - TH[0]  # the output falls from theta_max to theta_min (ccw) and rises on the rest of the turn
+        for k in range(MONOTONE):
+            down, up = self.at(TH[0] + MONO[k] * fall).v, self.at(TH[1] + MONO[MONOTONE + k] * (TWO_PI - fall)).v
+            self.row(f"falling stroke, point {k}: output velocity <= 0", down, -casadi.inf, 0.0, RowKind.DEAD_CENTRE)
+            self.row(f"rising stroke, point {k}: output velocity >= 0", up, 0.0, casadi.inf, RowKind.DEAD_CENTRE)
+
     def _condition_rows(self, problem):
         p, c = self.params, problem.conditions
         for r in self.mechanism.rules(CASADI, p, c.get("grashof")):
@@ -485,10 +510,14 @@ class Formulation:
         pad = np.zeros(self.n_extra)
         return np.concatenate([angles, pad]), np.concatenate([fractions, pad])
 
-    def param_vector(self, problem, targets: dict, samples, fractions, box=None, caps=None) -> np.ndarray:
+    def param_vector(
+        self, problem, targets: dict, samples, fractions, box=None, caps=None, monotone=None
+    ) -> np.ndarray:
         """p from the problem's fixed values and bound values (in the NLP's terms), the targets, the sample angles
         and working-arc fractions, the box sides' coordinates (from ``box``, a BoundingBox of the design the
-        solve is at) and ``caps`` (``Formulation.caps``; default loose)."""
+        solve is at), ``caps`` (``Formulation.caps``; default loose) and ``monotone``: the fractions of the
+        falling then the rising stroke where the output's velocity keeps its sign (default mid-stroke; a guarded
+        formulation's only)."""
         bounds = [criteria.bounds()[k].to_nlp(problem.conditions[k], problem.omega2) for k in self.bound_keys]
         return self.p_blocks.join(
             fixed=[problem.fixed[k] for k in self.fixed],
@@ -498,6 +527,7 @@ class Formulation:
             bounds=bounds,
             select=self._box_select(box),
             caps=np.ones(sum(self.cap_sizes)) if caps is None else caps,
+            monotone=(np.full(2 * MONOTONE, 0.5) if monotone is None else monotone) if self.guarded else [],
         )
 
     def caps(self, w, p) -> np.ndarray:

@@ -17,7 +17,7 @@ from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import CONVERGED, Status
 from qropt.synthesis.certificate import Designs, certify, residuals, target_values
-from qropt.synthesis.formulation import TWO_PI, Formulation
+from qropt.synthesis.formulation import MONOTONE, TWO_PI, Formulation
 
 RESTARTS = 2  # runs continued from their last iterate when they hit the iteration limit near a design
 RESTART_VIOLATION = 1e-6  # ... that is, with no constraint violated by more than this
@@ -70,7 +70,10 @@ class Formulations:
     def __len__(self):
         return len(self._built)
 
-    def get(self, problem, branch: dict, orientation: int, range_target=None, sense=1) -> Formulation:
+    def get(self, problem, branch: dict, orientation: int, range_target=None, sense=1, guarded=None) -> Formulation:
+        """guarded: with the rows that keep the output's reversals at its dead centres (default: unless its type
+        reverses once a turn by construction, ``Mechanism.ONE_REVERSAL``)."""
+        guarded = not problem.mechanism.ONE_REVERSAL if guarded is None else guarded
         c = problem.conditions
         bounds = tuple(k for k in c if k not in ("grashof", "linear", "ratio"))
         cond = (c.get("grashof"), bounds, repr(c.get("linear")), repr(c.get("ratio")))
@@ -87,12 +90,13 @@ class Formulations:
             orientation,
             range_target,
             sense,
+            guarded,
             *_dynamic_key(problem),
         )
         f = self._built.get(key)
         if f is None:
             f = self._built[key] = Formulation(
-                problem, branch, orientation, range_target, sense, self.samples, self.extra
+                problem, branch, orientation, range_target, sense, self.samples, self.extra, guarded
             )
         return f
 
@@ -151,6 +155,7 @@ class LocalSolve:
         samples, fractions = form.base_samples()
         used = used_f = form.n_base
         phi, box = form.lifted_start(form.concrete(problem), values0, designs)
+        mono, mono_next = np.full(2 * MONOTONE, 0.5), [0, 0]
         p = form.param_vector(problem, targets, samples, fractions, box=box)
         w = form.epigraph_start(form.pack(values0, th0, phi=phi, box=box), p)
         lbx, ubx = form.bounds(problem)
@@ -159,7 +164,7 @@ class LocalSolve:
         g, info, m, restarts, polished, polish = None, {}, None, 0, False, None
         while c.rounds < max_rounds:
             c.rounds += 1
-            run = self.backend.run(form, w, p, lbx, ubx, warm=c.rounds > 1)
+            run, ran = self.backend.run(form, w, p, lbx, ubx, warm=c.rounds > 1), form
             w, g = run.w, run.g
             c.t_ipopt += run.seconds
             c.iterations += run.iterations
@@ -184,7 +189,15 @@ class LocalSolve:
                 break
             caps = form.caps(w, p)
             tightened = not np.array_equal(caps, form.p_blocks.split(p)["caps"])
-            if not add and not frac and not tightened:
+            turned = info.get("monotone", [])  # where the output reversed inside a stroke: its velocity's sign stated
+            for stroke, fraction in turned:
+                mono[stroke * MONOTONE + mono_next[stroke]] = fraction
+                mono_next[stroke] = (mono_next[stroke] + 1) % MONOTONE
+            if info.get("guard") and not form.guarded:  # the same NLP with the rows that state where the output
+                # reverses (the certifier's angles sampled), from where it is
+                form = self.formulations.get(problem, branch, orientation, range_target, sense, guarded=True)
+                turned = True
+            if not add and not frac and not tightened and not turned:
                 if run.status is Status.ACCEPTABLE and not polished and c.rounds < max_rounds:
                     # IPOPT's looser tolerance: once more from there, warm, to its own (the acceptable point kept)
                     polished, polish = True, (w, g, c.values, c.problem, m, info, run.status, run.message)
@@ -198,10 +211,10 @@ class LocalSolve:
             if form.n_box and m is not None:  # each box side lifted at the coordinate that reaches it now
                 box = m.bounding_box()
                 w = form.with_box(w, box)
-            p = form.param_vector(problem, targets, samples, fractions, box=box, caps=caps)
+            p = form.param_vector(problem, targets, samples, fractions, box=box, caps=caps, monotone=mono)
             w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
         c.mechanism, c.info = m, info
-        c.residuals = residuals(c.problem or problem, form.violations(g), m, {k: targets[k] for k in form.targets})
+        c.residuals = residuals(c.problem or problem, ran.violations(g), m, {k: targets[k] for k in form.targets})
         c.ok = bool(info.get("ok")) and c.converged and self.within(c) and not c.pruned
         return c
 

@@ -1,9 +1,10 @@
 """The multi-start: a plan of starts -> local solves -> the distinct certified designs, best first.
 
 Closed forms first: a complete enumeration is polished point by point (no multi-start), a closed-form family is
-scanned by exact evaluation and only its best points refined; otherwise the closed-form points and a scrambled
-Sobol design. Each start is solved in its own TR orientation (both where it has none); the space-filling starts
-also try the other orientation until each has at least MIN_WAY of them.
+scanned by exact evaluation and only its best points refined; otherwise the atlas's designs of the problem's
+shape (``atlas``), and only where none of them certifies, the closed-form points and a scrambled Sobol design.
+Each start is solved in its own TR orientation (both where it has none); the space-filling starts also try the
+other orientation until each has at least MIN_WAY of them.
 """
 
 from __future__ import annotations
@@ -43,6 +44,11 @@ class MultiStart:
                 f"best along a closed-form family that holds every solution ({plan.how}; {len(plan.analytic)} points)"
             )
         else:
+            if plan.atlas.designs and not extra:  # the atlas's designs first: the multi-start only where none certifies
+                first = [("atlas", v, b) for v, b in plan.atlas.designs]
+                cands += self.run(problem, first, targets, max_rounds, designs, both_ways=False)
+                if any(c.ok for c in cands):
+                    return cands, f"best of {plan.atlas.how}", None
             if len(plan.analytic) > MANY_STARTS and not extra:  # a sweep of closed-form points: the best few
                 runs += [("analytic", v, *b) for _, v, *b in self.family_starts(problem, plan, designs)]
             else:

@@ -42,8 +42,9 @@ class Solver:
     samples: uniform epigraph sample angles per formulation (the exchange loop adds up to ``extra`` more);
     starts_n, seed: the Sobol multi-start used where no closed form enumerates the solutions (without closed
     forms, starts_n per two free parameters unless a solve names its own); backend: an NLP
-    backend (``qropt.synthesis.backends``; default IPOPT). Results do not depend on what the Solver solved
-    before: formulations take every value as a parameter.
+    backend (``qropt.synthesis.backends``; default IPOPT); atlas: start a problem whose shape is in the atlas
+    (``qropt.synthesis.atlas``) from its designs first, and run the multi-start only where none certifies.
+    Results do not depend on what the Solver solved before: formulations take every value as a parameter.
     """
 
     def __init__(
@@ -57,6 +58,7 @@ class Solver:
         seed: int = 0,
         max_rounds: int = 30,
         backend=None,
+        atlas: bool = True,
     ):
         tol = {**TOLERANCES, **(tolerances or {})}
         if set(tol) != set(TOLERANCES) or not all(_positive(v) for v in tol.values()):
@@ -75,6 +77,9 @@ class Solver:
             raise ProblemError(f"Solver: backend must have a run(form, w0, p, lbx, ubx, warm) method, got {backend!r}")
         self.tolerances, self.ipopt_options = tol, dict(ipopt_options or {})
         self.samples, self.extra, self.starts_n, self.seed, self.max_rounds = samples, extra, starts_n, seed, max_rounds
+        if not isinstance(atlas, bool):
+            raise ProblemError(f"Solver: atlas is True or False, got {atlas!r}")
+        self.atlas = atlas
         self.backend = backend or Ipopt(self.ipopt_options)
         self._formulations = Formulations(samples, extra)
         self.local_solve = LocalSolve(self._formulations, self.backend, tol, max_rounds)
@@ -97,6 +102,7 @@ class Solver:
             "starts_n": self.starts_n,
             "seed": self.seed,
             "max_rounds": self.max_rounds,
+            "atlas": self.atlas,
         }
 
     # ---- formulations ----------------------------------------------------------------------------
@@ -156,7 +162,7 @@ class Solver:
                     r, message=f"{r.message} (lengths in this message are {k:g} times the problem's)"
                 )
             return r
-        plan = starts_.plan(problem, use_analytic)
+        plan = starts_.plan(problem, use_analytic, self.atlas)
         if asked is None:
             starts_n = starts_.grown(starts_n, problem, plan)
         designs = Designs()  # every mechanism this solve builds, built once
@@ -197,6 +203,7 @@ class Solver:
             "plan": plan.kind,
             "omega2": problem.omega2,
             "formulations": self.formulations,
+            "atlas_starts": len(plan.atlas.designs),
             "ipopt_runs": sum(len(c.statuses) for c in cands if c.origin != "enumeration"),
             "iterations_total": sum(c.iterations for c in cands),
             "t_ipopt": sum(c.t_ipopt for c in cands),
@@ -246,7 +253,9 @@ class Solver:
         bounded = problem.replace(objective="min_size", conditions={**problem.conditions, c.bound: bound})
         alone = problem.replace(objective="min_size")
         local = {"use_analytic": False, "extra_starts": start}
-        tries = [(bounded, local), (alone, local), (bounded, {}), (alone, {})]  # from the optimum first
+        tries = [(bounded, local), (alone, local)]  # from the optimum first, then along a closed-form family
+        if starts_.plan(bounded).kind in ("family", "enumeration"):
+            tries += [(bounded, {}), (alone, {})]
         for sub, how in tries:
             s = self.solve(sub, starts_n=0, **how, **kw)
             if s.status == "optimal" and not c.better(bound, s.quantities[c.name]):

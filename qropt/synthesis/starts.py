@@ -16,6 +16,7 @@ from qropt.errors import QroptError
 from qropt.kinematics.closures import transmission_angle
 from qropt.kinematics.ops import NUMPY
 from qropt.synthesis import analytic
+from qropt.synthesis import atlas as atlas_
 from qropt.synthesis.formulation import slow_interval
 
 
@@ -28,6 +29,7 @@ class Plan:
     how: str
     outside: int = 0  # closed-form points of an enumeration left out as outside the bounds
     ranges: dict = field(default_factory=dict)  # target -> (low, high) over the bounds, by the closed form
+    atlas: atlas_.Starts = atlas_.Starts()  # where no closed form enumerates or walks every solution
 
 
 def _build(problem, values, branch):
@@ -40,10 +42,11 @@ def branches(problem) -> list[dict]:
     return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*problem.branches.values())]
 
 
-def plan(problem, use_analytic: bool = True) -> Plan:
-    """The closed-form starts (clipped to the bounds) and what they cover."""
+def plan(problem, use_analytic: bool = True, use_atlas: bool = False) -> Plan:
+    """The closed-form starts (clipped to the bounds) and what they cover; with ``use_atlas``, the atlas's designs
+    where the closed forms neither enumerate nor walk every solution."""
     if not use_analytic:
-        return Plan((), "none", "closed forms not used")
+        return Plan((), "none", "closed forms not used", atlas=atlas_.starts(problem) if use_atlas else atlas_.Starts())
     w = analytic.warm_starts(problem)
 
     def clip(v):
@@ -52,7 +55,8 @@ def plan(problem, use_analytic: bool = True) -> Plan:
     if w.kind == "enumeration":  # every design: one outside the bounds is no start, it is not a design here
         inside = [v for v in w.points if all(lo <= v[k] <= hi for k, (lo, hi) in problem.free.items())]
         return Plan(tuple(inside), w.kind, w.how, len(w.points) - len(inside), dict(w.ranges))
-    return Plan(tuple(clip(v) for v in w.points), w.kind, w.how)
+    found = atlas_.starts(problem) if use_atlas and w.kind != "family" else atlas_.Starts()
+    return Plan(tuple(clip(v) for v in w.points), w.kind, w.how, atlas=found)
 
 
 POOL = 64  # Sobol points drawn per start wanted: the type's rules (one vectorised check) thin them first

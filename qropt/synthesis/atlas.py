@@ -1,0 +1,103 @@
+"""The atlas: the best designs of a problem's shape, found once at time-ratio nodes by a search far larger than a
+solve's, and the starts they give a solve between the nodes.
+
+A problem whose targets are a time ratio and a stroke, whose bounds scale with the stroke and whose objective
+depends on the shape alone (gamma_min, a size, the peak acceleration or velocity) has optima whose shape depends
+on the time ratio alone: at stroke s every length is s times its value at stroke 1, and TR, gamma_min and the
+shape of the motion change with neither s nor omega2. ``signature`` is that shape of a problem (lengths in
+strokes, no targets, no name, no omega2). The atlas (``atlas.json`` beside this module, written by ``python -m
+benchmarks.atlas``) holds, per signature, node time ratios and at each node the best distinct certified designs
+of a many-start search, continued from node to node, lengths in strokes. A solve of a problem whose signature
+is in the atlas, at a TR inside its nodes, first starts from the designs of the two nodes around it
+(``starts``); only where none of them gives a certified design does it run the multi-start.
+"""
+
+from __future__ import annotations
+
+import bisect
+import functools
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+from qropt.synthesis import criteria
+
+PATH = Path(__file__).with_name("atlas.json")
+SHAPE_CONDITIONS = ("grashof", "gamma_min")  # conditions that do not change with the scale
+SCALED = ("length", "offset")  # parameter kinds that scale with the stroke
+
+
+def _round(x: float) -> float:
+    return float(f"{x:.9g}")  # scaled problems' bounds agree to rounding
+
+
+def signature(problem) -> str | None:
+    """The problem's shape as a key (JSON text): None where its optima do not scale with its stroke (other targets,
+    a dynamic objective, or a condition with a length in it)."""
+    if set(problem.targets) != {"time_ratio", "stroke"} or not problem.objective:
+        return None
+    c = criteria.of_problem(problem)
+    if c is None or not (c.kinematic or c.size) or set(problem.conditions) - set(SHAPE_CONDITIONS):
+        return None
+    s, kinds = float(problem.targets["stroke"]), problem.mechanism.kinds()
+
+    def rel(k, v):
+        return _round(v / s if kinds.get(k) in SCALED else v)
+
+    d = problem.to_dict()
+    shape = {
+        "mechanism": d["mechanism"],
+        "fixed": {k: rel(k, v) for k, v in d["fixed"].items()},
+        "free": {k: [rel(k, lo), rel(k, hi)] for k, (lo, hi) in d["free"].items()},
+        "conditions": d["conditions"],
+        "objective": d["objective"],
+        "size": d["size"],
+        "accel_over": d["accel_over"],
+        "branches": d["branches"],
+    }
+    return json.dumps(shape, sort_keys=True)
+
+
+@dataclass(frozen=True)
+class Starts:
+    """A solve's starts from the atlas: (free values, branch) pairs in the problem's lengths, and what they are."""
+
+    designs: tuple = ()
+    how: str = ""
+
+
+@functools.cache
+def _entries(path: str = str(PATH)) -> dict:
+    try:
+        data = json.loads(Path(path).read_text())
+    except FileNotFoundError:
+        return {}
+    return {e["signature"]: e for e in data["entries"]}
+
+
+def starts(problem) -> Starts:
+    """The atlas's designs at the nodes around the problem's time ratio, scaled to its stroke and clipped to its
+    bounds; empty where its signature is not in the atlas or its TR is outside the nodes."""
+    key = signature(problem)
+    entry = _entries().get(key) if key else None
+    if entry is None:
+        return Starts()
+    tr, nodes = float(problem.targets["time_ratio"]), entry["nodes"]
+    if not nodes[0] <= tr <= nodes[-1]:
+        return Starts()
+    i = max(bisect.bisect_right(nodes, tr) - 1, 0)
+    around = sorted({i, min(i + 1, len(nodes) - 1)})
+    s, kinds = float(problem.targets["stroke"]), problem.mechanism.kinds()
+    out = []
+    for j in around:
+        for d in entry["designs"][j]:
+            v = {k: x * s if kinds.get(k) in SCALED else x for k, x in d["params"].items()}
+            v = {k: min(max(v[k], lo), hi) for k, (lo, hi) in problem.free.items()}
+            out.append((v, {k: float(b) for k, b in d["branch"].items()}))
+    at = " and ".join(f"{nodes[j]:g}" for j in around)
+    how = f"{len(out)} designs of the atlas at TR {at} (each node's best of a {entry['starts']}-start search "
+    how += "and of solves from its neighbours' designs)"
+    return Starts(tuple(out), how)
+
+
+__all__ = ["signature", "starts", "Starts", "PATH"]

@@ -1,0 +1,167 @@
+"""The atlas (``qropt.synthesis.atlas``): its key is the problem's shape, its designs are certified designs of their
+nodes' problems, and a solve that starts from them is as good as the multi-start it replaces."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from qropt import Solver
+from qropt.studies._design import TYPES, type_problem
+from qropt.synthesis import atlas, criteria
+from qropt.synthesis.result import SOLUTION_PRESENT
+from tests import brute
+
+DATA = json.loads(atlas.PATH.read_text())
+
+
+def test_the_key_is_the_shape_of_the_problem():
+    key = atlas.signature(type_problem("coupler-slider", 1.7, 0.3))
+    assert key is not None
+    # the stroke, omega2, the unit and the TR do not change the shape
+    assert atlas.signature(type_problem("coupler-slider", 1.7, 3e-3, omega2=7.0)) == key
+    assert atlas.signature(type_problem("coupler-slider", 2.4, 300.0, units="mm")) == key
+    # the objective, the bounds and the conditions do
+    assert atlas.signature(type_problem("coupler-slider", 1.7, 0.3, objective="min_peak_accel")) != key
+    assert atlas.signature(type_problem("coupler-slider", 1.7, 0.3, bounds={"r1": (0.1, 1.0)})) != key
+    assert atlas.signature(type_problem("coupler-slider", 1.7, 0.3, conditions={"gamma_min": 0.5})) != key
+    # optima that do not scale with the stroke have no key
+    assert atlas.signature(type_problem("coupler-slider", 1.7, 0.3, conditions={"max_sum": 2.0})) is None
+    assert atlas.signature(type_problem("coupler-slider", 1.7, 0.3, objective=None)) is None
+
+
+def test_the_file_holds_every_row_as_design_builds_it():
+    """Each entry's key is that of its row's problem today (a changed row must rebuild the atlas)."""
+    rows = {(e["row"], e["objective"]): e for e in DATA["entries"]}
+    assert set(rows) == {(k, o) for k in TYPES for o in ("max_gamma_min", "min_peak_accel")}
+    for (kind, objective), e in rows.items():
+        assert e["signature"] == atlas.signature(type_problem(kind, 2.0, 1.0, objective=objective))
+        assert e["nodes"] == sorted(e["nodes"]) and len(e["designs"]) == len(e["nodes"])
+        # most nodes hold designs (a solve between two nodes without any runs the multi-start)
+        assert sum(map(bool, e["designs"])) >= len(e["nodes"]) // 2, kind
+
+
+@pytest.mark.parametrize("objective", ["max_gamma_min", "min_peak_accel"])
+def test_every_design_of_the_atlas_meets_its_node_exactly(objective):
+    """Rebuilt at stroke 1, each design meets its node's TR and stroke to 1e-8, keeps its row's rules and bounds,
+    and has the objective the atlas records; TR, stroke and gamma_min checked by the tests' own simulation too."""
+    for e in (e for e in DATA["entries"] if e["objective"] == objective):
+        for tr, designs in zip(e["nodes"], e["designs"], strict=True):
+            p = type_problem(e["row"], tr, 1.0, objective=objective)
+            for d in designs:
+                assert all(lo - 1e-12 <= d["params"][k] <= hi + 1e-12 for k, (lo, hi) in p.free.items())
+                m = p.build(d["params"], d["branch"])
+                assert m.time_ratio() == pytest.approx(tr, abs=1e-8)
+                assert m.stroke() == pytest.approx(1.0, abs=1e-8)
+                assert not any(v > 1e-8 for v in criteria.violations(p, m).values())
+                assert criteria.objective_of(p, m) == pytest.approx(d["value"], rel=1e-9)
+        if objective == "max_gamma_min":  # the tests' own simulation, at every fifth node
+            for tr, designs in list(zip(e["nodes"], e["designs"], strict=True))[::5]:
+                if designs:
+                    m = type_problem(e["row"], tr, 1.0).build(designs[0]["params"], designs[0]["branch"])
+                    b_tr, b_stroke, b_gamma = brute.task_values(TYPES[e["row"]][0], dict(m.params))
+                    assert (b_tr, b_stroke) == pytest.approx((tr, 1.0), abs=1e-8), e["row"]
+                    assert b_gamma == pytest.approx(designs[0]["value"], abs=1e-7), e["row"]
+
+
+def test_a_solve_between_nodes_starts_from_the_atlas_and_is_as_good_as_the_multi_start():
+    """The coupler slider (no closed form) at a TR between nodes and a stroke the atlas was not built at: from
+    the atlas in a few runs, and no worse than the default multi-start without it."""
+    p = type_problem("coupler-slider", 1.83, 0.42)
+    with_atlas, without = Solver().solve(p), Solver(atlas=False).solve(p)
+    assert with_atlas.status == "optimal", with_atlas.message
+    assert "atlas" in with_atlas.certificate.global_claim
+    assert with_atlas.stats["atlas_starts"] >= 2
+    assert with_atlas.stats["ipopt_runs"] < without.stats["ipopt_runs"] / 2
+    assert without.status in SOLUTION_PRESENT
+    assert with_atlas.objective >= without.objective - 1e-9
+    m = with_atlas.mechanism
+    assert (m.time_ratio(), m.stroke()) == pytest.approx((1.83, 0.42), abs=1e-8)
+
+
+def test_problems_outside_the_atlas_run_the_multi_start():
+    for p in (
+        type_problem("coupler-slider", 1.83, 0.42, bounds={"r1": (0.05, 1.0)}),  # its own bounds
+        type_problem("coupler-slider", 3.9, 0.42),  # beyond the nodes
+    ):
+        assert not atlas.starts(p).designs
+    assert atlas.starts(type_problem("coupler-slider", 1.83, 0.42)).designs
+
+
+def test_a_start_is_scaled_to_the_stroke_and_clipped_to_the_bounds():
+    p = type_problem("drag-link-slider", 2.0, 0.25)
+    found = atlas.starts(p)
+    e = next(e for e in DATA["entries"] if e["signature"] == atlas.signature(p))
+    i = e["nodes"].index(min(e["nodes"], key=lambda t: abs(t - 2.0) if t <= 2.0 else 9))
+    v0, _ = found.designs[0]
+    assert v0 == pytest.approx({k: x * 0.25 for k, x in e["designs"][i][0]["params"].items()}, rel=1e-12)
+    assert all(lo <= v[k] <= hi for v, _ in found.designs for k, (lo, hi) in p.free.items())
+    assert np.isfinite([x for v, _ in found.designs for x in v.values()]).all()
+
+
+# a coupler slider at TR 2.65 (stroke 1), the least peak acceleration found there: a valid start for max_gamma_min
+START_265 = {
+    "r1": 0.6648245579796193,
+    "r2": 0.15671227005783603,
+    "r3": 3.831640947533235,
+    "r4": 3.858296582703623,
+    "r5": 4.999999999889551,
+    "r6": 4.337804459608482,
+    "h": 4.999999999379198,
+    "beta": -1.0746614020625493,
+}
+
+
+def test_a_solve_keeps_one_reversal_a_turn():
+    """From a valid design, max_gamma_min used to end at a design whose output reverses twice a turn (its
+    dead centres local extremes): no design at all. The NLP now keeps each stroke's velocity of one sign where
+    the certifier saw it turn back, and the solve ends at a design the tests' own simulation confirms."""
+    p = type_problem("coupler-slider", 2.65, 1.0)
+    branch = {"sigma": -1.0, "sigma_slider": 1.0}
+    start = p.build(START_265, branch)
+    assert start.dead_centres().reversals == 1 and start.time_ratio() == pytest.approx(2.65, abs=1e-8)
+    c = Solver(atlas=False).local(p, START_265, branch, dict(p.targets))
+    assert c.ok, c.info
+    m = c.mechanism
+    assert m.dead_centres().reversals == 1
+    assert m.gamma_min().value > start.gamma_min().value + 0.3  # 0.13 rad at the start
+    b_tr, b_stroke, b_gamma = brute.task_values("coupler-slider", dict(m.params))
+    assert (b_tr, b_stroke) == pytest.approx((2.65, 1.0), abs=1e-8)
+    assert b_gamma == pytest.approx(m.gamma_min().value, abs=1e-7)
+
+
+def test_the_certifier_names_where_the_output_turns_back():
+    """A design whose output reverses twice a turn: ``wrong_way`` names, per stroke, a point where the velocity
+    has the wrong sign (checked by the exact motion there)."""
+    from qropt.mechanisms import CouplerSlider
+    from qropt.synthesis.certificate import TWO_PI, wrong_way
+
+    m = CouplerSlider(
+        r1=3.9767748182558744, r2=0.642575026063248, r3=4.314873925498792, r4=1.2206065015834444,
+        r5=4.999999999910129, r6=4.999999999760366, h=1.2320049288704513, beta=-0.8426513658110741,
+        sigma=-1.0, sigma_slider=1.0,
+    )  # fmt: skip
+    d = m.dead_centres()
+    assert d.reversals == 2
+    spots = wrong_way(m, d.theta_max, d.theta_min)
+    assert spots
+    fall = (d.theta_min - d.theta_max) % TWO_PI
+    for stroke, f in spots:
+        assert 0 < f < 1
+        t = d.theta_max + f * fall if stroke == 0 else d.theta_min + f * (TWO_PI - fall)
+        v = float(np.ravel(m.slider(t).v)[0])
+        assert (v > 0) if stroke == 0 else (v < 0)
+
+
+def test_the_solver_option():
+    from qropt.errors import ProblemError
+
+    with pytest.raises(ProblemError, match="atlas"):
+        Solver(atlas="yes")
+    off = Solver(atlas=False)
+    assert Solver(**off.options()).atlas is False  # the options rebuild an equal Solver (a Dask worker's)
+    p = type_problem("drag-link-slider", 1.83, 0.42)
+    r = off.solve(p)
+    assert r.stats["atlas_starts"] == 0 and "atlas" not in r.certificate.global_claim
