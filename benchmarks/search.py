@@ -210,6 +210,7 @@ def main(argv=None) -> int:
     ap.add_argument("--starts", type=int, default=256)
     ap.add_argument("--objectives", nargs="+", default=["max_gamma_min", "min_peak_accel"])
     ap.add_argument("--seed", type=int, default=20261124)
+    ap.add_argument("--name", default="search", help="results/<name>.json and .md")
     a = ap.parse_args(argv)
     task_list = tasks(a.tasks, seed=a.seed + 1)  # not the benchmark's tasks
     rows = []
@@ -226,14 +227,14 @@ def main(argv=None) -> int:
                     flush=True,
                 )
     misses = sum(r["miss"] for r in rows)
-    save("search.json", {"shapes": a.shapes, "starts": a.starts, "rows": rows, "misses": misses})
+    save(f"{a.name}.json", {"shapes": a.shapes, "starts": a.starts, "rows": rows, "misses": misses})
     lines = ["| objective | type | rows | misses |", "|---|---|---|---|"]
     for objective in a.objectives:
         for t in TYPES:
             mine = [r for r in rows if r["objective"] == objective and r["type"] == t]
             if mine:
                 lines.append(f"| {objective} | {t} | {len(mine)} | {sum(r['miss'] for r in mine)} |")
-    (RESULTS / "search.md").write_text("\n".join(lines) + "\n")
+    (RESULTS / f"{a.name}.md").write_text("\n".join(lines) + "\n")
     print(f"{misses} of {len(rows)} rows missed the reference")
     return 0
 

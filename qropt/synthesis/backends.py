@@ -65,12 +65,13 @@ IPOPT_STATUS = {
     "Search_Direction_Becomes_Too_Small": Status.STALLED,
 }
 WARM = {"ipopt.bound_push": 1e-8, "ipopt.bound_frac": 1e-8}
+PUSH = 0.01  # IPOPT's default bound_push: a start this near a bound (relative to it, at least 1) would move
 STALLED_KKT = 1e-9  # an IPOPT run stopped short of its tolerance is acceptable at a KKT point to this, relative
 
 
 class Ipopt:
-    """IPOPT through CasADi, one compiled solver per formulation (two: re-solves, and starts on a bound, move
-    off a bound by 1e-8 only, since IPOPT's default push of 0.01 is absolute and can move a small link across a
+    """IPOPT through CasADi, one compiled solver per formulation (two: re-solves, and starts on or near a bound,
+    move off a bound by 1e-8 only, since IPOPT's default push of 0.01 is absolute and can move a small link across a
     Grashof or assembly limit, where the loop has no real solution, or a start that meets its targets far from
     them)."""
 
@@ -89,7 +90,11 @@ class Ipopt:
 
     def run(self, form, w0, p, lbx, ubx, warm: bool = False) -> Run:
         w0 = np.clip(w0, lbx, ubx)
-        on_bound = bool(np.any((w0 == lbx) | (w0 == ubx)))  # a start on a bound (a family's end) stays there
+        # a start on a bound (a family's end), or nearer one than IPOPT's default push would move it (an optimum
+        # with a link at its bound, from the atlas or a neighbour), stays where it is
+        push = PUSH * np.maximum(1.0, np.abs(np.where(np.isfinite(lbx), lbx, 0.0)))
+        push_hi = PUSH * np.maximum(1.0, np.abs(np.where(np.isfinite(ubx), ubx, 0.0)))
+        on_bound = bool(np.any((w0 - lbx < push) | (ubx - w0 < push_hi)))
         solver = self.solver(form, warm or on_bound)
         r = solver(x0=w0, p=p, lbx=lbx, ubx=ubx, lbg=form.lbg, ubg=form.ubg)
         st = solver.stats()
