@@ -11,7 +11,7 @@ objective starts a solve by another), the walk is tried again, and the continuat
 keeps its KEEP best distinct designs. Rows run in ``--jobs`` processes; ``--fill`` runs only the last step, on
 the atlas as it is.
 
-Run: ``python -m benchmarks.atlas [--starts 24] [--jobs 2]`` (repository root; about 15 min on 2 cores).
+Run: ``python -m benchmarks.atlas [--starts 24] [--jobs 2]`` (repository root; about 35 min on 2 cores).
 """
 
 from __future__ import annotations
