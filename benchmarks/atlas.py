@@ -25,7 +25,7 @@ import numpy as np
 
 from qropt import Solver
 from qropt.studies._design import TYPES, type_problem
-from qropt.synthesis import atlas, starts
+from qropt.synthesis import atlas, criteria, starts
 from qropt.synthesis.result import SOLUTION_PRESENT
 
 NODES = tuple(round(float(x), 3) for x in np.arange(1.05, 3.55 + 1e-9, 0.1))
@@ -56,13 +56,13 @@ def _better(problem, a: list, b: list) -> bool:
         return False
     if not b:
         return True
-    sign = 1.0 if problem.objective == "max_gamma_min" else -1.0
+    sign = 1.0 if criteria.maximises(problem.objective) else -1.0
     return sign * (a[0]["value"] - b[0]["value"]) > 1e-9 * max(1.0, abs(b[0]["value"]))
 
 
 def _merge(problem, *lists) -> list:
     """The KEEP best distinct designs of several lists (apart by 1e-6 in some value)."""
-    sign = -1.0 if problem.objective == "max_gamma_min" else 1.0
+    sign = -1.0 if criteria.maximises(problem.objective) else 1.0
     out = []
     for d in sorted((d for ds in lists for d in ds), key=lambda d: sign * d["value"]):
         v = np.array(list(d["params"].values()))
@@ -95,6 +95,24 @@ def _walk(solver, problem, designs, step: float = 0.01) -> list:
     return found
 
 
+def _from(solver, problem, seeds: list, kept: list) -> tuple[list, bool]:
+    """(kept merged with the designs of a solve of ``problem`` from the designs ``seeds``, whether that solve
+    found a better best)."""
+    r = solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=[d["params"] for d in seeds])
+    found = _designs(problem, r)
+    return _merge(problem, kept, found), _better(problem, found, kept)
+
+
+def _walked(solver, problems, designs) -> tuple[list, int]:
+    """(designs with each node still without one walked to (``_walk``), how many nodes that filled)."""
+    designs, filled = list(designs), 0
+    for i, p in enumerate(problems):
+        if not designs[i]:
+            designs[i] = _walk(solver, p, designs)
+            filled += bool(designs[i])
+    return designs, filled
+
+
 def _continued(solver, problems, designs) -> list:
     """Each node solved again from its neighbours' designs, pass after pass until no node improves (PASSES at
     most), its KEEP best kept."""
@@ -103,12 +121,9 @@ def _continued(solver, problems, designs) -> list:
         changed = False
         for i, p in enumerate(problems):
             near = [d for j in (i - 1, i + 1) if 0 <= j < len(NODES) for d in designs[j]]
-            if not near:
-                continue
-            r = solver.solve(p, starts_n=0, use_analytic=False, extra_starts=[d["params"] for d in near])
-            found = _designs(p, r)
-            changed |= _better(p, found, designs[i])
-            designs[i] = _merge(p, designs[i], found)
+            if near:
+                designs[i], improved = _from(solver, p, near, designs[i])
+                changed |= improved
         if not changed:
             break
     return designs
@@ -120,12 +135,7 @@ def build_row(kind: str, objective: str, starts_n: int) -> dict:
     problems = [type_problem(kind, tr, 1.0, objective=objective) for tr in NODES]
     designs = [_designs(p, solver.solve(p)) for p in problems]
     first = [len(d) > 0 for d in designs]
-    designs = _continued(solver, problems, designs)
-    walked = 0
-    for i, p in enumerate(problems):  # a node still without a design: walked to from its nearest with one
-        if not designs[i]:
-            designs[i] = _walk(solver, p, designs)
-            walked += bool(designs[i])
+    designs, walked = _walked(solver, problems, _continued(solver, problems, designs))
     print(
         f"{kind:20s} {objective:15s} {sum(map(bool, designs))}/{len(NODES)} nodes "
         f"({sum(first)} by the search alone, {walked} walked to) in {time.perf_counter() - t0:.0f} s",
@@ -147,19 +157,14 @@ def fill_row(entry: dict, others: list) -> dict:
     the whole continued once more (``_continued``)."""
     t0, kind, objective = time.perf_counter(), entry["row"], entry["objective"]
     solver, designs = Solver(atlas=False), list(entry["designs"])
+    problems = [type_problem(kind, tr, 1.0, objective=objective) for tr in NODES]
     empty = [i for i, d in enumerate(designs) if not d]
     better = 0
     for i, seeds in enumerate(others):
         if seeds:
-            p = type_problem(kind, NODES[i], 1.0, objective=objective)
-            r = solver.solve(p, starts_n=0, use_analytic=False, extra_starts=[d["params"] for d in seeds])
-            found = _designs(p, r)
-            better += _better(p, found, designs[i])
-            designs[i] = _merge(p, designs[i], found)
-    problems = [type_problem(kind, tr, 1.0, objective=objective) for tr in NODES]
-    for i in empty:
-        if not designs[i]:
-            designs[i] = _walk(solver, problems[i], designs)
+            designs[i], improved = _from(solver, problems[i], seeds, designs[i])
+            better += improved
+    designs, _ = _walked(solver, problems, designs)
     before = designs
     designs = _continued(solver, problems, designs)
     better += sum(_better(p, d, b) for p, d, b in zip(problems, designs, before, strict=True))

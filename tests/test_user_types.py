@@ -23,7 +23,7 @@ from qropt.errors import ProblemError
 from qropt.mechanisms import REGISTRY, RegistryError, mechanism_type, type_reference
 from qropt.studies._chart_run import chart
 from qropt.studies._design import type_problem
-from qropt.synthesis.scaling import _scales
+from qropt.synthesis.scaling import scales
 
 ROOT = Path(__file__).resolve().parents[1]
 MODULE = "qropt_test_user_types_mod"  # written to a temporary folder: importable by name only from there
@@ -185,7 +185,7 @@ def test_parameter_kinds_drive_bounds_scaling_and_tolerances(user):
     assert p.free == {"r2": (0.01, 1.0), "r3": (0.01, 1.0), "e": (-1.0, 1.0), "phi": (-1.0, 1.0)}
     q = type_problem(cls, 1.5, 0.2)
     assert "phi" not in q.free and q.fixed["phi"] == 0.0  # an angle with a default stays fixed
-    assert [_scales(p, k) for k in ("r2", "e", "phi", "sigma_slider")] == [True, True, False, False]
+    assert [scales(p, k) for k in ("r2", "e", "phi", "sigma_slider")] == [True, True, False, False]
     m = cls(r2=0.1, r3=0.4, e=0.05, phi=0.3)
     assert (
         qropt.sensitivities(m).names == ("r2", "r3", "e", "phi") if hasattr(qropt.sensitivities(m), "names") else True

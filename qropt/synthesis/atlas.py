@@ -20,11 +20,10 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-from qropt.synthesis import criteria
+from qropt.synthesis import criteria, scaling
 
 PATH = Path(__file__).with_name("atlas.json")
 SHAPE_CONDITIONS = ("grashof", "gamma_min")  # conditions that do not change with the scale
-SCALED = ("length", "offset")  # parameter kinds that scale with the stroke
 
 
 def _round(x: float) -> float:
@@ -39,10 +38,10 @@ def signature(problem) -> str | None:
     c = criteria.of_problem(problem)
     if c is None or not (c.kinematic or c.size) or set(problem.conditions) - set(SHAPE_CONDITIONS):
         return None
-    s, kinds = float(problem.targets["stroke"]), problem.mechanism.kinds()
+    s = float(problem.targets["stroke"])
 
     def rel(k, v):
-        return _round(v / s if kinds.get(k) in SCALED else v)
+        return _round(v / s if scaling.scales(problem, k) else v)
 
     d = problem.to_dict()
     shape = {
@@ -67,9 +66,9 @@ class Starts:
 
 
 @functools.cache
-def _entries(path: str = str(PATH)) -> dict:
+def _entries() -> dict:
     try:
-        data = json.loads(Path(path).read_text())
+        data = json.loads(PATH.read_text())
     except FileNotFoundError:
         return {}
     return {e["signature"]: e for e in data["entries"]}
@@ -87,11 +86,11 @@ def starts(problem) -> Starts:
         return Starts()
     i = max(bisect.bisect_right(nodes, tr) - 1, 0)
     around = sorted({i, min(i + 1, len(nodes) - 1)})
-    s, kinds = float(problem.targets["stroke"]), problem.mechanism.kinds()
+    s = float(problem.targets["stroke"])
     out = []
     for j in around:
         for d in entry["designs"][j]:
-            v = {k: x * s if kinds.get(k) in SCALED else x for k, x in d["params"].items()}
+            v = {k: x * s if scaling.scales(problem, k) else x for k, x in d["params"].items()}
             v = {k: min(max(v[k], lo), hi) for k, (lo, hi) in problem.free.items()}
             out.append((v, {k: float(b) for k, b in d["branch"].items()}))
     at = " and ".join(f"{nodes[j]:g}" for j in around)

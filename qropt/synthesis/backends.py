@@ -69,6 +69,11 @@ PUSH = 0.01  # IPOPT's default bound_push: a start this near a bound (relative t
 STALLED_KKT = 1e-9  # an IPOPT run stopped short of its tolerance is acceptable at a KKT point to this, relative
 
 
+def _push(bound) -> np.ndarray:
+    """How far IPOPT's default bound_push moves a start inside each bound: PUSH of its magnitude, at least PUSH."""
+    return PUSH * np.maximum(1.0, np.abs(np.where(np.isfinite(bound), bound, 0.0)))
+
+
 class Ipopt:
     """IPOPT through CasADi, one compiled solver per formulation (two: re-solves, and starts on or near a bound,
     move off a bound by 1e-8 only, since IPOPT's default push of 0.01 is absolute and can move a small link across a
@@ -92,9 +97,7 @@ class Ipopt:
         w0 = np.clip(w0, lbx, ubx)
         # a start on a bound (a family's end), or nearer one than IPOPT's default push would move it (an optimum
         # with a link at its bound, from the atlas or a neighbour), stays where it is
-        push = PUSH * np.maximum(1.0, np.abs(np.where(np.isfinite(lbx), lbx, 0.0)))
-        push_hi = PUSH * np.maximum(1.0, np.abs(np.where(np.isfinite(ubx), ubx, 0.0)))
-        on_bound = bool(np.any((w0 - lbx < push) | (ubx - w0 < push_hi)))
+        on_bound = bool(np.any((w0 - lbx < _push(lbx)) | (ubx - w0 < _push(ubx))))
         solver = self.solver(form, warm or on_bound)
         r = solver(x0=w0, p=p, lbx=lbx, ubx=ubx, lbg=form.lbg, ubg=form.ubg)
         st = solver.stats()

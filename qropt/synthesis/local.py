@@ -193,11 +193,11 @@ class LocalSolve:
             for stroke, fraction in turned:
                 mono[stroke * MONOTONE + mono_next[stroke]] = fraction
                 mono_next[stroke] = (mono_next[stroke] + 1) % MONOTONE
-            if info.get("guard") and not form.guarded:  # the same NLP with the rows that state where the output
-                # reverses (the certifier's angles sampled), from where it is
+            guarding = bool(info.get("guard")) and not form.guarded
+            if guarding:  # the same NLP with the rows that state where the output reverses (the certifier's angles
+                # sampled), from where it is
                 form = self.formulations.get(problem, branch, orientation, range_target, sense, guarded=True)
-                turned = True
-            if not add and not frac and not tightened and not turned:
+            if not add and not frac and not tightened and not turned and not guarding:
                 if run.status is Status.ACCEPTABLE and not polished and c.rounds < max_rounds:
                     # IPOPT's looser tolerance: once more from there, warm, to its own (the acceptable point kept)
                     polished, polish = True, (w, g, c.values, c.problem, m, info, run.status, run.message)

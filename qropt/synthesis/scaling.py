@@ -41,7 +41,7 @@ def factor(problem) -> float:
     return 1.0 / scale
 
 
-def _scales(problem, name: str) -> bool:
+def scales(problem, name: str) -> bool:
     """Whether a parameter scales with the lengths: a length or an offset (``Mechanism.kinds()``), not an angle or
     a branch sign."""
     return problem.mechanism.kinds().get(name) in ("length", "offset")
@@ -59,7 +59,7 @@ def scaled(problem, k: float):
     if "linear" in c:
         c["linear"] = [(coeffs, lo * k, hi * k) for coeffs, lo, hi in c["linear"]]
     return problem.replace(
-        fixed={n: v * k if _scales(problem, n) else v for n, v in problem.fixed.items()},
+        fixed={n: v * k if scales(problem, n) else v for n, v in problem.fixed.items()},
         free={n: (lo * k, hi * k) for n, (lo, hi) in problem.free.items()},
         targets={n: v * k if n == "stroke" else v for n, v in problem.targets.items()},
         conditions=c,
@@ -71,7 +71,7 @@ def unscaled(result, problem, k: float):
     if k == 1.0:
         return result
     back = 1.0 / k
-    params = {n: problem.fixed.get(n, v * back) if _scales(problem, n) else v for n, v in result.params.items()}
+    params = {n: problem.fixed.get(n, v * back) if scales(problem, n) else v for n, v in result.params.items()}
     mechanism = None
     if result.mechanism is not None:
         branch = {n: v for n, v in params.items() if n in problem.mechanism.BRANCHES}
