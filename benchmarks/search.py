@@ -37,7 +37,8 @@ from qropt.synthesis.result import SOLUTION_PRESENT
 
 M = 64  # crank angles of the grid
 CHUNK = 20_000  # designs analysed in one numpy call
-TOL = 1e-6  # relative: a row this much worse than the reference misses
+TOL = 1e-5  # relative: a row this much worse than the reference misses (two certified optima of the coupler
+# slider 5e-6 apart, 0.0003 deg, are one design to a designer; 1e-5 of a transmission angle is 0.0006 deg)
 SENSE = {"max_gamma_min": -1.0, "min_size": 1.0, "min_peak_accel": 1.0}  # minimised: SENSE * objective
 
 

@@ -165,3 +165,51 @@ def test_the_solver_option():
     p = type_problem("drag-link-slider", 1.83, 0.42)
     r = off.solve(p)
     assert r.stats["atlas_starts"] == 0 and "atlas" not in r.certificate.global_claim
+
+
+def test_a_solve_short_of_both_nodes_runs_the_atlas_starts_again_with_more_iterations():
+    """At TR 2.295, 0.7816 m the coupler slider's atlas starts ended at IPOPT's iteration limit, and the row was
+    0.6923 rad: what a 64-start multi-start finds too. Both nodes around it have designs of over 1.01 rad, so the
+    starts run again with a larger iteration limit and reach 1.0637 rad, checked by the tests' own simulation."""
+    from qropt.synthesis import multistart
+    from qropt.synthesis.local import Designs
+
+    p = type_problem("coupler-slider", 2.295, 0.7816)
+    found = atlas.starts(p)
+    floor = multistart.expected(p, found, Designs())
+    assert floor == pytest.approx(1.0149, abs=1e-3)  # the worse node (TR 2.35): 58.1 deg
+    r = Solver().solve(p)
+    assert r.status == "optimal", r.message
+    assert "larger iteration limit" in r.certificate.global_claim
+    assert r.objective > floor  # between the nodes' values, as expected
+    b_tr, b_stroke, b_gamma = brute.task_values("coupler-slider", dict(r.mechanism.params))
+    assert (b_tr, b_stroke) == pytest.approx((2.295, 0.7816), abs=1e-8)
+    assert b_gamma == pytest.approx(r.objective, abs=1e-7)
+    assert b_gamma > 1.06  # 60.9 deg
+
+
+def test_no_value_is_expected_where_one_node_has_no_design():
+    """The slider-crank reaches TR 2.967 but not the node above it (3.05): no value is expected from one node."""
+    from qropt.synthesis import multistart
+    from qropt.synthesis.local import Designs
+
+    p = type_problem("slider-crank", 2.967, 0.0908)
+    found = atlas.starts(p)
+    assert found.designs and set(found.nodes) == {0}
+    assert multistart.expected(p, found, Designs()) is None
+    assert not multistart.short(p, [], None)
+
+
+def test_a_solve_still_short_after_the_rerun_runs_the_multi_start_as_well():
+    """At TR 1.898, 0.1077 m the crank-rocker slider's least peak acceleration from the atlas's starts is 0.1120
+    m/s^2, over 2 % above both nodes' designs, also after the rerun; the multi-start then finds 0.1044 (the
+    value a multi-start without the atlas finds), and the claim counts every start."""
+    p = type_problem("crank-rocker-slider", 1.898, 0.1077, objective="min_peak_accel")
+    r = Solver().solve(p)
+    assert r.status == "optimal", r.message
+    assert "distinct local optima" in r.certificate.global_claim
+    alone = Solver(atlas=False).solve(p)
+    assert r.objective <= alone.objective * (1 + 1e-9)
+    assert r.objective < 0.105  # 0.1120 from the atlas's starts alone
+    b_tr, b_stroke, _ = brute.task_values("crank-rocker-slider", dict(r.mechanism.params))
+    assert (b_tr, b_stroke) == pytest.approx((1.898, 0.1077), abs=1e-8)

@@ -16,9 +16,7 @@ from qropt.studies._design import type_problem
 
 SHAPES = 20_000
 STARTS = 64
-# docs/benchmarks.md: at TR 2.284, 0.9993 m (QROPT_TASK_SEED=606) the coupler slider's row gives gamma_min 0.6949
-# rad where the search finds 1.0687 (its solves from the atlas end at designs that reverse twice a turn)
-KNOWN_MISSES = {"coupler-slider"}
+KNOWN_MISSES: set = set()  # rows known to miss the search's design (docs/benchmarks.md says where); none today
 
 
 def _task():

@@ -59,10 +59,12 @@ def signature(problem) -> str | None:
 
 @dataclass(frozen=True)
 class Starts:
-    """A solve's starts from the atlas: (free values, branch) pairs in the problem's lengths, and what they are."""
+    """A solve's starts from the atlas: (free values, branch) pairs in the problem's lengths, the node (0 or 1,
+    the lower or upper time ratio) each comes from, and what they are."""
 
     designs: tuple = ()
     how: str = ""
+    nodes: tuple = ()
 
 
 @functools.cache
@@ -87,16 +89,17 @@ def starts(problem) -> Starts:
     i = max(bisect.bisect_right(nodes, tr) - 1, 0)
     around = sorted({i, min(i + 1, len(nodes) - 1)})
     s = float(problem.targets["stroke"])
-    out = []
-    for j in around:
+    out, node = [], []
+    for n, j in enumerate(around):
         for d in entry["designs"][j]:
             v = {k: x * s if scaling.scales(problem, k) else x for k, x in d["params"].items()}
             v = {k: min(max(v[k], lo), hi) for k, (lo, hi) in problem.free.items()}
             out.append((v, {k: float(b) for k, b in d["branch"].items()}))
+            node.append(n)
     at = " and ".join(f"{nodes[j]:g}" for j in around)
     how = f"{len(out)} designs of the atlas at TR {at} (each node's best of a {entry['starts']}-start search "
     how += "and of solves from its neighbours' designs)"
-    return Starts(tuple(out), how)
+    return Starts(tuple(out), how, tuple(node))
 
 
 __all__ = ["signature", "starts", "Starts", "PATH"]

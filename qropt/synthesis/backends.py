@@ -7,6 +7,7 @@ exact derivatives (the benchmarks' baselines). Each backend reads its own status
 from __future__ import annotations
 
 import enum
+import math
 import weakref
 from dataclasses import dataclass
 from typing import Protocol
@@ -74,6 +75,17 @@ def _push(bound) -> np.ndarray:
     return PUSH * np.maximum(1.0, np.abs(np.where(np.isfinite(bound), bound, 0.0)))
 
 
+def objective_scale(form, w0, p) -> float:
+    """1, or for a dynamic objective (newtons, newton-metres, their squares) the power of ten that brings its value
+    at the start to order one: IPOPT's tolerance (1e-12) is absolute, below the rounding of a peak force of 1e3 N
+    (an N^2 epigraph of 1e6 went to the iteration limit in every run)."""
+    c = form.objective
+    if c is None or not c.needs_masses:
+        return 1.0
+    f = abs(float(form.objective_function(w0, p)))
+    return 10.0 ** -math.ceil(math.log10(f)) if math.isfinite(f) and f > 10.0 else 1.0
+
+
 class Ipopt:
     """IPOPT through CasADi, one compiled solver per formulation (two: re-solves, and starts on or near a bound,
     move off a bound by 1e-8 only, since IPOPT's default push of 0.01 is absolute and can move a small link across a
@@ -81,24 +93,37 @@ class Ipopt:
     them)."""
 
     name = "ipopt"
+    PATIENCE = 4  # a patient run's iteration limit, in multiples of the default's
 
     def __init__(self, options: dict | None = None):
         self.options = {**IPOPT, **(options or {})}
         self._solvers: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+        self._patient = None
 
-    def solver(self, form, warm: bool = False):
-        pair = self._solvers.setdefault(form, [None, None])
-        if pair[warm] is None:
-            opts = {**WARM, **self.options} if warm else self.options
-            pair[warm] = casadi.nlpsol("qropt_warm" if warm else "qropt", "ipopt", form.nlp, opts)
-        return pair[warm]
+    def patient(self) -> Ipopt:
+        """The same backend with PATIENCE times the iteration limit (for a start known to be near an optimum of
+        a nearby problem, where a first run can need more iterations than a blind start's budget)."""
+        if self._patient is None:
+            limit = self.PATIENCE * int(self.options.get("ipopt.max_iter", 3000))
+            self._patient = Ipopt({**self.options, "ipopt.max_iter": limit})
+        return self._patient
+
+    def solver(self, form, warm: bool = False, scale: float = 1.0):
+        kept = self._solvers.setdefault(form, {})
+        key = (warm, scale)
+        if key not in kept:
+            opts = {**WARM, **self.options} if warm else dict(self.options)
+            if scale != 1.0:
+                opts["ipopt.obj_scaling_factor"] = scale
+            kept[key] = casadi.nlpsol("qropt_warm" if warm else "qropt", "ipopt", form.nlp, opts)
+        return kept[key]
 
     def run(self, form, w0, p, lbx, ubx, warm: bool = False) -> Run:
         w0 = np.clip(w0, lbx, ubx)
         # a start on a bound (a family's end), or nearer one than IPOPT's default push would move it (an optimum
         # with a link at its bound, from the atlas or a neighbour), stays where it is
         on_bound = bool(np.any((w0 - lbx < _push(lbx)) | (ubx - w0 < _push(ubx))))
-        solver = self.solver(form, warm or on_bound)
+        solver = self.solver(form, warm or on_bound, objective_scale(form, w0, p) if warm else 1.0)
         r = solver(x0=w0, p=p, lbx=lbx, ubx=ubx, lbg=form.lbg, ubg=form.ubg)
         st = solver.stats()
         word = st.get("return_status", "?")

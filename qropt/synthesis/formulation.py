@@ -592,6 +592,11 @@ class Formulation:
         )
 
     @functools.cached_property
+    def objective_function(self):
+        """[w, p] -> the NLP's objective."""
+        return casadi.Function("f", [self.w_sym, self.p_sym], [self.f_sym])
+
+    @functools.cached_property
     def square_rows(self) -> np.ndarray | None:
         """Indices of the equality rows in the free parameters and dead centres (targets, zero velocity), if
         they are as many as those unknowns: the system a closed-form enumeration is polished on."""

@@ -41,6 +41,7 @@ class Candidate:
     t_ipopt: float = 0.0
     rounds: int = 0
     origin: str = ""
+    start: int = -1  # the index of its start in a MultiStart.run's list
     q: dict | None = None
     pruned: bool = False
     problem: object = None  # the problem as the design fixes it (a free counterweight chosen); None: the solve's
@@ -121,11 +122,14 @@ class LocalSolve:
         sense=1,
         designs=None,
         bound=None,
+        patient=False,
     ) -> Candidate:
         """From values0 on branch; orientation: which way the TR equality is met (+1, -1), None for the start's
         own; designs: the solve's memo of built mechanisms; bound: the incumbent's NLP objective value, above
-        which the exchange loop stops (the start is pruned)."""
+        which the exchange loop stops (the start is pruned); patient: a start near an optimum of a nearby problem,
+        run on the backend's ``patient()`` variant (a larger iteration limit) where it has one."""
         max_rounds = self.max_rounds if max_rounds is None else max_rounds
+        backend = self.backend.patient() if patient and hasattr(self.backend, "patient") else self.backend
         designs = designs or Designs()
         objective = criteria.of_problem(problem)
         if (
@@ -164,7 +168,7 @@ class LocalSolve:
         g, info, m, restarts, polished, polish = None, {}, None, 0, False, None
         while c.rounds < max_rounds:
             c.rounds += 1
-            run, ran = self.backend.run(form, w, p, lbx, ubx, warm=c.rounds > 1), form
+            run, ran = backend.run(form, w, p, lbx, ubx, warm=c.rounds > 1), form
             w, g = run.w, run.g
             c.t_ipopt += run.seconds
             c.iterations += run.iterations
