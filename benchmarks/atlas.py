@@ -56,13 +56,13 @@ def _better(problem, a: list, b: list) -> bool:
         return False
     if not b:
         return True
-    sign = 1.0 if criteria.maximises(problem.objective) else -1.0
+    sign = criteria.sense(problem.objective)
     return sign * (a[0]["value"] - b[0]["value"]) > 1e-9 * max(1.0, abs(b[0]["value"]))
 
 
 def _merge(problem, *lists) -> list:
     """The KEEP best distinct designs of several lists (apart by 1e-6 in some value)."""
-    sign = -1.0 if criteria.maximises(problem.objective) else 1.0
+    sign = -criteria.sense(problem.objective)  # best first
     out = []
     for d in sorted((d for ds in lists for d in ds), key=lambda d: sign * d["value"]):
         v = np.array(list(d["params"].values()))

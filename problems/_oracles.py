@@ -55,7 +55,7 @@ def along(problem, design, lo, hi, n=400, boundary=None):
     """Dense grid along a 1-D family ``design(t) -> params or None`` for t in [lo, hi], refined by bounded Brent
     around the best grid point; if ``boundary(t)`` is given (>= 0 where the design is acceptable, e.g. a
     gamma_min margin), sign changes of it are refined by brentq and included."""
-    sign = -1.0 if criteria.maximises(problem.objective) else 1.0
+    sign = -criteria.sense(problem.objective)
 
     def f(t):
         d = design(t)

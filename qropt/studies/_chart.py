@@ -21,7 +21,7 @@ import numpy as np
 from qropt.errors import ChartError, QroptError
 from qropt.io.paths import picture_path
 from qropt.synthesis import criteria
-from qropt.synthesis.criteria import maximises
+from qropt.synthesis.criteria import maximises, sense
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import STATUSES, Result
 from qropt.units import named
@@ -585,7 +585,7 @@ def chart_figure(ch: Chart):
     ridge = None
     if ch.y.kind == "fixed":  # a design choice on y: its best value for each x
         z = _panel(ch, "objective")[0]
-        sign = 1.0 if maximises(ch.problem.objective) else -1.0
+        sign = sense(ch.problem.objective)
         cols_ok = np.isfinite(z).any(axis=0)
         ridge = (xs[cols_ok], ys[np.nanargmax(sign * np.where(np.isfinite(z), z, -np.inf * sign), axis=0)][cols_ok])
     for ax, name in zip(axes.flat, names, strict=False):

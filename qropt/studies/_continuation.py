@@ -16,7 +16,7 @@ import time
 from qropt.studies._chart import Axis, Cell, axis_kind, problem_at
 from qropt.synthesis import starts
 from qropt.synthesis.certificate import better
-from qropt.synthesis.criteria import maximises
+from qropt.synthesis.criteria import sense
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import Result
 
@@ -85,7 +85,7 @@ class _Tile:
         if a.objective is None or b.objective is None:
             return False
         tol = BETTER * max(1.0, abs(b.objective))
-        return better(self.problem, a.objective, b.objective + (tol if maximises(self.problem.objective) else -tol))
+        return better(self.problem, a.objective, b.objective + tol * sense(self.problem.objective))
 
     def full(self, problem) -> Result:
         """The default solve; a cell it cannot give a design is explained (a closed form that gives every design

@@ -90,7 +90,7 @@ class Ipopt:
     """IPOPT through CasADi, one compiled solver per formulation (two: re-solves, and starts on or near a bound,
     move off a bound by 1e-8 only, since IPOPT's default push of 0.01 is absolute and can move a small link across a
     Grashof or assembly limit, where the loop has no real solution, or a start that meets its targets far from
-    them)."""
+    them; and a re-solve of a dynamic objective one per objective scale, ``objective_scale``)."""
 
     name = "ipopt"
     PATIENCE = 4  # a patient run's iteration limit, in multiples of the default's

@@ -457,6 +457,12 @@ def maximises(objective: str | None) -> bool:
     return bool(objective) and of(objective, "sum").maximise
 
 
+def sense(objective: str | None) -> float:
+    """+1.0 where the objective is maximised, -1.0 where it is minimised: sense * value is larger for a better
+    design."""
+    return 1.0 if maximises(objective) else -1.0
+
+
 def violations(problem, m) -> dict:
     """Exact violation (>= 0) of each bound condition of the problem: '<condition> bound (exact)' -> value."""
     out = {}
@@ -513,6 +519,7 @@ __all__ = [
     "of",
     "of_problem",
     "maximises",
+    "sense",
     "violations",
     "objective_of",
     "objective_value",

@@ -51,13 +51,14 @@ class MultiStart:
                 first = [("atlas", v, b) for v, b in plan.atlas.designs]
                 cands += self.run(problem, first, targets, max_rounds, designs, both_ways=False)
                 floor = expected(problem, plan.atlas, designs)
-                how = plan.atlas.how
-                if short(problem, cands, floor):  # again, each without a design, with a larger iteration limit
+                how, falls_short = plan.atlas.how, short(problem, cands, floor)
+                if falls_short:  # again, each start without a design, with a larger iteration limit
                     done = {c.start for c in cands if c.ok}
                     again = [r for i, r in enumerate(first) if i not in done]
                     cands += self.run(problem, again, targets, max_rounds, designs, both_ways=False, patient=True)
                     how += ", those without a design run again with a larger iteration limit"
-                if any(c.ok for c in cands) and not short(problem, cands, floor):
+                    falls_short = short(problem, cands, floor)
+                if any(c.ok for c in cands) and not falls_short:
                     return cands, f"best of {how}", None
                 # none certified, or still short: the multi-start as well (the atlas's candidates kept, counted)
             if len(plan.analytic) > MANY_STARTS and not extra:  # a sweep of closed-form points: the best few
@@ -138,7 +139,7 @@ def expected(problem, found, designs) -> float | None:
     reach) or without an objective."""
     if not problem.objective:
         return None
-    sign = 1.0 if criteria.maximises(problem.objective) else -1.0
+    sign = criteria.sense(problem.objective)
     at_nodes = {}
     for (v, b), n in zip(found.designs, found.nodes, strict=True):
         f = score(problem, v, b, designs)[0]
@@ -151,7 +152,7 @@ def short(problem, cands, floor: float | None) -> bool:
     """Whether the best certified candidate (or none) falls ATLAS_SHORT (relative) below ``expected``'s value."""
     if floor is None:
         return False
-    sign = 1.0 if criteria.maximises(problem.objective) else -1.0
+    sign = criteria.sense(problem.objective)
     best = max((sign * criteria.objective_of(problem, c.mechanism) for c in cands if c.ok), default=-np.inf)
     return bool(best < floor - ATLAS_SHORT * abs(floor))
 
