@@ -7,11 +7,14 @@ points per two free parameters (the default solve's is 8), closed forms and grid
 solved again from its neighbours' designs (continuation), until no node improves: a design found at one TR is
 carried to the next; a node still without a design is walked to from the nearest with one, TR in small steps.
 Last (``fill``), each node is solved again from the row's other objectives' designs there (a design by one
-objective starts a solve by another), the walk is tried again, and the continuation run once more. Each node
-keeps its KEEP best distinct designs. Rows run in ``--jobs`` processes; ``--fill`` runs only the last step, on
-the atlas as it is.
+objective starts a solve by another) and, with ``--shapes N``, from the best of N random shapes within 5 % of
+its TR (the grid analysis of ``benchmarks.search``), the walk is tried again, and the continuation run once more.
+Each node keeps its KEEP best distinct designs. Rows run in ``--jobs`` processes; ``--fill`` runs only the last
+step, on the atlas as it is.
 
-Run: ``python -m benchmarks.atlas [--starts 24] [--jobs 2]`` (repository root; about 35 min on 2 cores).
+Run: ``python -m benchmarks.atlas [--starts 24] [--jobs 2]`` (repository root; about 35 min on 2 cores);
+``python -m benchmarks.atlas --fill [--rows coupler-slider] [--shapes 1000000]`` (about 5 min without shapes;
+10^6 shapes a node add about 10 min a row).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
+from benchmarks import search
 from qropt import Solver
 from qropt.studies._design import TYPES, type_problem
 from qropt.synthesis import atlas, criteria, starts
@@ -32,6 +36,8 @@ NODES = tuple(round(float(x), 3) for x in np.arange(1.05, 3.55 + 1e-9, 0.1))
 OBJECTIVES = ("max_gamma_min", "min_peak_accel")
 KEEP = 2  # designs kept per node
 PASSES = 3  # continuation passes at most
+SHAPE_WINDOW = 0.05  # random shapes within this (relative) of a node's TR start local solves there (``--shapes``)
+POLISH = 16  # ... the best this many of them by the objective's grid value
 
 
 HEAVY = ("coupler-slider", "drag-link-slider", "crank-rocker-slider")  # built first: the longest jobs
@@ -151,10 +157,21 @@ def build_row(kind: str, objective: str, starts_n: int) -> dict:
     }
 
 
-def fill_row(entry: dict, others: list) -> dict:
+def _shaped(solver, problem, kept: list, n: int, seed: int) -> tuple[list, bool]:
+    """(kept merged with the designs of a solve from the POLISH best of n random shapes within SHAPE_WINDOW of the
+    node's TR (``benchmarks.search.shapes``: the grid analysis, no solver), whether that solve found a better
+    best)."""
+    found, _, _ = search.shapes(problem, n, seed, window=SHAPE_WINDOW)
+    if not found:
+        return kept, False
+    return _from(solver, problem, [{"params": v} for v in found[:POLISH]], kept)
+
+
+def fill_row(entry: dict, others: list, shapes_n: int = 0) -> dict:
     """An entry improved where the row's other objectives' designs at a node (``others``: per node, a list) give a
-    better one, its nodes still without a design walked to (``_walk``) from the nearest nodes with designs, and
-    the whole continued once more (``_continued``)."""
+    better one, and (``shapes_n``) where the best of that many random shapes near the node's TR does (``_shaped``),
+    its nodes still without a design walked to (``_walk``) from the nearest nodes with designs, and the whole
+    continued once more (``_continued``)."""
     t0, kind, objective = time.perf_counter(), entry["row"], entry["objective"]
     solver, designs = Solver(atlas=False), list(entry["designs"])
     problems = [type_problem(kind, tr, 1.0, objective=objective) for tr in NODES]
@@ -164,6 +181,9 @@ def fill_row(entry: dict, others: list) -> dict:
         if seeds:
             designs[i], improved = _from(solver, problems[i], seeds, designs[i])
             better += improved
+    for i, p in enumerate(problems) if shapes_n else ():
+        designs[i], improved = _shaped(solver, p, designs[i], shapes_n, seed=i)
+        better += improved
     designs, _ = _walked(solver, problems, designs)
     before = designs
     designs = _continued(solver, problems, designs)
@@ -174,10 +194,10 @@ def fill_row(entry: dict, others: list) -> dict:
         f"designs; {got} of {len(empty)} empty nodes filled in {time.perf_counter() - t0:.0f} s",
         flush=True,
     )
-    return {**entry, "designs": designs}
+    return {**entry, "designs": designs} | ({"shapes": max(shapes_n, entry.get("shapes", 0))} if shapes_n else {})
 
 
-def fill(data: dict, rows, jobs: int) -> dict:
+def fill(data: dict, rows, jobs: int, shapes_n: int = 0) -> dict:
     """The atlas with the entries of ``rows`` improved (``fill_row``)."""
     todo = [e for e in data["entries"] if e["row"] in rows]
     others = [
@@ -188,7 +208,7 @@ def fill(data: dict, rows, jobs: int) -> dict:
         for e in todo
     ]
     with ProcessPoolExecutor(jobs) as pool:
-        filled = {(e["row"], e["objective"]): e for e in pool.map(fill_row, todo, others)}
+        filled = {(e["row"], e["objective"]): e for e in pool.map(fill_row, todo, others, [shapes_n] * len(todo))}
     return {**data, "entries": [filled.get((e["row"], e["objective"]), e) for e in data["entries"]]}
 
 
@@ -198,6 +218,7 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--rows", nargs="+", default=list(TYPES), help="rebuild these rows only (the others kept)")
     ap.add_argument("--fill", action="store_true", help="only improve the atlas's nodes (see fill_row)")
+    ap.add_argument("--shapes", type=int, default=0, help="in the last step, also polish the best of this many shapes")
     args = ap.parse_args(argv)
     if args.fill:
         data = json.loads(atlas.PATH.read_text())
@@ -211,7 +232,7 @@ def main(argv=None) -> int:
             entries = sorted(kept + entries, key=lambda e: (list(TYPES).index(e["row"]), e["objective"]))
         data = {"nodes": list(NODES), "keep": KEEP, "entries": entries}
         atlas.PATH.write_text(json.dumps(data, indent=1) + "\n")  # kept, whatever the last step does
-    data = fill(data, args.rows, args.jobs)
+    data = fill(data, args.rows, args.jobs, args.shapes)
     atlas.PATH.write_text(json.dumps(data, indent=1) + "\n")
     print(f"wrote {atlas.PATH}")
     return 0

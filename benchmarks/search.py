@@ -37,8 +37,9 @@ from qropt.synthesis.result import SOLUTION_PRESENT
 
 M = 64  # crank angles of the grid
 CHUNK = 20_000  # designs analysed in one numpy call
-TOL = 1e-5  # relative: a row this much worse than the reference misses (two certified optima of the coupler
-# slider 5e-6 apart, 0.0003 deg, are one design to a designer; 1e-5 of a transmission angle is 0.0006 deg)
+TOL = 1e-4  # relative: a row this much worse than the reference misses. The coupler slider has certified optima
+# this close: 5e-6 apart at TR 2.284 (0.0003 deg) and 1.9e-5 at TR 2.056 (1.24908 and 1.24910 rad, 0.0013 deg),
+# one design to a designer; 1e-4 of a transmission angle of 1 rad is 0.006 deg, of a peak acceleration 0.01 %
 SENSE = {"max_gamma_min": -1.0, "min_size": 1.0, "min_peak_accel": 1.0}  # minimised: SENSE * objective
 
 

@@ -16,9 +16,7 @@ from qropt.studies._design import type_problem
 
 SHAPES = 20_000
 STARTS = 64
-# docs/benchmarks.md: at TR 2.056, 0.2236 m (QROPT_TASK_SEED=855123) the coupler slider's row gives gamma_min
-# 1.1377 rad where the search finds 1.2491 (the atlas's node at TR 2.05 holds 1.1393: its build missed the design)
-KNOWN_MISSES = {"coupler-slider"}
+KNOWN_MISSES: set[str] = set()  # rows the search is known to beat (docs/benchmarks.md), none today
 
 
 def _task():

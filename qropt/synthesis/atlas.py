@@ -60,11 +60,12 @@ def signature(problem) -> str | None:
 @dataclass(frozen=True)
 class Starts:
     """A solve's starts from the atlas: (free values, branch) pairs in the problem's lengths, the node (0 or 1,
-    the lower or upper time ratio) each comes from, and what they are."""
+    the lower or upper time ratio) each comes from, what they are, and the nodes' time ratios (``trs``)."""
 
     designs: tuple = ()
     how: str = ""
     nodes: tuple = ()
+    trs: tuple = ()
 
 
 @functools.cache
@@ -97,9 +98,10 @@ def starts(problem) -> Starts:
             out.append((v, {k: float(b) for k, b in d["branch"].items()}))
             node.append(n)
     at = " and ".join(f"{nodes[j]:g}" for j in around)
-    how = f"{len(out)} designs of the atlas at TR {at} (each node's best of a {entry['starts']}-start search "
-    how += "and of solves from its neighbours' designs)"
-    return Starts(tuple(out), how, tuple(node))
+    how = f"{len(out)} designs of the atlas at TR {at} (each node's best of a {entry['starts']}-start search"
+    how += f", of the best of {entry['shapes']:,} random shapes near it" if entry.get("shapes") else ""
+    how += " and of solves from its neighbours' designs)"
+    return Starts(tuple(out), how, tuple(node), tuple(float(nodes[j]) for j in around))
 
 
 __all__ = ["signature", "starts", "Starts", "PATH"]

@@ -67,6 +67,7 @@ IPOPT_STATUS = {
 }
 WARM = {"ipopt.bound_push": 1e-8, "ipopt.bound_frac": 1e-8}
 PUSH = 0.01  # IPOPT's default bound_push: a start this near a bound (relative to it, at least 1) would move
+NEAR_MU = 1e-6  # the barrier's first value for a start at an optimum of a nearby problem (``Ipopt.near``)
 STALLED_KKT = 1e-9  # an IPOPT run stopped short of its tolerance is acceptable at a KKT point to this, relative
 
 
@@ -98,7 +99,7 @@ class Ipopt:
     def __init__(self, options: dict | None = None):
         self.options = {**IPOPT, **(options or {})}
         self._solvers: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-        self._patient = None
+        self._patient = self._near = None
 
     def patient(self) -> Ipopt:
         """The same backend with PATIENCE times the iteration limit (for a start known to be near an optimum of
@@ -107,6 +108,17 @@ class Ipopt:
             limit = self.PATIENCE * int(self.options.get("ipopt.max_iter", 3000))
             self._patient = Ipopt({**self.options, "ipopt.max_iter": limit})
         return self._patient
+
+    def near(self) -> Ipopt:
+        """The same backend with a barrier that starts at NEAR_MU and falls monotonically, for a run that starts at
+        or near an optimum: an exchange loop's re-solve (the last round's optimum, a few samples added) and a start
+        from the atlas or a neighbour's design. The adaptive barrier's first large steps move such a start off its
+        active constraints, often to another local optimum: from the coupler slider's best design at TR 2.056,
+        its re-solves ended at a design whose dead centres are local (no design), and the atlas's walk from TR
+        1.75 to 1.85 failed where this one keeps the branch."""
+        if self._near is None:
+            self._near = Ipopt({**self.options, "ipopt.mu_strategy": "monotone", "ipopt.mu_init": NEAR_MU})
+        return self._near
 
     def solver(self, form, warm: bool = False, scale: float = 1.0):
         kept = self._solvers.setdefault(form, {})
