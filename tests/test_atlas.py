@@ -268,3 +268,15 @@ def test_a_start_at_an_optimum_stays_there():
     b_tr, b_stroke, b_gamma = brute.task_values("coupler-slider", dict(r.mechanism.params))
     assert (b_tr, b_stroke) == pytest.approx((2.056, 0.2236), abs=1e-8)
     assert b_gamma == pytest.approx(r.objective, abs=1e-7)
+
+
+def test_the_small_barrier_keeps_the_callers_options():
+    """``Ipopt.near`` is IPOPT's monotone barrier from mu_init 1e-6, except where the caller named a barrier option;
+    the patient variant keeps both the caller's options and the small barrier."""
+    near = Solver().backend.near().options
+    assert (near["ipopt.mu_strategy"], near["ipopt.mu_init"]) == ("monotone", 1e-6)
+    own = Solver(ipopt_options={"ipopt.mu_strategy": "adaptive", "ipopt.max_iter": 100}).backend
+    assert own.near().options["ipopt.mu_strategy"] == "adaptive"
+    patient = own.patient()
+    assert patient.options["ipopt.max_iter"] == 400 and patient.options["ipopt.mu_strategy"] == "adaptive"
+    assert Solver().backend.patient().near().options["ipopt.max_iter"] == 240

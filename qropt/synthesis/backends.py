@@ -68,6 +68,7 @@ IPOPT_STATUS = {
 WARM = {"ipopt.bound_push": 1e-8, "ipopt.bound_frac": 1e-8}
 PUSH = 0.01  # IPOPT's default bound_push: a start this near a bound (relative to it, at least 1) would move
 NEAR_MU = 1e-6  # the barrier's first value for a start at an optimum of a nearby problem (``Ipopt.near``)
+NEAR = {"ipopt.mu_strategy": "monotone", "ipopt.mu_init": NEAR_MU}
 STALLED_KKT = 1e-9  # an IPOPT run stopped short of its tolerance is acceptable at a KKT point to this, relative
 
 
@@ -97,7 +98,8 @@ class Ipopt:
     PATIENCE = 4  # a patient run's iteration limit, in multiples of the default's
 
     def __init__(self, options: dict | None = None):
-        self.options = {**IPOPT, **(options or {})}
+        self.given = dict(options or {})  # the caller's, which the variants below keep
+        self.options = {**IPOPT, **self.given}
         self._solvers: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
         self._patient = self._near = None
 
@@ -106,7 +108,7 @@ class Ipopt:
         a nearby problem, where a first run can need more iterations than a blind start's budget)."""
         if self._patient is None:
             limit = self.PATIENCE * int(self.options.get("ipopt.max_iter", 3000))
-            self._patient = Ipopt({**self.options, "ipopt.max_iter": limit})
+            self._patient = Ipopt({**self.given, "ipopt.max_iter": limit})
         return self._patient
 
     def near(self) -> Ipopt:
@@ -115,9 +117,9 @@ class Ipopt:
         from the atlas or a neighbour's design. The adaptive barrier's first large steps move such a start off its
         active constraints, often to another local optimum: from the coupler slider's best design at TR 2.056,
         its re-solves ended at a design whose dead centres are local (no design), and the atlas's walk from TR
-        1.75 to 1.85 failed where this one keeps the branch."""
+        1.75 to 1.85 failed where this one keeps the branch. A barrier option the caller gave stays theirs."""
         if self._near is None:
-            self._near = Ipopt({**self.options, "ipopt.mu_strategy": "monotone", "ipopt.mu_init": NEAR_MU})
+            self._near = Ipopt({**NEAR, **self.given})
         return self._near
 
     def solver(self, form, warm: bool = False, scale: float = 1.0):

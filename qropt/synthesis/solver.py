@@ -38,7 +38,8 @@ class Solver:
     """Owns the NLP formulations (built once per problem structure), the backend and the options of every solve.
 
     tolerances: {'feasibility': largest accepted violation, 'gap': certified minus NLP epigraph value that
-    ends the exchange loop}; ipopt_options: merged into IPOPT's (names as CasADi takes them, 'ipopt.tol');
+    ends the exchange loop}; ipopt_options: merged into IPOPT's (names as CasADi takes them, 'ipopt.tol'; runs
+    that start at or near an optimum use a monotone barrier from mu_init 1e-6, unless these name their own);
     samples: uniform epigraph sample angles per formulation (the exchange loop adds up to ``extra`` more);
     starts_n, seed: the Sobol multi-start used where no closed form enumerates the solutions (without closed
     forms, starts_n per two free parameters unless a solve names its own); backend: an NLP
