@@ -194,7 +194,10 @@ def fill_row(entry: dict, others: list, shapes_n: int = 0) -> dict:
         f"designs; {got} of {len(empty)} empty nodes filled in {time.perf_counter() - t0:.0f} s",
         flush=True,
     )
-    return {**entry, "designs": designs} | ({"shapes": max(shapes_n, entry.get("shapes", 0))} if shapes_n else {})
+    out = {**entry, "designs": designs}
+    if shapes_n:  # the atlas's claim names the largest shape search its nodes had
+        out["shapes"] = max(shapes_n, entry.get("shapes", 0))
+    return out
 
 
 def fill(data: dict, rows, jobs: int, shapes_n: int = 0) -> dict:

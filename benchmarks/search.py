@@ -33,6 +33,7 @@ from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle
 from qropt.kinematics.ops import NUMPY
 from qropt.mechanisms import REQUIRED
 from qropt.studies._design import TYPES, design, type_problem
+from qropt.synthesis.criteria import sense
 from qropt.synthesis.result import SOLUTION_PRESENT
 
 M = 64  # crank angles of the grid
@@ -40,7 +41,6 @@ CHUNK = 20_000  # designs analysed in one numpy call
 TOL = 1e-4  # relative: a row this much worse than the reference misses. The coupler slider has certified optima
 # this close: 5e-6 apart at TR 2.284 (0.0003 deg) and 1.9e-5 at TR 2.056 (1.24908 and 1.24910 rad, 0.0013 deg),
 # one design to a designer; 1e-4 of a transmission angle of 1 rad is 0.006 deg, of a peak acceleration 0.01 %
-SENSE = {"max_gamma_min": -1.0, "min_size": 1.0, "min_peak_accel": 1.0}  # minimised: SENSE * objective
 
 
 def _params(problem, rng, n: int) -> dict:
@@ -156,8 +156,8 @@ def reference(problem, n: int, seed: int, polish: int = 16, starts: int = 256, s
     polished = solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=found[:polish], diagnose=False)
     multi = solver.solve(problem, starts_n=starts, use_analytic=False, seed=seed, diagnose=False)
     for how, r in (("shapes", polished), ("multistart", multi)):
-        if r.status in SOLUTION_PRESENT and (best is None or SENSE[problem.objective] * r.objective < best[1]):
-            best = (how, SENSE[problem.objective] * r.objective, r)
+        if r.status in SOLUTION_PRESENT and (best is None or -sense(problem.objective) * r.objective < best[1]):
+            best = (how, -sense(problem.objective) * r.objective, r)
     return {
         "shapes": n,
         "valid": counted,
@@ -179,13 +179,13 @@ def compare(time_ratio: float, stroke: float, objective: str, n: int, seed: int,
         problem = type_problem(row.type, time_ratio, stroke, objective=objective)
         ref = reference(problem, n, seed, starts=starts)
         mine = row.result.objective if row.result.status in SOLUTION_PRESENT else None
-        sense = SENSE[objective]
+        worse = -sense(objective)  # larger is worse
         if ref["objective"] is None:
             miss = False
         elif mine is None:
             miss = True
         else:
-            miss = sense * mine > sense * ref["objective"] + TOL * max(1.0, abs(ref["objective"]))
+            miss = worse * mine > worse * ref["objective"] + TOL * max(1.0, abs(ref["objective"]))
         out.append(
             {
                 "type": row.type,
