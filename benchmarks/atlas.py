@@ -8,9 +8,9 @@ solved again from its neighbours' designs (continuation), until no node improves
 carried to the next; a node still without a design is walked to from the nearest with one, TR in small steps.
 Last (``fill``), each node is solved again from the row's other objectives' designs there (a design by one
 objective starts a solve by another) and, with ``--shapes N``, from the best of N random shapes within 5 % of
-its TR (the grid analysis of ``benchmarks.search``), the walk is tried again, and the continuation run once more.
-Each node keeps its KEEP best distinct designs. Rows run in ``--jobs`` processes; ``--fill`` runs only the last
-step, on the atlas as it is.
+its TR (the grid analysis of ``benchmarks.search``), the walk is tried again, and the continuation run once more;
+its solves have four times IPOPT's iteration limit (a patient solve's). Each node keeps its KEEP best distinct
+designs. Rows run in ``--jobs`` processes; ``--fill`` runs only the last step, on the atlas as it is.
 
 Run: ``python -m benchmarks.atlas [--starts 24] [--jobs 2]`` (repository root; about 35 min on 2 cores);
 ``python -m benchmarks.atlas --fill [--rows coupler-slider] [--shapes 1000000]`` (about 5 min without shapes;
@@ -30,6 +30,8 @@ from benchmarks import search
 from qropt import Solver
 from qropt.studies._design import TYPES, type_problem
 from qropt.synthesis import atlas, criteria, starts
+from qropt.synthesis.backends import Ipopt
+from qropt.synthesis.formulation import IPOPT
 from qropt.synthesis.result import SOLUTION_PRESENT
 
 NODES = tuple(round(float(x), 3) for x in np.arange(1.05, 3.55 + 1e-9, 0.1))
@@ -50,7 +52,7 @@ def _designs(problem, r) -> list[dict]:
     for x in (r, *r.local_optima[1:]) if r.local_optima else (r,):
         if x.status not in SOLUTION_PRESENT or x.status == "feasible" or x.objective is None:
             continue
-        params = {k: float(x.params[k]) for k in problem.free}
+        params = {k: min(max(float(x.params[k]), lo), hi) for k, (lo, hi) in problem.free.items()}  # rounding
         branch = {k: float(x.params[k]) for k in problem.branches}
         out.append({"params": params, "branch": branch, "value": float(x.objective)})
     return out
@@ -173,7 +175,10 @@ def fill_row(entry: dict, others: list, shapes_n: int = 0) -> dict:
     its nodes still without a design walked to (``_walk``) from the nearest nodes with designs, and the whole
     continued once more (``_continued``)."""
     t0, kind, objective = time.perf_counter(), entry["row"], entry["objective"]
-    solver, designs = Solver(atlas=False), list(entry["designs"])
+    # with a patient solve's iteration limit: from a neighbour's design the default's can run out (the coupler
+    # slider's gamma_min at TR 2.25 went from 1.0827 to 1.1752 rad with it)
+    patient = {"ipopt.max_iter": Ipopt.PATIENCE * IPOPT["ipopt.max_iter"]}
+    solver, designs = Solver(atlas=False, ipopt_options=patient), list(entry["designs"])
     problems = [type_problem(kind, tr, 1.0, objective=objective) for tr in NODES]
     empty = [i for i, d in enumerate(designs) if not d]
     better = 0

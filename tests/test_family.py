@@ -170,3 +170,62 @@ def test_reachable_bad_input():
         reachable(m, "sigma")
     with pytest.raises(Exception, match="give bounds for r5"):
         reachable(m, "r5")
+
+
+@pytest.mark.parametrize("tr", [1.1, 1.5, 2.2, 2.848, 2.967, 2.986])
+def test_the_slider_crank_window_is_where_the_stroke_triangle_gives_a_design(tr):
+    """The family's window (bisection) against a dense scan of cranks: every crank of the scan inside it gives a
+    slider-crank, none outside; at high TR the window is a sliver of the bounds (0.47-0.5 strokes at TR 2.85,
+    0.497-0.5 at TR 2.986, where the triangle's last test fails by rounding 1e-12 below half the stroke)."""
+    stroke, lo, hi = 0.834, 0.0417, 4.17
+    a, b = analytic.slider_crank_window(tr, stroke, lo, hi)
+    scan = np.geomspace(lo, hi, 20001)
+    gives = np.array([bool(analytic.slider_crank_design(tr, stroke, float(r2))) for r2 in scan])
+    inside = (scan >= a) & (scan <= b)
+    assert np.array_equal(gives, inside)
+    assert stroke / 2 * (1 - 1e-9) <= b < stroke / 2
+
+
+def _peak_accel(p, omega2=1.0):
+    """The slider's largest |acceleration| by the tests' own simulation: the complex-step velocity's central
+    difference on a dense grid, the largest refined by bounded Brent."""
+    h = 1e-6
+
+    def accel(t):
+        return abs(brute._dx("slider-crank", p, t + h) - brute._dx("slider-crank", p, t - h)) / (2 * h) * omega2**2
+
+    grid = brute.TH[::4]
+    values = [accel(float(t)) for t in grid]
+    k = int(np.argmax(values))
+    step = grid[1] - grid[0]
+    from scipy.optimize import minimize_scalar
+
+    best = minimize_scalar(lambda t: -accel(t), bounds=(grid[k] - step, grid[k] + step), method="bounded")
+    return -best.fun
+
+
+def test_a_slider_crank_near_a_toggle_is_refined_along_its_family():
+    """At TR 2.848, stroke 0.834 m every slider-crank passes within half a degree of a toggle: IPOPT ends without a
+    design from every point of the family, and the bounded 1-D search along it gives the least peak acceleration.
+    Checked against a dense scan of the family (2,001 cranks in its window, each design's exact peak) and by the
+    tests' own simulation (TR, stroke, peak)."""
+    from qropt import Solver
+    from qropt.studies import type_problem
+
+    p = type_problem("slider-crank", 2.848, 0.834, objective="min_peak_accel")
+    r = Solver().solve(p)
+    assert r.status == "optimal", r.message
+    assert "1-D search of the exact objective along the family's r2" in r.certificate.global_claim
+    a, b = analytic.slider_crank_window(2.848, 0.834, *p.free["r2"])
+    scan = []
+    for r2 in np.geomspace(a, b, 2003)[1:-1]:
+        d = analytic.slider_crank_design(2.848, 0.834, float(r2))[0]
+        scan.append(type(r.mechanism)(r2=d.r2, r3=d.r3, e=d.e).peak_acceleration(1.0).value)
+    assert r.objective <= min(scan) * (1 + 1e-9)
+    assert r.objective >= min(scan) * (1 - 1e-3)  # the scan's spacing
+    params = dict(r.mechanism.params)
+    t_max, t_min, x_max, x_min = brute.dead_centres("slider-crank", params)
+    assert brute.time_ratio(t_max, t_min) == pytest.approx(2.848, abs=1e-8)
+    assert x_max - x_min == pytest.approx(0.834, abs=1e-9)
+    assert brute.gamma_min("slider-crank", params) < math.radians(0.5)
+    assert _peak_accel(params) == pytest.approx(r.objective, rel=1e-6)

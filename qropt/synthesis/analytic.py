@@ -9,6 +9,7 @@ Wittchen, "Quick-return mechanism design and analysis projects" (2004).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -280,6 +281,27 @@ def slider_crank_design(time_ratio: float, stroke: float, r2: float) -> list[Sli
     return [SliderCrankDesign(r2, r3, e), SliderCrankDesign(r2, r3, -e)]
 
 
+WINDOW_STEPS = 60  # bisection steps for the end of the slider-crank's family (a 2^-60 part of the bounds' ratio)
+
+
+def slider_crank_window(time_ratio: float, stroke: float, lo: float, hi: float) -> tuple[float, float] | None:
+    """The cranks r2 in [lo, hi] for which the stroke triangle gives a slider-crank: an interval from the crank
+    that just turns fully (|e| = r3 - r2, a toggle) up to stroke/2. It narrows as TR grows (0.47 to 0.5 strokes at
+    TR 2.85), so a scan of the bounds alone can miss it. None where no crank in [lo, hi] gives one."""
+    # just below stroke/2 (where r3 - r2 and e vanish, rounding can break the triangle's last test)
+    tops = [t for k in (12, 9, 6, 3) if lo < (t := min(hi, 0.5 * stroke * (1.0 - 10.0**-k)))]
+    top = next((t for t in tops if slider_crank_design(time_ratio, stroke, t)), None)
+    if top is None:
+        return None
+    if slider_crank_design(time_ratio, stroke, lo):
+        return lo, top
+    a, b = lo, top  # a gives none, b gives one
+    for _ in range(WINDOW_STEPS):
+        m = math.sqrt(a * b)
+        a, b = (a, m) if slider_crank_design(time_ratio, stroke, m) else (m, b)
+    return b, top
+
+
 class CrankRockerDesign(NamedTuple):
     """A crank-rocker four-bar for a TR and swing (either branch sigma: they are mirror images)."""
 
@@ -332,6 +354,17 @@ class WarmStarts(NamedTuple):
     kind: str
     how: str
     ranges: dict = {}  # target -> (low, high) over the free bounds, where the closed form gives it
+    walk: Walk | None = None  # a family's designs as a function of its parameter, where the closed form has one
+
+
+class Walk(NamedTuple):
+    """A closed-form family as a function: ``at(x)`` the free values of its designs at parameter x (a list, in the
+    order the points were emitted at that x: mirror images are several), ``positions`` each point's x, ``name``
+    what x is."""
+
+    at: Callable[[float], list]
+    positions: tuple
+    name: str
 
 
 FAMILY_POINTS = 17  # closed-form family points scanned when a family holds every solution
@@ -364,17 +397,23 @@ class _Context:
         self.tr, self.stroke = self.tg.get("time_ratio"), self.tg.get("stroke")
         self.square = len(self.free) == len(self.tg)
         self.kind = problem.mechanism.CLASS  # the four-bar's Grashof class, if the type has one
-        self.out = []
+        self.out, self.positions = [], []
+        self.position = None  # a family's parameter at the points emitted next (``result``'s walk)
 
     def emit(self, **set_):
         if all(k in self.free for k in set_):
             v = {**self.val, **set_}
             self.out.append({k: v[k] for k in self.free})
+            self.positions.append(self.position)
 
-    def result(self, kind, how):
+    def result(self, kind, how, walk=None, name=""):
+        """The starts; walk: for a family, its designs' free values as a function of the parameter ``name``."""
         if kind == "enumeration":  # complete: no point is a proof that no design exists
             return WarmStarts(self.out, kind, how)
-        return WarmStarts(self.out, kind if self.out else "none", how if self.out else "no closed form applies")
+        if not self.out:
+            return WarmStarts(self.out, "none", "no closed form applies")
+        family = Walk(walk, tuple(self.positions), name) if walk is not None and kind == "family" else None
+        return WarmStarts(self.out, kind, how, walk=family)
 
     def names(self):
         return self.fixed, self.free, self.tg, self.val, self.tr, self.stroke, self.square, self.emit, self.result
@@ -524,14 +563,27 @@ def _slider_crank(c: _Context):
     fixed, free, tg, val, tr, stroke, square, emit, result = c.names()
     if tr is not None and stroke is not None:
         family = "r2" in free and len(free) == 3
-        crank = [val["r2"]] if "r2" not in free else list(np.geomspace(*free["r2"], FAMILY_POINTS if family else 7))
+        window = slider_crank_window(tr, stroke, *free["r2"]) if "r2" in free else None
+        lo, hi = window or free.get("r2", (0.0, 0.0))
+        n = FAMILY_POINTS if family else 7
+        crank = (
+            [val["r2"]]
+            if "r2" not in free
+            else list(np.geomspace(lo, hi, n + 2)[1:-1] if window else np.geomspace(lo, hi, n))
+        )
         for r2 in crank:
+            c.position = float(r2)
             for d in slider_crank_design(tr, stroke, r2):
                 emit(**{k: getattr(d, k) for k in ("r2", "r3", "e") if k in free})
         how = "the stroke triangle (sides r3 + r2, r3 - r2, angle phi of eq. 7) gives r3 and e for each r2"
         if square and set(free) == {"r3", "e"}:
             return result("enumeration", how)
-        return result("family" if family else "partial", how + "; r2 walks the family")
+
+        def walk(r2):  # as emit gives them: the free values, others at mid-bounds
+            designs = ({**val, "r2": d.r2, "r3": d.r3, "e": d.e} for d in slider_crank_design(tr, stroke, r2))
+            return [{k: v[k] for k in free} for v in designs]
+
+        return result("family" if family else "partial", how + "; r2 walks the family", walk, "r2")
     return None
 
 

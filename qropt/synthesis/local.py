@@ -281,11 +281,29 @@ class LocalSolve:
         c.values = {
             k: values0[k] if abs(v - values0[k]) <= 4e-16 * abs(values0[k]) else v for k, v in pt.values.items()
         }
-        w = form.epigraph_start(form.pack(c.values, pt.theta), p)
+        return self._certified(problem, form, c, pt.theta, p, targets, designs)
+
+    def evaluate(self, problem, values, branch, targets, designs=None) -> Candidate:
+        """The certificate of a design as it is, without a backend run (a point a closed form puts on the targets,
+        ``MultiStart.walked``): exact evaluation of its targets, rules, conditions and objective."""
+        designs = designs or Designs()
+        th0, orientation = starts_.dead_centre_start(problem, values, branch, targets, None, None, designs)
+        form = self.formulations.get(problem, branch, orientation)
+        c = Candidate(False, dict(values), branch, orientation, origin="walk")
+        c.statuses, c.ends = ["evaluated as given"], [Status.SOLVED]
+        if form.concrete(problem) is not problem:  # a free counterweight: only the NLP chooses it
+            c.info, c.ends = {"ok": False, "reason": "a free counterweight is chosen by the NLP"}, [Status.FAILED]
+            return c
+        p = form.param_vector(problem, targets, *form.base_samples())
+        return self._certified(problem, form, c, th0, p, targets, designs)
+
+    def _certified(self, problem, form, c, theta, p, targets, designs) -> Candidate:
+        """Candidate c (its values, at dead centres theta) certified by exact evaluation."""
+        w = form.epigraph_start(form.pack(c.values, theta), p)
         g = form.constraint_values(np.concatenate([w, p])[None, :])[0]
         tol = self.tolerances
         m, info, _, _ = certify(
-            problem, form, c.values, branch, pt.theta, None, None, tol["gap"], tol["feasibility"], designs
+            problem, form, c.values, c.branch, theta, None, None, tol["gap"], tol["feasibility"], designs
         )
         c.mechanism, c.info = m, info
         c.residuals = residuals(problem, form.violations(g), m, {k: targets[k] for k in form.targets})

@@ -18,6 +18,8 @@ from qropt.synthesis.local import Candidate, LocalSolve, nlp_value
 
 NEAR = ("atlas", "given")  # starts at optima of nearby problems: run from a small barrier (``Ipopt.near``)
 MIN_WAY = 3  # space-filling starts tried in each way of meeting the TR equality, at least
+WALK_XTOL = 1e-12  # a family walk's search tolerance relative to its parameter (SciPy's bounded Brent stops
+# within sqrt(machine epsilon) of it, relative, at the least: about 1e-16 of a smooth objective's optimum)
 MANY_STARTS = 6  # more closed-form points than this are scored exactly and only the best few refined
 ATLAS_SHORT = 0.02  # where the atlas's starts end this much (relative) worse than their nodes' designs interpolated
 # to the TR, those without a design run again with a larger iteration limit (a jump of 0.05 in TR from an optimum
@@ -72,6 +74,15 @@ class MultiStart:
                 runs += [("shape", v) for v in starts_.shapes(problem, starts_.SHAPES_KEEP, seed)]
             runs += [("multistart", v) for v in starts_.sobol(problem, starts_n, seed, designs)]
         cands += self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
+        if plan.kind == "family" and plan.walk is not None and not extra and problem.objective:
+            failed = [(runs[c.start], c) for c in cands if c.origin == "family" and not c.ok and not c.pruned]
+            walked = [w for run, c in failed if (w := self.walked(problem, plan, run, c, targets, designs))]
+            if any(c.ok for c in walked):
+                claim += (
+                    f"; from {sum(c.ok for c in walked)} point(s) where IPOPT ended without a design, a bounded 1-D "
+                    f"search of the exact objective along the family's {plan.walk.name} instead"
+                )
+            cands += walked
         spread = [r for r in runs if r[0] == "multistart"]
         if not spread or any(c.ok for c in cands):
             return cands, claim, None
@@ -131,6 +142,47 @@ class MultiStart:
                 best += [i for i in near if i not in best]
             out += [("family", plan.analytic[i], br) for i in best]
         return out
+
+    def walked(self, problem, plan, run, failed, targets, designs) -> Candidate | None:
+        """A family point's design by a bounded 1-D search (Brent) of the exact objective along the closed-form
+        family (``plan.walk``) between the scan's points on either side of it, where IPOPT from it (``failed``)
+        ended without a design (near a toggle the NLP is too ill-conditioned to converge: the slider-crank's least
+        peak acceleration at TR 2.85, gamma_min 0.5 deg, failed in every start). Every design of the family meets
+        the targets, so the search's best is the best design between those points; it is certified by exact
+        evaluation like any design. None where the search finds no design."""
+        from scipy.optimize import minimize_scalar  # imported here: only this fallback needs it
+
+        _, values, branch = run
+        walk = plan.walk
+        i = next(k for k, v in enumerate(plan.analytic) if v is values)
+        x = walk.positions[i]
+        variant = [k for k, at in enumerate(walk.positions) if at == x].index(i)  # which design at x (mirrors)
+        xs = sorted(set(walk.positions))
+        j = xs.index(x)
+        lo, hi = xs[max(j - 1, 0)], xs[min(j + 1, len(xs) - 1)]
+        sign = criteria.sense(problem.objective)
+
+        def design(t):
+            vs = walk.at(float(t))
+            v = vs[variant] if variant < len(vs) else None
+            inside = v is not None and all(a <= v[k] <= b for k, (a, b) in problem.free.items())
+            return v if inside else None
+
+        def cost(t):
+            v = design(t)
+            f = score(problem, v, branch, designs)[0] if v is not None else None
+            return np.inf if f is None else -sign * f
+
+        found = minimize_scalar(
+            cost, bounds=(lo, hi), method="bounded", options={"xatol": WALK_XTOL * max(abs(lo), abs(hi))}
+        )
+        v = design(found.x) if np.isfinite(found.fun) else None
+        if v is None:
+            return None
+        c = self.local.evaluate(problem, v, branch, targets, designs)
+        c.origin, c.start = "walk", failed.start
+        c.statuses = [f"bounded 1-D search along the family ({found.nfev} evaluations)"]
+        return c
 
 
 def expected(problem, found, designs) -> tuple[float | None, float | None]:

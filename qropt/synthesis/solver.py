@@ -205,7 +205,7 @@ class Solver:
             "omega2": problem.omega2,
             "formulations": self.formulations,
             "atlas_starts": len(plan.atlas.designs),
-            "ipopt_runs": sum(len(c.statuses) for c in cands if c.origin != "enumeration"),
+            "ipopt_runs": sum(len(c.statuses) for c in cands if c.origin not in ("enumeration", "walk")),
             "iterations_total": sum(c.iterations for c in cands),
             "t_ipopt": sum(c.t_ipopt for c in cands),
         }

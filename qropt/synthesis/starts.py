@@ -30,6 +30,7 @@ class Plan:
     outside: int = 0  # closed-form points of an enumeration left out as outside the bounds
     ranges: dict = field(default_factory=dict)  # target -> (low, high) over the bounds, by the closed form
     atlas: atlas_.Starts = atlas_.Starts()  # where no closed form enumerates or walks every solution
+    walk: analytic.Walk | None = None  # a family's designs as a function of its parameter (``analytic.Walk``)
 
 
 def _build(problem, values, branch):
@@ -56,7 +57,7 @@ def plan(problem, use_analytic: bool = True, use_atlas: bool = False) -> Plan:
         inside = [v for v in w.points if all(lo <= v[k] <= hi for k, (lo, hi) in problem.free.items())]
         return Plan(tuple(inside), w.kind, w.how, len(w.points) - len(inside), dict(w.ranges))
     found = atlas_.starts(problem) if use_atlas and w.kind != "family" else atlas_.Starts()
-    return Plan(tuple(clip(v) for v in w.points), w.kind, w.how, atlas=found)
+    return Plan(tuple(clip(v) for v in w.points), w.kind, w.how, atlas=found, walk=w.walk)
 
 
 POOL = 64  # Sobol points drawn per start wanted: the type's rules (one vectorised check) thin them first
