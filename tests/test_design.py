@@ -482,3 +482,25 @@ def test_the_readme_shows_the_design_table_of_today():
     table = qropt.design(1.5, 0.3).markdown()
     assert table in readme
     assert len(table.splitlines()) == 2 + 8
+
+
+def test_beyond_their_reach_the_shapers_are_infeasible_by_their_closed_forms():
+    """At TR 1.116 every crank shaper has r2/r1 = sin(phi/2) = 0.0860, so a stroke of 1.871 m needs the lever
+    r4 = 10.877 m (the slot-ram shaper the slide line at h = 10.837 m), beyond the row's bound of 5 strokes: the
+    closed form that gives every design proves there is none (in milliseconds: a multi-start and its diagnosis
+    took 0.4 s to say only that no start converged). The tests' own simulation, at the largest lever and offset
+    the bounds allow, gives that TR and a shorter stroke."""
+    tr, stroke = 1.116, 1.871
+    ratio = math.sin(math.pi * (tr - 1) / (tr + 1) / 2)
+    for kind, name, needed in (("crank-shaper", "r4", stroke / (2 * ratio)), ("slot-ram-shaper", "h", None)):
+        p = type_problem(kind, tr, stroke)
+        r = qropt.solve(p)
+        assert r.status == "infeasible", r.message
+        assert f"every design has {name} = " in r.message and "outside its bounds" in r.message
+        top = p.free[name][1]
+        if needed is not None:
+            assert needed > top and f"{needed:.6g}" in r.message
+        built = p.build({"r1": 1.0, "r2": ratio, **({"r4": top} if name == "r4" else {"h": top})}, {})
+        b_tr, b_stroke, _ = brute.task_values(kind, dict(built.params))
+        assert b_tr == pytest.approx(tr, abs=1e-9)
+        assert b_stroke < stroke

@@ -461,11 +461,14 @@ def _crank_shaper(c: _Context):
         lever = {"r4": stroke / (2 * ratio)} if stroke is not None and "r4" in free else {}
         yoke = "r6" not in fixed and "r6" not in free
         if yoke and stroke is not None and set(free) == {"r1", "r2", "r4"}:  # r1 walks the family, r4 fixed
-            for r1 in np.geomspace(
-                max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1], free["r2"][1] / ratio), FAMILY_POINTS
-            ):
+            how = "sin(beta) = r2/r1 fixes the TR; stroke = 2 r4 r2/r1; r1 walks the family"
+            lo, hi = max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1], free["r2"][1] / ratio)
+            missing = _outside(free, lever, lo, hi, "r1")
+            if missing:  # the family holds every design: none lies inside the bounds
+                return result("enumeration", f"{how}: {missing}")
+            for r1 in np.geomspace(lo, hi, FAMILY_POINTS):
                 emit(r1=float(r1), r2=float(ratio * r1), **lever)
-            return result("family", "sin(beta) = r2/r1 fixes the TR; stroke = 2 r4 r2/r1; r1 walks the family")
+            return result("family", how)
         rod = "r6" in free and "h" not in free and stroke is not None and len(free) == 3 and "r4" in free
         if rod and ("r2" in free) != ("r1" in free):  # the rod's slider reverses where the lever does
             for r6 in np.geomspace(*free["r6"], FAMILY_POINTS):
@@ -499,6 +502,20 @@ def slot_ram_shaper_gamma_min(r1: float, r2: float) -> float:
     return math.acos(r2 / r1)
 
 
+def _outside(free, fixed_along, lo, hi, walker) -> str:
+    """Why a family that holds every design has none inside the bounds (a value that every design shares lies
+    outside its bounds, or no ``walker`` in [lo, hi] keeps the other crank link inside its own), or ''."""
+    for k, v in fixed_along.items():  # v, or (v, -v) where the mirror image has -v
+        a, b = free[k]
+        values = v if isinstance(v, tuple) else (v,)
+        if not any(a <= x <= b for x in values):
+            shown = " or ".join(f"{x:.6g}" for x in values)
+            return f"every design has {k} = {shown}, outside its bounds [{a:.6g}, {b:.6g}]"
+    if lo > hi:
+        return f"no {walker} inside its bounds keeps r2 = r1 sin(beta) inside r2's"
+    return ""
+
+
 def _slot_ram_shaper(c: _Context):
     """sin(beta) = r2/r1 fixes the TR; h = stroke sqrt(r1^2 - r2^2) / (2 r2); with r1 and r2 free r1 walks the
     family (the motion depends on r2/r1 and h only: every kinematic criterion is the same along it)."""
@@ -523,6 +540,9 @@ def _slot_ram_shaper(c: _Context):
     how = "sin(beta) = r2/r1 fixes the TR; h = stroke sqrt(r1^2 - r2^2) / (2 r2)"
     if len(crank) == 2:  # the family: r1 over its bounds (and r2's over the ratio)
         lo, hi = max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1], free["r2"][1] / ratio)
+        missing = _outside(free, {"h": (h["h"], -h["h"])}, lo, hi, "r1") if h else ""
+        if missing and len(free) == len(tg) + 1 and "h" in free:  # the family holds every design: none inside
+            return result("enumeration", f"{how}: {missing}")
         if lo <= hi:
             for r1 in np.geomspace(lo, hi, FAMILY_POINTS) if lo < hi else [lo]:
                 emit(r1=float(r1), r2=float(ratio * r1), **h)
