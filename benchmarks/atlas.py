@@ -31,7 +31,6 @@ from qropt import Solver
 from qropt.studies._design import TYPES, type_problem
 from qropt.synthesis import atlas, criteria, starts
 from qropt.synthesis.backends import Ipopt
-from qropt.synthesis.formulation import IPOPT
 from qropt.synthesis.result import SOLUTION_PRESENT
 
 NODES = tuple(round(float(x), 3) for x in np.arange(1.05, 3.55 + 1e-9, 0.1))
@@ -175,10 +174,9 @@ def fill_row(entry: dict, others: list, shapes_n: int = 0) -> dict:
     its nodes still without a design walked to (``_walk``) from the nearest nodes with designs, and the whole
     continued once more (``_continued``)."""
     t0, kind, objective = time.perf_counter(), entry["row"], entry["objective"]
-    # with a patient solve's iteration limit: from a neighbour's design the default's can run out (the coupler
-    # slider's gamma_min at TR 2.25 went from 1.0827 to 1.1752 rad with it)
-    patient = {"ipopt.max_iter": Ipopt.PATIENCE * IPOPT["ipopt.max_iter"]}
-    solver, designs = Solver(atlas=False, ipopt_options=patient), list(entry["designs"])
+    # on the patient backend (its iteration limit): from a neighbour's design the default's can run out (the
+    # coupler slider's gamma_min at TR 2.25 went from 1.0827 to 1.1752 rad with it)
+    solver, designs = Solver(atlas=False, backend=Ipopt().patient()), list(entry["designs"])
     problems = [type_problem(kind, tr, 1.0, objective=objective) for tr in NODES]
     empty = [i for i, d in enumerate(designs) if not d]
     better = 0

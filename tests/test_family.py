@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq
+from scipy.optimize import brentq, minimize_scalar
 
 from qropt import DragLinkSlider, Problem, ProblemError, grashof
 from qropt.examples import paper_mechanism
@@ -198,8 +198,6 @@ def _peak_accel(p, omega2=1.0):
     values = [accel(float(t)) for t in grid]
     k = int(np.argmax(values))
     step = grid[1] - grid[0]
-    from scipy.optimize import minimize_scalar
-
     best = minimize_scalar(lambda t: -accel(t), bounds=(grid[k] - step, grid[k] + step), method="bounded")
     return -best.fun
 

@@ -400,10 +400,18 @@ class _Context:
         self.out, self.positions = [], []
         self.position = None  # a family's parameter at the points emitted next (``result``'s walk)
 
+    def point(self, **set_) -> dict | None:
+        """The free values with ``set_`` given (every other free parameter at mid-bounds); None where ``set_``
+        names a parameter that is not free."""
+        if not all(k in self.free for k in set_):
+            return None
+        v = {**self.val, **set_}
+        return {k: v[k] for k in self.free}
+
     def emit(self, **set_):
-        if all(k in self.free for k in set_):
-            v = {**self.val, **set_}
-            self.out.append({k: v[k] for k in self.free})
+        v = self.point(**set_)
+        if v is not None:
+            self.out.append(v)
             self.positions.append(self.position)
 
     def result(self, kind, how, walk=None, name=""):
@@ -540,13 +548,13 @@ def _slot_ram_shaper(c: _Context):
     how = "sin(beta) = r2/r1 fixes the TR; h = stroke sqrt(r1^2 - r2^2) / (2 r2)"
     if len(crank) == 2:  # the family: r1 over its bounds (and r2's over the ratio)
         lo, hi = max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1], free["r2"][1] / ratio)
+        exact = len(free) == len(tg) + 1 and ("h" in free) == both
         missing = _outside(free, {"h": (h["h"], -h["h"])}, lo, hi, "r1") if h else ""
-        if missing and len(free) == len(tg) + 1 and "h" in free:  # the family holds every design: none inside
+        if missing and exact:  # the family holds every design: none inside the bounds
             return result("enumeration", f"{how}: {missing}")
         if lo <= hi:
             for r1 in np.geomspace(lo, hi, FAMILY_POINTS) if lo < hi else [lo]:
                 emit(r1=float(r1), r2=float(ratio * r1), **h)
-        exact = len(free) == len(tg) + 1 and ("h" in free) == both
         return result("family" if exact else "partial", how + "; r1 walks the family (the least size at its least)")
     emit(**({"r2": ratio * val["r1"]} if "r2" in free else {"r1": val["r2"] / ratio}), **h)
     exact = square and ("h" in free) == both
@@ -591,17 +599,22 @@ def _slider_crank(c: _Context):
             if "r2" not in free
             else list(np.geomspace(lo, hi, n + 2)[1:-1] if window else np.geomspace(lo, hi, n))
         )
+
+        def designs(r2):  # the free values of the triangle's designs with crank r2
+            return [
+                {k: getattr(d, k) for k in ("r2", "r3", "e") if k in free} for d in slider_crank_design(tr, stroke, r2)
+            ]
+
         for r2 in crank:
             c.position = float(r2)
-            for d in slider_crank_design(tr, stroke, r2):
-                emit(**{k: getattr(d, k) for k in ("r2", "r3", "e") if k in free})
+            for v in designs(r2):
+                emit(**v)
         how = "the stroke triangle (sides r3 + r2, r3 - r2, angle phi of eq. 7) gives r3 and e for each r2"
         if square and set(free) == {"r3", "e"}:
             return result("enumeration", how)
 
-        def walk(r2):  # as emit gives them: the free values, others at mid-bounds
-            designs = ({**val, "r2": d.r2, "r3": d.r3, "e": d.e} for d in slider_crank_design(tr, stroke, r2))
-            return [{k: v[k] for k in free} for v in designs]
+        def walk(r2):  # the designs as emit gives them
+            return [c.point(**v) for v in designs(r2)]
 
         return result("family" if family else "partial", how + "; r2 walks the family", walk, "r2")
     return None
