@@ -639,3 +639,42 @@ def test_cycle_routes_refuse_a_load_at_zero_speed():
             f"{ex.peak_torque.value:g} N m: the cutting force silently dropped) where m.dynamics raises "
             "InvalidParameter; qropt/dynamics/cycle.py CycleDynamics.__init__ lacks inverse_dynamics' omega2 == 0 check"
         )
+
+
+# ---- friction on the slide -----------------------------------------------------------------------------------------
+@pytest.mark.parametrize("kind", SLIDER_KINDS)
+def test_the_slides_friction_is_coulombs_law_at_every_angle(kind):
+    """Route: the friction law itself. With mu = 0.3 the force the guide puts on the ram along the slide is
+    -mu |N| sign(v) at every crank angle (v the ram's velocity from differences of its exact positions), and the
+    bodies are in equilibrium with it (``test_newton_euler_body_by_body`` checks that with friction)."""
+    mu = 0.3
+    for i, m in enumerate(_designs(kind, 2, seed=9)):
+        masses, loads, omega2, alpha2 = _case(kind, i, m)
+        loads = Loads(cutting_force=loads.cutting_force, gravity=G0, friction=mu)
+        d = m.dynamics(THETA, omega2, alpha2, masses=masses, loads=loads)
+        kin = _kinematics(m, m.body_masses(masses), THETA, omega2, alpha2)
+        v = kin[_output_body(m).name]["v"][:, 0]
+        friction, normal = d.joint_forces["slide"].T
+        assert np.abs(normal).max() > 1.0  # the law is not met trivially
+        assert friction == pytest.approx(-mu * np.abs(normal) * np.sign(v), rel=1e-12, abs=1e-9)
+
+
+def test_a_slide_that_friction_locks_is_an_error_naming_the_angle():
+    """Route: statics of the massless slider-crank. Its rod holds the ram: a force F along the slide needs the
+    guide's N = F tan(phi), phi the rod's angle to the slide, so friction mu locks the slide where mu tan(phi) >= 1.
+    A mu 1 % above 1 / max tan(phi) (from the exact positions on a 200,001-angle grid) raises DegenerateMechanism
+    naming friction and an angle where tan(phi) is within 2 % of its largest; 1 % below does not."""
+    m = qropt.SliderCrank(r2=0.1, r3=0.16, e=0.05)
+    t = np.linspace(0.0, TWO_PI, 200_001)
+    p = m.positions(t).points
+    rod = p["C"] - p["A"]
+    tan = np.abs(rod[:, 1] / rod[:, 0])
+    limit = 1.0 / tan.max()
+    loads = Loads(cutting_force=500.0, friction=1.01 * limit)
+    with pytest.raises(qropt.DegenerateMechanism, match="friction") as e:
+        m.dynamics(t[::100], 10.0, loads=loads)
+    deg = float(str(e.value).split("crank angle ")[1].split(" deg")[0])
+    k = np.argmin(np.abs(t - np.radians(deg)))
+    assert tan[k] >= 0.98 * tan.max()
+    d = m.dynamics(t[::100], 10.0, loads=Loads(cutting_force=500.0, friction=0.99 * limit))
+    assert np.isfinite(d.torque).all()

@@ -95,6 +95,25 @@ def test_design_by_min_peak_torque_on_the_command_line(capsys):
     assert "needs masses or loads" in capsys.readouterr().err
 
 
+def test_design_with_friction_on_the_command_line(capsys):
+    """--friction reaches the solve: the row's peak torque is the library's exact value with the slide's friction,
+    and differs from the frictionless row's."""
+    argv = ["design", "--tr", "1.5", "--stroke", "0.3", "--types", "slider-crank", "--objective", "min_peak_torque"]
+    dyn = ["--density", "1.57", "--ram-mass", "20", "--force", "1000", "--gravity", "9.81", "--omega2", "10", "--json"]
+    assert cli.main([*argv, *dyn, "--friction", "0.2"]) == 0
+    row = json.loads(capsys.readouterr().out)["rows"][0]
+    assert cli.main([*argv, *dyn]) == 0
+    plain = json.loads(capsys.readouterr().out)["rows"][0]
+    m = qropt.SliderCrank(**row["params"])
+    masses, loads = qropt.Masses.bars(1.57, 20.0), qropt.Loads(1000.0, friction=0.2, gravity=9.81)
+    exact = m.dynamic_extremes(10.0, masses=masses, loads=loads).peak_torque.value
+    assert row["peak_torque"] == pytest.approx(exact, rel=1e-9)
+    assert row["peak_torque"] > plain["peak_torque"] * 1.05
+    assert cli.main([*argv, *dyn, "--friction", "-1"]) != 0
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "friction" in err
+
+
 def test_a_counterweight_on_the_command_line_is_the_librarys(capsys):
     assert cli.main([*ARGS, "--counterweight", "5", "0.1", "180deg", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)

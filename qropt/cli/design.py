@@ -41,6 +41,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--density", type=real, help="links as uniform bars of this many kg per metre (dynamics)")
     parser.add_argument("--ram-mass", dest="ram_mass", type=real, help="the ram's mass, kg (dynamics)")
     parser.add_argument("--force", type=real, help="cutting force on the working stroke, N (dynamics)")
+    parser.add_argument("--friction", type=real, help="the slide's friction coefficient (dynamics)")
     parser.add_argument("--gravity", type=real, help="gravity along -y, m/s^2 (dynamics)")
     parser.add_argument(
         "--balance",
@@ -85,8 +86,8 @@ def dynamics_of(args) -> tuple:
     if args.density is not None or args.ram_mass is not None or balance:
         cw = Counterweight.balancing(*balance) if balance else None
         masses = Masses.bars(args.density or 0.0, args.ram_mass or 0.0, counterweight=cw)
-    if args.force is not None or args.gravity is not None:
-        loads = Loads(args.force or 0.0, gravity=args.gravity or 0.0)
+    if args.force is not None or args.gravity is not None or args.friction is not None:
+        loads = Loads(args.force or 0.0, friction=args.friction or 0.0, gravity=args.gravity or 0.0)
     return masses, loads
 
 

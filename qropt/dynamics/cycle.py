@@ -83,7 +83,7 @@ class CycleDynamics:
         self.pieces = [(d.theta_max, d.theta_max + a), (d.theta_max + a, d.theta_max + TWO_PI)]
         first = _first_is_working(m, self.omega2 or 1.0)
         self.working_pieces = (first, not first)
-        self.switching = self.loads.switching and m.working_direction(self.omega2 or 1.0) is not None
+        self.switching = self.loads.jumps and m.working_direction(self.omega2 or 1.0) is not None
 
     def at(self, theta2, working=None):
         """The dynamics at crank angles theta2 (rad); ``working`` forces the cutting force on or off."""

@@ -8,7 +8,8 @@ force vector at every pin, a force along the contact normal at every slot (a blo
 the guide's normal force under the ram (and the moment a yoke-ram's guide carries), and the couple between a
 massive crank-pin block and its slot. A massless block (the default) passes its force straight from the crank to
 the lever along the slot's normal. Friction on the slide (mu |N| against the ram's velocity) makes the system
-depend on N: it is solved by fixed-point iteration. SI units throughout.
+depend on N; as the system is linear in a load on the ram, N has a closed form (``friction_load``), the same in
+the exact analysis and in the NLP. SI units throughout.
 """
 
 from __future__ import annotations
@@ -26,8 +27,6 @@ from qropt.dynamics.rigid import body_motion
 from qropt.errors import DegenerateMechanism, InvalidParameter
 from qropt.kinematics.ops import JET, Jet
 
-FRICTION_ITERATIONS = 200  # fixed-point steps at most for the slide's friction
-FRICTION_TOL = 1e-13  # relative change of the guide force that ends them
 LENGTH_GRID = 720  # crank angles where a lever's reach is sampled before its exact maximum is refined
 
 
@@ -385,6 +384,7 @@ def _solve(m, s: _System, t, omega2, alpha2, loads, working=None) -> Dynamics:
     """``working``: the cutting force's state at every angle (True on, False off; None: by the stroke)."""
     k = units_.to_metres(m.units)
     n = t.size
+    forced = working is not None
     working = _working(m, t, omega2) if working is None else np.full(t.shape, bool(working))
     way = m.working_direction(omega2 or 1.0)  # the load resists the working stroke's motion, its ends included
     way = 0.0 if way is None else (1.0 if way == "+x" else -1.0)
@@ -406,16 +406,9 @@ def _solve(m, s: _System, t, omega2, alpha2, loads, working=None) -> Dynamics:
         x = a.solve(load)
         friction = np.zeros(n)
         if sliding:
-            v_sign = -np.sign(a.v_out)
-            for _ in range(FRICTION_ITERATIONS):
-                new = loads.friction * np.abs(x[guide_col]) * v_sign
-                x_new = a.solve(-new if load is None else load - new)
-                done = np.max(np.abs(x_new[guide_col] - x[guide_col])) <= FRICTION_TOL * max(
-                    1.0, float(np.max(np.abs(x_new[guide_col])))
-                )
-                x, friction = x_new, new
-                if done:
-                    break
+            x, friction = _with_friction(
+                m, t, a, x, load, guide_col, loads.friction, _velocity_sign(a, working, way, forced)
+            )
     except np.linalg.LinAlgError:
         raise DegenerateMechanism(
             f"{m!r}: the force analysis is singular at some crank angle (a transmission angle of zero: no force "
@@ -435,6 +428,39 @@ def _solve(m, s: _System, t, omega2, alpha2, loads, working=None) -> Dynamics:
     gm = x[s.guide_moment_col] if s.yoke is not None else None
     sm = np.broadcast_to(sm, t.shape).astype(float)
     return Dynamics(t, omega2, alpha2, x[0], forces, _pairs(sfx, sfy, n), sm, gm)
+
+
+def friction_load(xp, n0, n1, mu, sigma):
+    """The friction on the slide as a load on the ram's row (N along x): e = -(mu |N| against the velocity), with
+    the guide's normal force N = N0 + N1 e (N0 without friction, N1 its change per newton on that row), so
+    |N| = |N0| / (1 - mu sigma N1 sign(N0)), sigma the sign of the ram's velocity. The one solution while
+    mu |N1| < 1 (beyond it the slide locks). xp: numpy, or casadi for the NLP's expressions."""
+    return mu * sigma * xp.fabs(n0) / (1 - mu * sigma * n1 * xp.sign(n0))
+
+
+def _velocity_sign(a: _Parts, working, way: float, forced: bool) -> np.ndarray:
+    """The sign of the ram's velocity: its stroke's direction where the stroke is given (a peak's search over a
+    stroke closed at its dead centres, where the velocity vanishes), else the velocity's own sign."""
+    if forced and way:
+        return np.where(working, way, -way)
+    return np.sign(np.broadcast_to(a.v_out, working.shape))
+
+
+def _with_friction(m, t, a: _Parts, x, load, col: int, mu: float, sigma) -> tuple:
+    """The unknowns with the slide's friction (``friction_load``) and the friction force along x (N); raises
+    DegenerateMechanism where the slide locks (mu |dN/dF| >= 1: the guide's force grows with its own friction)."""
+    base = 0.0 if load is None else load
+    unit = a.solve(base + np.ones_like(sigma, dtype=float))
+    n1 = unit[col] - x[col]
+    locked = (mu * np.abs(n1) >= 1.0) & (sigma != 0)
+    if locked.any():
+        i = int(np.flatnonzero(locked)[0])
+        raise DegenerateMechanism(
+            f"{m!r}: friction mu = {mu:g} locks the slide at crank angle {math.degrees(t[i]) % 360:.6g} deg "
+            f"(the guide's force grows with its own friction: mu |dN/dF| = {mu * abs(n1[i]):.4g} >= 1)"
+        )
+    e = friction_load(np, x[col], n1, mu, sigma)
+    return [p + (q - p) * e for p, q in zip(x, unit, strict=True)], -e
 
 
 def shaking(kin) -> tuple:

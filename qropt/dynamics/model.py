@@ -234,6 +234,12 @@ class Loads:
         f = self.cutting_force
         return bool(self.follower_torque or (any(r[1] > 0 for r in f) if isinstance(f, tuple) else f))
 
+    @property
+    def jumps(self) -> bool:
+        """Whether the joint forces jump at the dead centres: a cutting force switching on or off there, or the
+        slide's friction turning with the ram's velocity."""
+        return self.switching or bool(self.friction)
+
     def force_at(self, x) -> np.ndarray:
         """The cutting force's magnitude (N) at ram positions x (the mechanism's unit)."""
         f = self.cutting_force

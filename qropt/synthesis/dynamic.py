@@ -3,7 +3,8 @@ speed) with its masses and loads (``Problem.masses``, ``Problem.loads``), SI.
 
 Exact values come from ``qropt.dynamics`` (Newton-Euler over the turn). In the NLP the torque at a crank angle is
 the power balance ``T = omega2^2 sum(m v_G . a_G + I phi' phi'') + g sum(m v_Gy) + F max(0, w x' omega2) / omega2``
-(derivatives in theta2; w the working direction), written from the joints' coordinates and their first and second
+(derivatives in theta2; w the working direction), plus the slide's friction's power ``e x'`` (its load e on the ram
+from the Newton-Euler system, ``friction_load``), written from the joints' coordinates and their first and second
 derivatives, with the mass model following the design: each bar as long as its joints reach (a lever's sliding
 crank pin at most |pivot - O2| + r2 from the pivot, a sliding output at most as far as at a dead centre). The RMS
 torque is a Gauss-Legendre quadrature over each stroke on nodes that move with the dead centres, the same rule as
@@ -28,6 +29,7 @@ TWO_PI = 2 * math.pi
 LIFTS = (2, 4)  # extremes the NLP lifts for the peak torque and the peak shaking force: the design's degrees of
 # freedom + 1 (a minimax optimum equalises that many peaks), at least two (one of two equal peaks is often sharp)
 CW_X, CW_Y = "counterweight moment x", "counterweight moment y"  # a free counterweight's variables (kg m)
+NO_LOCK = 0.99  # the NLP keeps mu |dN/dF| at most this at its samples: the slide's friction's closed form's domain
 EXCHANGE_PEAKS = 4  # local maxima the exchange loop looks at: each above the NLP's bound becomes a sample angle
 
 
@@ -43,8 +45,6 @@ def _problem_check(c, problem) -> str | None:
     loads = problem.loads
     if problem.masses is None and loads is None:
         return f"{c.objective} needs masses or loads (Problem(..., masses=qropt.Masses..., loads=qropt.Loads(...)))"
-    if loads is not None and loads.friction:
-        return f"{c.name}: friction on the slide is in the exact analysis, not in the NLP; give friction=0"
     return None
 
 
@@ -203,13 +203,42 @@ class _Symbolic:
             )
         return self._system
 
-    def bearing_loads(self, out, working=None):
-        """joint -> |force|^2 (N^2) at one crank angle at constant omega2: every pin and every block or pin in a
-        slot (what its pin carries), from the Newton-Euler system solved symbolically; the cutting force on
-        (``working`` True), off (False) or by the ram's velocity (None)."""
+    def forces(self, out, working=None, lengths=None) -> tuple:
+        """(x, e): the Newton-Euler unknowns at one crank angle at constant omega2 as expressions (the torque,
+        every pin's force, a slot's and the guide's normal force), the system assembled by the same code as the
+        exact analysis and solved by the structure's sparse elimination, and the slide's friction as a load on the
+        ram's row (``friction_load``; 0 without friction). The cutting force on (``working`` True), off (False)
+        or by the ram's velocity (None); the friction against the ram's velocity, or its stroke's direction where
+        ``working`` is given; ``lengths`` as ``mass_model``."""
+        from qropt.dynamics.inverse import Elimination, friction_load
+
+        self.no_lock()
+        f, s = self.f, self.system()
+        entries, rhs = self._assembled(out, lengths)
+        ram = s.output
+        force = self.cutting_force(out)
+        way = working_sign(f.orientation > 0, f.omega2)
+        if ram is not None and not (isinstance(force, (int, float)) and not force):  # against the working stroke
+            r = s.rows[ram.name]
+            on = -force * way
+            load = casadi.if_else(way * out.v * f.omega2 > 0, on, 0.0) if working is None else on * working
+            rhs[r] = rhs.get(r, 0.0) - load
+        elim = Elimination(entries, s.n, None)
+        x = elim.solve(rhs)
+        col = self.guide()
+        if col is None:
+            return x, 0
+        unit = elim.solve({s.load_row(): 1.0})  # the unknowns' change per newton on the ram's row
+        sigma = casadi.sign(out.v * f.omega2) if working is None else (way if working else -way)
+        e = friction_load(casadi, x[col], unit[col], f.loads.friction, sigma)
+        return [p + q * e for p, q in zip(x, unit, strict=True)], e
+
+    def _assembled(self, out, lengths=None) -> tuple:
+        """The Newton-Euler system at one crank angle at constant omega2: (entries, right-hand sides) with the
+        mass model (``lengths`` as ``mass_model``) and gravity, no cutting force."""
         f, s = self.f, self.system()
         w2 = f.omega2**2
-        models = self.mass_model(out)
+        models = self.mass_model(out, lengths)
         kin = {}
         for b in s.bodies:
             mass, com, inertia = models.get(b.name, (0.0, (0.0, 0.0), 0.0))
@@ -218,18 +247,35 @@ class _Symbolic:
         P = {j: self.point(out, j) for j in f.joint_index}
         g = f.loads.gravity if f.loads is not None else 0.0
         entries, rows = s.assemble(P, kin, g, casadi.sqrt)
-        rhs = dict(rows)
-        ram = s.output
-        force = self.cutting_force(out)
-        if ram is not None and not (isinstance(force, (int, float)) and not force):  # against the working stroke
-            way = working_sign(f.orientation > 0, f.omega2)
-            r = s.rows[ram.name]
-            on = -force * way
-            load = casadi.if_else(way * out.v * f.omega2 > 0, on, 0.0) if working is None else on * working
-            rhs[r] = rhs.get(r, 0.0) - load
+        return entries, dict(rows)
+
+    def no_lock(self):
+        """Rows that keep the slide from locking at every sample (mu |dN/dF| <= NO_LOCK, where ``friction_load``
+        holds), once per formulation, from the first expression that needs them; none without friction."""
         from qropt.dynamics.inverse import Elimination
 
-        x = Elimination(entries, s.n, None).solve(rhs)  # the structure's sparse elimination: small expressions
+        col = self.guide()
+        if col is None or getattr(self, "_no_lock", False):
+            return
+        self._no_lock = True
+        s, mu = self.system(), self.f.loads.friction
+        for k, out in enumerate(self.f.sampled):
+            entries, _ = self._assembled(out)
+            n1 = Elimination(entries, s.n, None).solve({s.load_row(): 1.0})[col]
+            self.f.row(f"the slide does not lock at sample {k}", (mu * n1) ** 2, -casadi.inf, NO_LOCK**2)
+
+    def guide(self) -> int | None:
+        """The guide's normal force's column where the slide has friction, else None."""
+        f = self.f
+        if f.loads is None or not f.loads.friction:
+            return None
+        return next((col for c, col, _ in self.system().cols if c.kind == "guide"), None)
+
+    def bearing_loads(self, out, working=None):
+        """joint -> |force|^2 (N^2) at one crank angle at constant omega2: every pin and every block or pin in a
+        slot (what its pin carries), from ``forces``."""
+        s = self.system()
+        x, _ = self.forces(out, working)
         loads = {}
         for c, col, _ in s.cols:
             if c.kind == "pin" and not (s.block_massive and s.kind(c.receiver) == "block"):
@@ -239,7 +285,9 @@ class _Symbolic:
         return loads
 
     def torque(self, out, lengths=None):
-        """The crank torque (N m) at constant omega2 at one crank angle (``lengths`` as ``mass_model``)."""
+        """The crank torque (N m) at constant omega2 at one crank angle (``lengths`` as ``mass_model``): the power
+        balance, with the slide's friction's power ``e v`` (``friction_load``'s e on the ram's row) where it
+        has friction."""
         f = self.f
         w2 = f.omega2**2
         g = f.loads.gravity if f.loads is not None else 0.0
@@ -248,7 +296,14 @@ class _Symbolic:
             b = next(x for x in self.bodies if x.name == name)
             v, a, w, al = self.kinematics(out, b, com)
             T += w2 * (m * (v[0] * a[0] + v[1] * a[1]) + inertia * w * al) + g * m * v[1]
-        return T + self.load(out)
+        return T + self.load(out) + self.friction_torque(out, lengths)
+
+    def friction_torque(self, out, lengths=None):
+        """The torque (N m) the slide's friction takes: its power mu |N| |v| over omega2, which is e x' with e
+        the friction as a load on the ram's row (``friction_load``) and x' = dx/dtheta2 (m/rad)."""
+        if self.guide() is None:
+            return 0
+        return self.forces(out, None, lengths)[1] * out.v * self.k
 
     def load(self, out):
         f, loads = self.f, self.f.loads
@@ -276,6 +331,7 @@ class _Symbolic:
 
     def shaking_squared(self, out):
         """|sum(m a_G)|^2 at constant omega2 (N^2)."""
+        self.no_lock()  # the exact value, like every dynamic one, needs a slide that does not lock
         w2 = self.f.omega2**2
         sx = sy = 0
         for name, (m, com, _) in self.mass_model(out).items():
@@ -470,7 +526,7 @@ class PeakBearingForce(_Squared):
     def epigraph(self, f):
         s = _symbolic(f)
         if (
-            f.loads is not None and f.loads.switching
+            f.loads is not None and f.loads.jumps
         ):  # the loads jump at the dead centres: each stroke's samples with its own load
             outs = [(o, True) for o in f.working()] + [(o, False) for o in f.returning()]
         else:
@@ -494,7 +550,7 @@ class PeakBearingForce(_Squared):
     def _placed(problem, m, theta):
         """Where a sample goes for crank angle theta: the angle itself, or (the loads switching) its fraction of
         its stroke, which the working and the return samples share."""
-        if problem.loads is None or not problem.loads.switching:
+        if problem.loads is None or not problem.loads.jumps:
             return [theta], []
         lo, length = m.working_arc()
         d = (theta - lo) % TWO_PI
