@@ -39,19 +39,33 @@ def makespan(tiles: list, workers: int, per_tile: float) -> float:
     return max(free)
 
 
+class _FromDesign:
+    """A solver whose warm solves start IPOPT from the neighbour's design only (no ``continue_from``: the
+    continuation before Newton on the neighbour's active set), the baseline of the same run."""
+
+    def __init__(self, solver):
+        self.solver = solver
+
+    def solve(self, problem, diagnose=True, **options):
+        options.pop("continue_from", None)
+        return self.solver.solve(problem, diagnose=diagnose, **options)
+
+
 def _tiles(args):
     """A plain process solving every ``step``-th tile from the ``k``-th: the in-process chart (step 1, away from
-    the clusters' schedulers in the main process) or half of it (step 2: the ceiling for 2 workers, no Dask)."""
-    specs, k, step = args
+    the clusters' schedulers in the main process) or half of it (step 2: the ceiling for 2 workers, no Dask);
+    ``newton`` False: the baseline without continuation by Newton (``_FromDesign``)."""
+    specs, k, step, *newton = args
     from qropt import solve
     from qropt.studies._continuation import solve_tile
     from qropt.synthesis.solver import DEFAULT
 
+    solver = DEFAULT if not newton or newton[0] else _FromDesign(DEFAULT)
     solve(Problem.from_dict(specs[0]["problem"]))
     seconds = []
     for s in specs[k::step]:
         t = time.perf_counter()
-        solve_tile(s, DEFAULT)
+        solve_tile(s, solver)
         seconds.append(time.perf_counter() - t)
     return seconds
 
@@ -70,7 +84,7 @@ def main() -> None:
     local = chart(p, x, y, workers=2)
     t_local = time.perf_counter() - t
     print(f"scheduler='local', 2 workers (cluster start and the workers' NLP builds included): {t_local:.2f} s")
-    heres, warms, ones, plains = [], [], [], []
+    heres, befores, warms, ones, plains = [], [], [], [], []
     specs = [
         {
             "problem": p.to_dict(),
@@ -94,6 +108,7 @@ def main() -> None:
         for _ in range(REPEAT):  # interleaved: a shared machine's speed drifts
             tiles = pool.submit(_tiles, (specs, 0, 1)).result()  # the last run's tile times feed the estimates
             heres.append(sum(tiles))
+            befores.append(sum(pool.submit(_tiles, (specs, 0, 1, False)).result()))
             t = time.perf_counter()
             warm = chart(p, x, y, scheduler=lc2.scheduler_address, progress=False)
             warms.append(time.perf_counter() - t)
@@ -101,8 +116,12 @@ def main() -> None:
             chart(p, x, y, scheduler=lc1.scheduler_address, progress=False)
             ones.append(time.perf_counter() - t)
             plains.append(max(sum(half) for half in pool.map(_tiles, [(specs, 0, 2), (specs, 1, 2)])))
-    t_here, t_warm, t_one, t_plain = (statistics.median(v) for v in (heres, warms, ones, plains))
+    t_here, t_before, t_warm, t_one, t_plain = (statistics.median(v) for v in (heres, befores, warms, ones, plains))
     print(f"in-process: {cells} cells in {t_here:.2f} s ({cells / t_here:.1f} cells/s); {here!r}")
+    print(
+        f"in-process, each continued cell by IPOPT from its neighbour's design (no Newton on the neighbour's active "
+        f"set): {t_before:.2f} s ({cells / t_before:.1f} cells/s); Newton's gain {t_before / t_here:.2f}x"
+    )
     same = all(
         [getattr(a, k) for k in SAME] == [getattr(b, k) for k in SAME]
         for ch in (local, cold, warm)
@@ -151,6 +170,8 @@ def main() -> None:
         "load_before": load0,
         "load_after": load1,
         "in_process_s": t_here,
+        "in_process_without_newton_s": t_before,
+        "runs_in_process_without_newton_s": befores,
         "local_with_start_s": t_local,
         "cluster_cold_s": t_cold,
         "cluster_warm_s": t_warm,
@@ -185,6 +206,7 @@ def markdown(d: dict, env: dict) -> str:
     v = env["versions"]
     rows = [
         ("in-process", d["in_process_s"], "1 process"),
+        ("in-process, without Newton", d["in_process_without_newton_s"], "each continued cell by IPOPT"),
         ("2-worker LocalCluster, workers building their NLPs", d["cluster_cold_s"], "first chart on the cluster"),
         ("2-worker LocalCluster, warm", d["cluster_warm_s"], "second chart on the same cluster"),
         ("1-worker LocalCluster, warm", d["cluster_one_worker_s"], "the same, one worker"),

@@ -37,7 +37,9 @@ class _Tile:
         self.axes = [Axis(n, tuple(v), axis_kind(self.problem, n)) for n, v in (spec["x"], spec["y"] or ("", ())) if n]
         self.i0, self.i1, self.j0, self.j1 = spec["block"]
         self.check, self.solver, self.progress = spec["check"], solver, progress
-        self.quiet = {"diagnose": False} if "diagnose" in inspect.signature(solver.solve).parameters else {}
+        given = inspect.signature(solver.solve).parameters
+        self.quiet = {"diagnose": False} if "diagnose" in given else {}
+        self.continues = "continue_from" in given
         self.cells: dict[tuple, Cell] = {}
 
     def run(self) -> list[Cell]:
@@ -57,9 +59,11 @@ class _Tile:
         return problem_at(self.problem, self.axes, values)
 
     def warm(self, problem, src: Cell) -> Result:
-        """One local solve from a certified neighbour's design (a failure is not explained: the full solve follows)."""
+        """One local solve from a certified neighbour's design, continued from its optimum where the solver can
+        (a failure is not explained: the full solve follows)."""
         start = {k: src.params[k] for k in self.problem.free}
-        return self.solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=[start], **self.quiet)
+        kw = {**self.quiet, "continue_from": src.result} if self.continues else self.quiet
+        return self.solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=[start], **kw)
 
     def neighbours(self, ij):
         i, j = ij

@@ -35,7 +35,8 @@ CONVERGED = (Status.SOLVED, Status.ACCEPTABLE)
 @dataclass(frozen=True)
 class Run:
     """One local run: the point w, objective f and constraint values g; its Status, the backend's own word for
-    it (``message``), iterations and wall time (s)."""
+    it (``message``), iterations and wall time (s); the multipliers of the rows and of the bounds where the backend
+    gives them (IPOPT's signs: positive at an upper bound), for a continuation to start from."""
 
     w: np.ndarray
     f: float
@@ -44,6 +45,8 @@ class Run:
     message: str
     iterations: int
     seconds: float
+    lam_g: np.ndarray | None = None
+    lam_x: np.ndarray | None = None
 
     @property
     def converged(self) -> bool:
@@ -152,6 +155,8 @@ class Ipopt:
             word,
             int(st.get("iter_count", 0)),
             float(st.get("t_wall_total", 0.0)),
+            np.array(r["lam_g"]).ravel(),
+            np.array(r["lam_x"]).ravel(),
         )
 
     def _stationary(self, form, r, p, lbx, ubx) -> bool:

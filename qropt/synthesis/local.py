@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qropt.errors import QroptError
-from qropt.synthesis import criteria
+from qropt.synthesis import criteria, newton
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import CONVERGED, Status
 from qropt.synthesis.certificate import Designs, certify, residuals, target_values
@@ -45,6 +45,7 @@ class Candidate:
     q: dict | None = None
     pruned: bool = False
     problem: object = None  # the problem as the design fixes it (a free counterweight chosen); None: the solve's
+    hint: object = None  # a certified optimum's NLP point and multipliers, for a continuation (``newton.Hint``)
 
     @property
     def converged(self) -> bool:
@@ -103,7 +104,9 @@ class Formulations:
 
 
 class LocalSolve:
-    """One start to one candidate, on a backend, with the exchange loop. tolerances: {'feasibility', 'gap'}."""
+    """One start to one candidate, on a backend, with the exchange loop. tolerances: {'feasibility', 'gap'}. A
+    start given with a nearby problem's optimum at its design (a chart's neighbour) is first continued by Newton on
+    that optimum's active set (``newton``), the backend running only where that is not verified."""
 
     def __init__(self, formulations: Formulations, backend, tolerances: dict, max_rounds: int):
         self.formulations, self.backend = formulations, backend
@@ -124,6 +127,7 @@ class LocalSolve:
         bound=None,
         patient=False,
         near=False,
+        hint=None,
     ) -> Candidate:
         """From values0 on branch; orientation: which way the TR equality is met (+1, -1), None for the start's
         own; designs: the solve's memo of built mechanisms; bound: the incumbent's NLP objective value, above
@@ -159,27 +163,36 @@ class LocalSolve:
             )
             if pre.converged and not pre.residuals_over(self.tolerances["feasibility"]):
                 values0, orientation = pre.values, pre.orientation
-        th0, orientation = starts_.dead_centre_start(
-            problem, values0, branch, targets, orientation, range_target, designs
-        )
-        form = self.formulations.get(problem, branch, orientation, range_target, sense)
-        samples, fractions = form.base_samples()
-        used = used_f = form.n_base
-        phi, box = form.lifted_start(form.concrete(problem), values0, designs)
+        continued = self._continued(problem, values0, branch, targets, orientation, range_target, sense, hint)
+        if continued is None:
+            th0, orientation = starts_.dead_centre_start(
+                problem, values0, branch, targets, orientation, range_target, designs
+            )
+            form = self.formulations.get(problem, branch, orientation, range_target, sense)
+            samples, fractions = form.base_samples()
+            used = used_f = form.n_base
+            phi, box = form.lifted_start(form.concrete(problem), values0, designs)
+            p = form.param_vector(problem, targets, samples, fractions, box=box)
+            w = form.epigraph_start(form.pack(values0, th0, phi=phi, box=box), p)
+        else:  # the start's optimum continued here: its samples, its point (a box is set from the design later)
+            form, p, _ = continued
+            samples, fractions = hint.blocks["samples"].copy(), hint.blocks["fractions"].copy()
+            (used, used_f), box = hint.used, None
         mono, mono_next = np.full(2 * MONOTONE, 0.5), [0, 0]
-        p = form.param_vector(problem, targets, samples, fractions, box=box)
-        w = form.epigraph_start(form.pack(values0, th0, phi=phi, box=box), p)
         lbx, ubx = form.bounds(problem)
         c = Candidate(False, dict(values0), branch, orientation)
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
         g, info, m, restarts, polished, polish = None, {}, None, 0, False, None
+        first = continued[2] if continued is not None else None
         while c.rounds < max_rounds:
             c.rounds += 1
             warm = c.rounds > 1  # a re-solve: from the small barrier, unless a start not near an optimum ended at a
             # design that turned back in a stroke (its optimum is not near)
             small = warm and (near or not info.get("guard"))
-            run = (warm_backend if small else backend).run(form, w, p, lbx, ubx, warm=warm)
-            ran = form
+            run, first = first, None
+            if run is None:
+                run = (warm_backend if small else backend).run(form, w, p, lbx, ubx, warm=warm)
+            ran, last = form, run
             w, g = run.w, run.g
             c.t_ipopt += run.seconds
             c.iterations += run.iterations
@@ -194,6 +207,7 @@ class LocalSolve:
             if polish is not None:  # the warm run after an acceptable end: kept if it converges and certifies
                 if not run.converged or not info.get("ok"):
                     w, g, c.values, c.problem, m, info, c.ends[-1], c.statuses[-1] = polish
+                    last = None
                     break
                 polish = None
             close = range_target or max(form.violations(g).values(), default=0.0) <= RESTART_VIOLATION
@@ -231,7 +245,23 @@ class LocalSolve:
         c.mechanism, c.info = m, info
         c.residuals = residuals(c.problem or problem, ran.violations(g), m, {k: targets[k] for k in form.targets})
         c.ok = bool(info.get("ok")) and c.converged and self.within(c) and not c.pruned
+        if c.ok and last is not None and last.lam_g is not None and ran is form and range_target is None:
+            c.hint = newton.Hint.of(form, c.values, last, p, (used, used_f))
         return c
+
+    def _continued(self, problem, values0, branch, targets, orientation, range_target, sense, hint):
+        """(formulation, p, run) where ``hint`` is the optimum at values0 of this problem's formulation and Newton
+        continues it here (``newton.correct``, verified); None otherwise (the start is built and run as any)."""
+        if hint is None or orientation is None or range_target is not None:
+            return None
+        form = self.formulations.get(problem, branch, orientation, range_target, sense)
+        if not hint.fits(form, values0):
+            return None
+        base = form.p_blocks.split(form.param_vector(problem, targets, *form.base_samples()))
+        p = form.p_blocks.join(**{**base, **hint.blocks})
+        lbx, ubx = form.bounds(problem)
+        run = newton.correct(form, hint, p, lbx, ubx)
+        return None if run is None else (form, p, run)
 
     def _feasibility(self, problem):
         """The problem without its objective (its targets, conditions and bounds), built once per problem."""

@@ -33,10 +33,11 @@ class MultiStart:
     def __init__(self, local: LocalSolve):
         self.local = local
 
-    def candidates(self, problem, plan, extra, targets, starts_n, seed, max_rounds, designs, retry=True):
+    def candidates(self, problem, plan, extra, targets, starts_n, seed, max_rounds, designs, retry=True, hint=None):
         """(candidates, claim, the retry): where no space-filling start gives a certified design, the retry runs
         each of them in both TR orientations; with ``retry`` it is run here (and None is returned), otherwise it
-        is returned as a callable (None where there is nothing to retry)."""
+        is returned as a callable (None where there is nothing to retry). ``hint``: a nearby problem's optimum
+        (``newton.Hint``) that a given start continues where it is that optimum's design."""
         runs = [("given", v) for v in extra]
         cands: list[Candidate] = []
         claim = ""
@@ -73,7 +74,7 @@ class MultiStart:
             if not extra:  # shapes best by the objective among many, on a grid
                 runs += [("shape", v) for v in starts_.shapes(problem, starts_.SHAPES_KEEP, seed)]
             runs += [("multistart", v) for v in starts_.sobol(problem, starts_n, seed, designs)]
-        cands += self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
+        cands += self.run(problem, runs, targets, max_rounds, designs, both_ways=False, hint=hint)
         if plan.kind == "family" and plan.walk is not None and not extra and problem.objective:
             failed = [(runs[c.start], c) for c in cands if c.origin == "family" and not c.ok and not c.pruned]
             walked = [w for run, c in failed if (w := self.walked(problem, plan, run, c, targets, designs))]
@@ -94,7 +95,7 @@ class MultiStart:
             return cands + again(), claim, None
         return cands, claim, again
 
-    def run(self, problem, runs, targets, max_rounds, designs, both_ways, patient=False):
+    def run(self, problem, runs, targets, max_rounds, designs, both_ways, patient=False, hint=None):
         """A local solve from every start; the incumbent's NLP value prunes starts that cannot beat it; patient:
         each run with the backend's larger iteration limit (``LocalSolve.run``). A start of a NEAR origin runs
         from the backend's small barrier; one from the atlas that gives no design there runs from its default
@@ -104,7 +105,8 @@ class MultiStart:
         plans, count = [], {1: 0, -1: 0}
         for i, (origin, v, *br) in enumerate(runs):
             for b in br or starts_.branches(problem):
-                own = starts_.orientation(problem, v, b, designs)
+                known = hint.orientation(v, b) if hint is not None and origin == "given" else None
+                own = known or starts_.orientation(problem, v, b, designs)  # a continued optimum's: its NLP's
                 ways = [own] if own and not both_ways else [1, -1]
                 plans.append((i, origin, v, b, ways))
                 if origin == "multistart":
@@ -118,7 +120,8 @@ class MultiStart:
         for i, origin, v, b, ways in plans:
             for way in ways:
                 kw = {"orientation": way, "max_rounds": max_rounds, "designs": designs, "bound": bound}
-                c = self.local.run(problem, v, b, targets, patient=patient, near=origin in NEAR, **kw)
+                given = hint if origin == "given" else None
+                c = self.local.run(problem, v, b, targets, patient=patient, near=origin in NEAR, hint=given, **kw)
                 if origin == "atlas" and not patient and not c.ok and not c.pruned:
                     first, c = c, self.local.run(problem, v, b, targets, patient=patient, **kw)
                     c.t_ipopt, c.iterations = c.t_ipopt + first.t_ipopt, c.iterations + first.iterations

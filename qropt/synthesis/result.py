@@ -87,6 +87,8 @@ class Result:
     reachable: dict = field(default_factory=dict)
     units: str | None = None
     counterweight: Any = None
+    continuation: Any = field(default=None, repr=False, compare=False)  # the optimum's NLP point and multipliers
+    # (``newton.Hint``), for a solve that continues from this design (``Solver.solve(continue_from=...)``)
 
     def __post_init__(self):
         if self.status not in STATUSES:

@@ -107,6 +107,7 @@ def unscaled(result, problem, k: float):
         reachable=reachable,
         stats={**result.stats, "length_scale": back},
         local_optima=tuple(unscaled(o, problem, k) for o in result.local_optima),
+        continuation=None,  # the scaled NLP's: a continuation from these params starts afresh
     )
 
 

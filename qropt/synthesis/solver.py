@@ -132,6 +132,7 @@ class Solver:
         max_rounds: int | None = None,
         extra_starts=(),
         diagnose: bool = True,
+        continue_from: Result | None = None,
     ) -> Result:
         """Solve a synthesis problem; returns a Result whatever happens (only invalid input raises).
 
@@ -139,7 +140,9 @@ class Solver:
         use_analytic: use the closed forms; targets: new values for some targets (the NLP is not rebuilt);
         extra_starts: more starting points (free-parameter dicts), tried first; diagnose: on failure, find why
         (within the diagnosis budget); without it a failure is 'failed' with the backend's reasons, or
-        'infeasible' where a closed form that gives every design gives none that is valid.
+        'infeasible' where a closed form that gives every design gives none that is valid; continue_from: a
+        Result of a nearby problem (a chart's neighbour) whose design is one of ``extra_starts``: that start is
+        continued by Newton on the optimum's active set, verified, before the backend runs (``newton``).
         """
         t0 = time.perf_counter()
         asked = starts_n
@@ -167,8 +170,11 @@ class Solver:
         if asked is None:
             starts_n = starts_.grown(starts_n, problem, plan)
         designs = Designs()  # every mechanism this solve builds, built once
+        if continue_from is not None and not isinstance(continue_from, Result):
+            raise ProblemError(f"continue_from is a qropt Result, got {type(continue_from).__name__}")
+        hint = continue_from.continuation if continue_from is not None and extra else None
         cands, claim, retry = self.multistart.candidates(
-            problem, plan, extra, targets, starts_n, seed, max_rounds, designs, retry=not diagnose
+            problem, plan, extra, targets, starts_n, seed, max_rounds, designs, retry=not diagnose, hint=hint
         )
         good = [c for c in cands if c.ok]
         if plan.kind == "enumeration" and not extra and not good and not diagnose:  # every design, none valid
@@ -326,6 +332,7 @@ class Solver:
             quantities=c.q,
             residuals=c.residuals,
             certificate=cert,
+            continuation=c.hint,
             stats={
                 **stats,
                 "statuses": list(c.statuses),
