@@ -9,6 +9,7 @@ dominates are removed, with the reason kept. Units as in ``qropt.criteria``.
 from __future__ import annotations
 
 import csv
+import inspect
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -97,11 +98,18 @@ def pareto(
     end_a = _lexicographic(solver, base, end_a, a, b, problem.size)
     end_b = _lexicographic(solver, base, end_b, b, a, problem.size)
     lo, hi = _value(problem, qb, end_a), _value(problem, qb, end_b)
+    continues = "continue_from" in inspect.signature(solver.solve).parameters
+
+    def after(r):  # each point continued from the last one's optimum where the solver can (``newton``)
+        return {"continue_from": r} if continues else {}
+
     runs = [(None, end_a)]
     prev = end_a
     for eps in np.linspace(lo, hi, n)[1:-1]:
         p = base.replace(objective=a, conditions={**base.conditions, bound_b: float(eps)})
-        r = solver.solve(p, extra_starts=[_free(p, prev)], starts_n=0, use_analytic=False, diagnose=False)
+        r = solver.solve(
+            p, extra_starts=[_free(p, prev)], starts_n=0, use_analytic=False, diagnose=False, **after(prev)
+        )
         if r.status not in SOLUTION_PRESENT:  # the neighbour's basin ended here: the full solve
             r = solver.solve(p)
         runs.append((float(eps), r))
