@@ -52,6 +52,14 @@ class DegenerateMechanism(QroptError):
     """A quantity is undefined because the mechanism sits on a singular configuration over its whole turn."""
 
 
+class SlideLocked(DegenerateMechanism):
+    """Friction locks the slide at crank angle ``theta2`` (rad): the guide's force grows with its own friction."""
+
+    def __init__(self, message: str, theta2: float):
+        super().__init__(message)
+        self.theta2 = theta2
+
+
 class ProblemError(QroptError):
     """A synthesis problem is malformed: unknown names, empty or contradictory bounds, no free parameter."""
 

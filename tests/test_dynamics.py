@@ -674,7 +674,8 @@ def test_a_slide_that_friction_locks_is_an_error_naming_the_angle():
     with pytest.raises(qropt.DegenerateMechanism, match="friction") as e:
         m.dynamics(t[::100], 10.0, loads=loads)
     deg = float(str(e.value).split("crank angle ")[1].split(" deg")[0])
-    k = np.argmin(np.abs(t - np.radians(deg)))
+    assert e.value.theta2 == pytest.approx(np.radians(deg), abs=1e-5)  # SlideLocked: the angle, for a sample
+    k = np.argmin(np.abs(t - e.value.theta2))
     assert tan[k] >= 0.98 * tan.max()
     d = m.dynamics(t[::100], 10.0, loads=Loads(cutting_force=500.0, friction=0.99 * limit))
     assert np.isfinite(d.torque).all()

@@ -24,7 +24,7 @@ from qropt import units as units_
 from qropt.dynamics import compiled
 from qropt.dynamics.model import BodyMass, Loads, Masses, slender_bar, union
 from qropt.dynamics.rigid import body_motion
-from qropt.errors import DegenerateMechanism, InvalidParameter
+from qropt.errors import DegenerateMechanism, InvalidParameter, SlideLocked
 from qropt.kinematics.ops import JET, Jet
 
 LENGTH_GRID = 720  # crank angles where a lever's reach is sampled before its exact maximum is refined
@@ -448,16 +448,18 @@ def _velocity_sign(a: _Parts, working, way: float, forced: bool) -> np.ndarray:
 
 def _with_friction(m, t, a: _Parts, x, load, col: int, mu: float, sigma) -> tuple:
     """The unknowns with the slide's friction (``friction_load``) and the friction force along x (N); raises
-    DegenerateMechanism where the slide locks (mu |dN/dF| >= 1: the guide's force grows with its own friction)."""
+    SlideLocked (a DegenerateMechanism) where the slide locks (mu |dN/dF| >= 1: the guide's force grows with its
+    own friction)."""
     base = 0.0 if load is None else load
     unit = a.solve(base + np.ones_like(sigma, dtype=float))
     n1 = unit[col] - x[col]
     locked = (mu * np.abs(n1) >= 1.0) & (sigma != 0)
     if locked.any():
         i = int(np.flatnonzero(locked)[0])
-        raise DegenerateMechanism(
+        raise SlideLocked(
             f"{m!r}: friction mu = {mu:g} locks the slide at crank angle {math.degrees(t[i]) % 360:.6g} deg "
-            f"(the guide's force grows with its own friction: mu |dN/dF| = {mu * abs(n1[i]):.4g} >= 1)"
+            f"(the guide's force grows with its own friction: mu |dN/dF| = {mu * abs(n1[i]):.4g} >= 1)",
+            float(t[i] % (2 * math.pi)),
         )
     e = friction_load(np, x[col], n1, mu, sigma)
     return [p + (q - p) * e for p, q in zip(x, unit, strict=True)], -e

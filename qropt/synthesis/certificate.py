@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from qropt.errors import AssemblyError, QroptError
+from qropt.errors import AssemblyError, QroptError, SlideLocked
 from qropt.synthesis import criteria
 from qropt.synthesis.criteria import better, objective_of, objective_value
 
@@ -135,6 +135,8 @@ def certify(problem, form, values, branch, th, z, f, gap_tol, feas_tol, build=bu
     except AssemblyError as e:
         mids = [((lo + hi) / 2) % TWO_PI for _, lo, hi in e.failures]
         return None, {"ok": False, "reason": str(e)}, mids, []
+    except SlideLocked as e:  # the angle becomes a sample, where the NLP keeps the slide from locking
+        return None, {"ok": False, "reason": str(e)}, [e.theta2], []
     except QroptError as e:
         return None, {"ok": False, "reason": str(e)}, [], []
 

@@ -229,6 +229,7 @@ class _Symbolic:
         if col is None:
             return x, 0
         unit = elim.solve({s.load_row(): 1.0})  # the unknowns' change per newton on the ram's row
+        self._no_lock_at(out, unit[col])
         sigma = casadi.sign(out.v * f.omega2) if working is None else (way if working else -way)
         e = friction_load(casadi, x[col], unit[col], f.loads.friction, sigma)
         return [p + q * e for p, q in zip(x, unit, strict=True)], e
@@ -250,19 +251,28 @@ class _Symbolic:
         return entries, dict(rows)
 
     def no_lock(self):
-        """Rows that keep the slide from locking at every sample (mu |dN/dF| <= NO_LOCK, where ``friction_load``
-        holds), once per formulation, from the first expression that needs them; none without friction."""
+        """Rows that keep the slide from locking (mu |dN/dF| <= NO_LOCK, where ``friction_load`` holds) at every
+        sample, once per formulation, from the first expression that needs them; none without friction."""
         from qropt.dynamics.inverse import Elimination
 
         col = self.guide()
         if col is None or getattr(self, "_no_lock", False):
             return
         self._no_lock = True
-        s, mu = self.system(), self.f.loads.friction
-        for k, out in enumerate(self.f.sampled):
+        s = self.system()
+        for out in self.f.sampled:
             entries, _ = self._assembled(out)
-            n1 = Elimination(entries, s.n, None).solve({s.load_row(): 1.0})[col]
-            self.f.row(f"the slide does not lock at sample {k}", (mu * n1) ** 2, -casadi.inf, NO_LOCK**2)
+            self._no_lock_at(out, Elimination(entries, s.n, None).solve({s.load_row(): 1.0})[col])
+
+    def _no_lock_at(self, out, n1):
+        """The no-lock row at one point where the friction is used (a sample, a stroke's or the quadrature's node,
+        a lifted angle), once per point; n1: dN/dF there."""
+        kept = self.__dict__.setdefault("_lock_points", [])
+        if any(o is out for o in kept):
+            return
+        kept.append(out)
+        mu = self.f.loads.friction
+        self.f.row(f"the slide does not lock at point {len(kept)}", (mu * n1) ** 2, -casadi.inf, NO_LOCK**2)
 
     def guide(self) -> int | None:
         """The guide's normal force's column where the slide has friction, else None."""

@@ -143,8 +143,10 @@ class LocalSolve:
         backend = warm_backend if near else backend
         designs = designs or Designs()
         objective = criteria.of_problem(problem)
+        continued = self._continued(problem, values0, branch, targets, orientation, range_target, sense, hint)
         if (
-            objective is not None
+            continued is None
+            and objective is not None
             and not objective.kinematic
             and range_target is None
             and not _meets(problem, values0, branch, targets, designs)
@@ -163,7 +165,6 @@ class LocalSolve:
             )
             if pre.converged and not pre.residuals_over(self.tolerances["feasibility"]):
                 values0, orientation = pre.values, pre.orientation
-        continued = self._continued(problem, values0, branch, targets, orientation, range_target, sense, hint)
         if continued is None:
             th0, orientation = starts_.dead_centre_start(
                 problem, values0, branch, targets, orientation, range_target, designs
@@ -179,6 +180,8 @@ class LocalSolve:
             samples, fractions = hint.blocks["samples"].copy(), hint.blocks["fractions"].copy()
             (used, used_f), box = hint.used, None
         mono, mono_next = np.full(2 * MONOTONE, 0.5), [0, 0]
+        if continued is not None and hint.blocks["monotone"].size:  # a guarded NLP: the hint's reversal rows
+            mono = hint.blocks["monotone"].copy()
         lbx, ubx = form.bounds(problem)
         c = Candidate(False, dict(values0), branch, orientation)
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]

@@ -106,6 +106,8 @@ class MultiStart:
         for i, (origin, v, *br) in enumerate(runs):
             for b in br or starts_.branches(problem):
                 known = hint.orientation(v, b) if hint is not None and origin == "given" else None
+                if known and self.local.formulations.get(problem, b, known) is not hint.form:
+                    known = None  # a hint of another problem's NLP
                 own = known or starts_.orientation(problem, v, b, designs)  # a continued optimum's: its NLP's
                 ways = [own] if own and not both_ways else [1, -1]
                 plans.append((i, origin, v, b, ways))

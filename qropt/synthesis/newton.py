@@ -1,18 +1,20 @@
 """Newton's method on the KKT conditions of a nearby problem's optimum, with its active set kept: the corrector of
-a continuation (a chart's next cell, a family's next point), where the optimum moves smoothly with the problem.
+a continuation (a chart's next cell, a front's next point), where the optimum moves smoothly with the problem.
 
 From the neighbour's NLP point and multipliers, the rows it held at a bound (its equalities, the inequalities with
 a multiplier, the variables on a bound) are held at theirs, and Newton solves the stationarity of the Lagrangian
 and those rows for the point and the multipliers. The result is a local run like a backend's, but only once it is
 verified a strict local minimum of the whole NLP: the KKT residuals to ``TOL``, every other row and bound met, each
-held row's multiplier of the sign that a bound holding it needs, and the Lagrangian's Hessian positive definite on
-the held rows' tangent space. Anything else (the active set changed, the point left the region where the loop
-closes, a singular system) returns None, and the backend runs from the neighbour's design as before.
+held row's multiplier of the sign that a bound holding it needs and away from zero (strict complementarity), and
+the Lagrangian's Hessian positive definite on the held rows' tangent space. Anything else (the active set changed,
+the point left the region where the loop closes, a singular system, an NLP too large for its exact Hessian to pay)
+returns None, and the backend runs from the neighbour's design as before.
 """
 
 from __future__ import annotations
 
 import time
+import weakref
 from dataclasses import dataclass
 
 import casadi
@@ -24,6 +26,9 @@ from qropt.synthesis.backends import Run, Status
 ITERATIONS = 8  # Newton steps at most (a converging corrector needs 2-4 from a neighbour)
 TOL = 1e-11  # KKT residuals relative to their terms' scale; rows and bounds met to this, relative, at least 1
 ACTIVE = 1e-7  # a multiplier counts (its row held) above this, relative to the largest
+NLP_LIMIT = 2_000  # NLPs (objective and rows) of at most this many instructions are continued by Newton: their
+# KKT function (exact Hessian) builds in under about 0.3 s (a chart's four-bar: 380, 0.09 s; a dynamic
+# objective's 4,000-11,000 took 1-7 s)
 CURVED = 1e-10  # the reduced Hessian's smallest eigenvalue, relative to its largest, at least this
 
 
@@ -43,12 +48,17 @@ class Hint:
     lam_x: np.ndarray
     blocks: dict
     used: tuple
-    form: object = None
+    formulation: object = None  # a weak reference: a kept Result does not keep its NLP alive
 
     @classmethod
     def of(cls, form, values: dict, run, p, used) -> Hint:
         blocks = {k: v.copy() for k, v in form.p_blocks.split(p).items() if k in BLOCKS}
-        return cls(_key(values), run.w, run.lam_g, run.lam_x, blocks, used, form)
+        return cls(_key(values), run.w, run.lam_g, run.lam_x, blocks, used, weakref.ref(form))
+
+    @property
+    def form(self):
+        """Its formulation, or None (gone, or the hint was pickled)."""
+        return self.formulation() if self.formulation is not None else None
 
     def fits(self, form, values: dict) -> bool:
         """Whether this is the optimum of ``form`` at the design ``values``."""
@@ -56,12 +66,13 @@ class Hint:
 
     def orientation(self, values: dict, branch: dict) -> int | None:
         """The TR orientation of this optimum's formulation where ``values`` and ``branch`` are its design's, else
-        None."""
-        mine = self.form is not None and self.values == _key(values) and self.form.branch == branch
-        return self.form.orientation if mine else None
+        None (the caller checks that the formulation is its problem's)."""
+        form = self.form
+        mine = form is not None and self.values == _key(values) and form.branch == branch
+        return form.orientation if mine else None
 
     def __getstate__(self):
-        return {**self.__dict__, "form": None}
+        return {**self.__dict__, "formulation": None}
 
     def __setstate__(self, state):
         for k, v in state.items():
@@ -72,13 +83,23 @@ def _key(values: dict) -> tuple:
     return tuple(sorted((k, float(v)) for k, v in values.items()))
 
 
+class _Compiled(Batched):
+    HOT = 256  # evaluations after which a KKT function runs as machine code: a chart's hundreds of cells pay for
+    # the compile (about a second, then cached on disk), a front's twenty points stay on CasADi's VM
+
+
 def _functions(form):
     """(f, grad f, g, dg/dw, the Lagrangian's Hessian) at z = (w, p, lam_g) as one dense row, built once per
-    formulation and evaluated like the cycle kernels (``Batched``: buffers, machine code once it is used often);
-    with the offsets of its parts."""
-    f = getattr(form, "_newton_kkt", None)
-    if f is None:
+    formulation and evaluated like the cycle kernels (``Batched``: buffers, machine code once it is used often),
+    with the offsets of its parts; None for an NLP of more than NLP_LIMIT instructions (its exact Hessian would
+    take longer to build than the continuation saves)."""
+    f = getattr(form, "_newton_kkt", False)
+    if f is False:
         w, obj, g = form.w_sym, form.f_sym, form.g_sym
+        size = casadi.Function("nlp", [w, form.p_sym], [obj, g]).n_instructions()
+        if size > NLP_LIMIT:
+            form._newton_kkt = None
+            return None
         lam = casadi.SX.sym("lam", g.numel())
         hess, _ = casadi.hessian(obj + casadi.dot(lam, g), w)
         parts = [obj, casadi.gradient(obj, w), g, casadi.jacobian(g, w), hess]
@@ -88,12 +109,8 @@ def _functions(form):
         n, k, m = w.numel(), form.p_sym.numel(), g.numel()
         z = casadi.SX.sym("z", n + k + m)
         row = kkt(z[:n], z[n : n + k], z[n + k :])
-        f = form._newton_kkt = (
-            Batched(casadi.Function(f"kkt_{n}_{m}", [z], [row], CSE)),
-            n,
-            m,
-            np.cumsum([1, n, m, m * n]),
-        )
+        batched = _Compiled(casadi.Function(f"kkt_{n}_{m}", [z], [row], CSE))
+        f = form._newton_kkt = (batched, n, m, np.cumsum([1, n, m, m * n]))
     return f
 
 
@@ -123,7 +140,7 @@ def correct(form, hint: Hint, p, lbx, ubx) -> Run | None:
     lam[rows] = hint.lam_g[rows]
     fun = _functions(form)
     n, k = free.size, rows.size
-    if k > n:
+    if fun is None or k > n:
         return None
     side_scale = max(1.0, _largest(side))
     for it in range(1, ITERATIONS + 1):
@@ -161,18 +178,21 @@ def _kkt_matrix(H, A) -> np.ndarray:
 
 def _verified(form, w, f, g, J, df, K, lam, rows, upper, on, free, lbx, ubx, iterations, seconds) -> Run | None:
     """The run at w if it is a strict local minimum of the whole NLP on the held rows (module docstring): every
-    row and bound met, the held inequalities' and bounds' multipliers of their bound's sign, and the KKT matrix K
+    row and bound met, the held inequalities' and bounds' multipliers of their bound's sign and away from zero
+    (strictly active: the held rows' tangent space is then the critical cone), and the KKT matrix K
     of inertia (free variables, held rows, 0): the held rows independent and the Lagrangian's Hessian positive
     definite on their tangent space (the inertia of K is that of the reduced Hessian plus (rows, rows, 0))."""
     lbg, ubg = form.lbg, form.ubg
     tol = TOL * np.maximum(1.0, np.abs(np.where(np.isfinite(lbg), lbg, np.where(np.isfinite(ubg), ubg, 0.0))))
     if (g < lbg - tol).any() or (g > ubg + tol).any() or (w < lbx).any() or (w > ubx).any():
         return None
-    if (np.where(upper, lam[rows] < 0, lam[rows] > 0) & (lbg[rows] != ubg[rows])).any():
-        return None
     lam_x = np.zeros(w.size)
     lam_x[on] = -(df + J[rows].T @ lam[rows])[on]
-    if np.where(w[on] >= ubx[on], lam_x[on] < 0, lam_x[on] > 0).any():
+    weak = ACTIVE * max(_largest(lam), _largest(lam_x), 1e-300)  # strictly active: a multiplier away from zero
+    ineq = lbg[rows] != ubg[rows]
+    if (np.where(upper, lam[rows] <= weak, lam[rows] >= -weak) & ineq).any():
+        return None
+    if np.where(w[on] >= ubx[on], lam_x[on] <= weak, lam_x[on] >= -weak).any():
         return None
     e = np.linalg.eigvalsh(K)
     small = CURVED * max(1.0, _largest(e))
