@@ -16,12 +16,14 @@ Signs: ``Simulation.theta2``, ``omega2`` and ``motor_torque`` follow the contrac
 ``motor_torque * omega2`` is the power the motor delivers). A ``Motor``'s numbers are given in the sense of
 rotation: a positive torque drives the crank the way ``omega0`` turns it, and a line motor's speed is the crank's
 speed in that sense. The crank stalls when its speed in that sense falls to zero (to ``STALL_FRACTION * |omega0|``):
-the simulation then ends there with ``stalled=True``. Friction on the slide depends on the guide's force, not on
-the crank's state alone, and is not modelled here.
+the simulation then ends there with ``stalled=True``. Friction on the slide depends on the guide's force, which
+depends on the crank's acceleration: with friction the acceleration comes from the Newton-Euler system instead
+(``inverse.crank_acceleration``: affine in theta2'' on either side of where the guide's force vanishes).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -29,7 +31,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from qropt.dynamics.inverse import body_masses, generalised
+from qropt.dynamics.inverse import body_masses, crank_acceleration, generalised, system_of
 from qropt.dynamics.model import Loads, Masses, _real
 from qropt.errors import InvalidParameter, NoDeadCentres
 
@@ -173,7 +175,7 @@ def simulate(
 ) -> Simulation:
     """Integrate the crank's equation of motion (see the module) from theta2 = 0, omega2 = omega0 (rad/s, nonzero:
     its sign is the sense of rotation) over ``turns`` turns, under ``motor`` with a flywheel of ``flywheel`` kg m^2
-    on the crank; masses, loads: ``qropt.Masses`` and ``qropt.Loads`` (default massless, none; no friction)."""
+    on the crank; masses, loads: ``qropt.Masses`` and ``qropt.Loads`` (default massless, none)."""
     if not isinstance(motor, Motor):
         raise InvalidParameter(f"motor is a qropt Motor (Motor.constant or Motor.line), got {type(motor).__name__}")
     masses = Masses() if masses is None else masses
@@ -182,10 +184,6 @@ def simulate(
         raise InvalidParameter(f"masses is a qropt.Masses, got {type(masses).__name__}")
     if not isinstance(loads, Loads):
         raise InvalidParameter(f"loads is a qropt.Loads, got {type(loads).__name__}")
-    if loads.friction:
-        raise InvalidParameter(
-            "simulate does not model the slide's friction (it depends on the guide's force): give Loads(friction=0)"
-        )
     fw = _real("flywheel (kg m^2)", flywheel, nonneg=True)
     omega0 = _real("omega0 (rad/s)", omega0, nonzero=True)
     turns = _count("turns", turns, 1, 1000)
@@ -196,8 +194,10 @@ def simulate(
     # every body's mass model once (the same numbers generalised() would derive at each call)
     resolved = Masses(bodies=body_masses(m, masses))
 
+    plain = dataclasses.replace(loads, friction=0.0)  # M and Q (with friction the Newton-Euler system, in rhs)
+
     def gen(theta):
-        return generalised(m, theta, masses=resolved, loads=loads, sense=sense)
+        return generalised(m, theta, masses=resolved, loads=plain, sense=sense)
 
     grid = np.linspace(0.0, TWO_PI, INERTIA_GRID, endpoint=False)
     try:
@@ -216,12 +216,16 @@ def simulate(
 
     nfev = 0
 
+    system = system_of(m, resolved) if loads.friction else None
+
     def rhs(_t, y):
         nonlocal nfev
         nfev += 1
-        g = gen(y[0])
         w = y[1]
         torque = sense * motor.torque(sense * w)
+        if system is not None:  # the slide's friction: from the Newton-Euler system (it depends on alpha2)
+            return [w, crank_acceleration(m, system, y[0], w, loads, torque, fw)]
+        g = gen(y[0])
         return [w, (torque - g.Q[0] - 0.5 * g.dM[0] * w * w) / (g.M[0] + fw)]
 
     def stall(_t, y):

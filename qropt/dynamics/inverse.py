@@ -380,10 +380,11 @@ def _kinetics(m, s: _System, t, omega2, alpha2, k):
     return P, kin, vel
 
 
-def _solve(m, s: _System, t, omega2, alpha2, loads, working=None) -> Dynamics:
-    """``working``: the cutting force's state at every angle (True on, False off; None: by the stroke)."""
+def _loaded(m, s: _System, t, omega2, alpha2, loads, working=None) -> tuple:
+    """One solve's parts with its loads at crank angles t: (parts, the load on the ram's row (an (n,) array, or
+    None: it is in the parts), the guide's column where the slide has friction and the ram's velocity's sign
+    there, else (None, None)). ``working`` as ``_solve``."""
     k = units_.to_metres(m.units)
-    n = t.size
     forced = working is not None
     working = _working(m, t, omega2) if working is None else np.full(t.shape, bool(working))
     way = m.working_direction(omega2 or 1.0)  # the load resists the working stroke's motion, its ends included
@@ -397,23 +398,34 @@ def _solve(m, s: _System, t, omega2, alpha2, loads, working=None) -> Dynamics:
         known = np.where(working, loads.cutting_force * way, 0.0)
     elif out_body is None and loads.follower_torque and m.OUTPUT == "follower":
         known = np.where(working, loads.follower_torque * way, 0.0)
+    a = compiled.parts(m, s, t, omega2, alpha2, loads.gravity, k, known, table or sliding)
+    if a is None:
+        a = _numpy_parts(m, s, t, omega2, alpha2, loads.gravity, k, known)
+    # along x, through the ram's point (no moment about a yoke's centre on its line)
+    load = np.where(working, loads.force_at(a.x_out), 0.0) * way if table else None
+    if not sliding:
+        return a, load, None, None
+    return a, load, guide_col, _velocity_sign(a, working, way, forced)
+
+
+def _singular(m) -> DegenerateMechanism:
+    return DegenerateMechanism(
+        f"{m!r}: the force analysis is singular at some crank angle (a transmission angle of zero: no force can "
+        "drive the output there)"
+    )
+
+
+def _solve(m, s: _System, t, omega2, alpha2, loads, working=None) -> Dynamics:
+    """``working``: the cutting force's state at every angle (True on, False off; None: by the stroke)."""
+    n = t.size
     try:
-        a = compiled.parts(m, s, t, omega2, alpha2, loads.gravity, k, known, table or sliding)
-        if a is None:
-            a = _numpy_parts(m, s, t, omega2, alpha2, loads.gravity, k, known)
-        # along x, through the ram's point (no moment about a yoke's centre on its line)
-        load = np.where(working, loads.force_at(a.x_out), 0.0) * way if table else None
+        a, load, col, sigma = _loaded(m, s, t, omega2, alpha2, loads, working)
         x = a.solve(load)
         friction = np.zeros(n)
-        if sliding:
-            x, friction = _with_friction(
-                m, t, a, x, load, guide_col, loads.friction, _velocity_sign(a, working, way, forced)
-            )
+        if col is not None:
+            x, friction = _with_friction(m, t, a, x, load, col, loads.friction, sigma)
     except np.linalg.LinAlgError:
-        raise DegenerateMechanism(
-            f"{m!r}: the force analysis is singular at some crank angle (a transmission angle of zero: no force "
-            "can drive the output there)"
-        ) from None
+        raise _singular(m) from None
     forces = {}
     for c, col, _ in s.cols:
         if c.kind == "pin":
@@ -463,6 +475,52 @@ def _with_friction(m, t, a: _Parts, x, load, col: int, mu: float, sigma) -> tupl
         )
     e = friction_load(np, x[col], n1, mu, sigma)
     return [p + (q - p) * e for p, q in zip(x, unit, strict=True)], -e
+
+
+def crank_acceleration(m, s: _System, theta: float, omega2: float, loads, torque: float, flywheel: float) -> float:
+    """The crank's angular acceleration (rad/s^2) at crank angle theta (rad) and speed omega2 (rad/s) where the
+    motor's torque (N m) drives the mechanism (system s) and a flywheel (kg m^2), with the slide's friction: every
+    unknown is affine in alpha2 but for the friction, whose load (``friction_load``) follows the guide's force
+    N(alpha2) = N0 + alpha2 dN, piecewise linear in alpha2 with its kink where N vanishes. The balance
+    T(alpha2) + I_fw alpha2 = torque is solved on each side of the kink; the answer is the one that lies on its
+    own side (DegenerateMechanism where none or two do: friction makes the motion undetermined)."""
+    t = np.array([float(theta)])
+    try:
+        a0, load, col, sigma = _loaded(m, s, t, omega2, 0.0, loads)
+        a1 = _loaded(m, s, t, omega2, 1.0, loads)[0]
+        x0, x1 = a0.solve(load), a1.solve(load)
+        unit = [p - q for p, q in zip(a0.solve((0.0 if load is None else load) + np.ones(1)), x0, strict=True)]
+    except np.linalg.LinAlgError:
+        raise _singular(m) from None
+    T0, dT, uT = float(x0[0][0]), float(x1[0][0] - x0[0][0]), float(unit[0][0])
+    N0, dN, n1, mu, sg = (
+        float(x0[col][0]),
+        float(x1[col][0] - x0[col][0]),
+        float(unit[col][0]),
+        loads.friction,
+        float(sigma[0]),
+    )
+    if mu * abs(n1) >= 1.0 and sg:
+        raise SlideLocked(
+            f"{m!r}: friction mu = {mu:g} locks the slide at crank angle {math.degrees(theta) % 360:.6g} deg "
+            f"(mu |dN/dF| = {mu * abs(n1):.4g} >= 1)",
+            float(theta % (2 * math.pi)),
+        )
+    found = []
+    for side in (1.0, -1.0):  # on this side of the kink |N| = side N: e = c (N0 + alpha2 dN)
+        c = mu * sg * side / (1.0 - mu * sg * n1 * side)
+        slope = dT + uT * c * dN + flywheel
+        if slope == 0.0:
+            continue
+        alpha = (torque - T0 - uT * c * N0) / slope
+        if side * (N0 + alpha * dN) >= -1e-12 * max(1.0, abs(N0)):
+            found.append(alpha)
+    if not found or max(found) - min(found) > 1e-9 * max(1.0, *map(abs, found)):
+        raise DegenerateMechanism(
+            f"{m!r}: at crank angle {math.degrees(theta) % 360:.6g} deg and {omega2:g} rad/s the slide's friction "
+            f"leaves the crank's acceleration {'undetermined' if found else 'without a solution'}"
+        )
+    return found[0]
 
 
 def shaking(kin) -> tuple:
