@@ -29,7 +29,7 @@ TWO_PI = 2 * math.pi
 LIFTS = (2, 4)  # extremes the NLP lifts for the peak torque and the peak shaking force: the design's degrees of
 # freedom + 1 (a minimax optimum equalises that many peaks), at least two (one of two equal peaks is often sharp)
 CW_X, CW_Y = "counterweight moment x", "counterweight moment y"  # a free counterweight's variables (kg m)
-NO_LOCK = 0.99  # the NLP keeps mu |dN/dF| at most this at its samples: the slide's friction's closed form's domain
+NO_LOCK = 0.99  # the NLP keeps mu |dN/dF| at most this wherever it states the friction (its closed form's domain)
 EXCHANGE_PEAKS = 4  # local maxima the exchange loop looks at: each above the NLP's bound becomes a sample angle
 
 

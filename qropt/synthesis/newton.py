@@ -29,7 +29,7 @@ ACTIVE = 1e-7  # a multiplier counts (its row held) above this, relative to the 
 NLP_LIMIT = 2_000  # NLPs (objective and rows) of at most this many instructions are continued by Newton: their
 # KKT function (exact Hessian) builds in under about 0.3 s (a chart's four-bar: 380, 0.09 s; a dynamic
 # objective's 4,000-11,000 took 1-7 s)
-CURVED = 1e-10  # the reduced Hessian's smallest eigenvalue, relative to its largest, at least this
+CURVED = 1e-10  # an eigenvalue of the KKT matrix counts as nonzero above this, relative to the largest
 
 
 BLOCKS = ("samples", "fractions", "select", "caps", "monotone")  # the exchange loop's blocks of p a hint keeps
@@ -40,7 +40,7 @@ class Hint:
     """A certified optimum to continue from: its design (free values), the NLP point, its multipliers (rows,
     bounds; IPOPT's signs: positive at an upper bound), the exchange loop's parameter blocks (sample angles,
     fractions, the box's selection, caps, the monotone rows' fractions) with how many sample slots it used, and
-    its formulation, which stays in this process (a hint that was pickled fits no formulation)."""
+    a weak reference to its formulation, which stays in this process (a pickled hint fits no formulation)."""
 
     values: tuple
     w: np.ndarray
