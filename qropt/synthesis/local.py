@@ -19,6 +19,7 @@ from qropt.synthesis.backends import CONVERGED, Status
 from qropt.synthesis.certificate import Designs, certify, residuals, target_values
 from qropt.synthesis.formulation import MONOTONE, TWO_PI, Formulation
 
+STUCK = 3  # exchange rounds that end alike, in a row, after which the loop stops (``_stuck``)
 RESTARTS = 2  # runs continued from their last iterate when they hit the iteration limit near a design
 RESTART_VIOLATION = 1e-6  # ... that is, with no constraint violated by more than this
 MEMO = 64  # problems a solver keeps derived problems of (a chart's tiles bring thousands)
@@ -187,6 +188,7 @@ class LocalSolve:
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
         g, info, m, restarts, polished, polish = None, {}, None, 0, False, None
         first = continued[2] if continued is not None else None
+        rounds = []  # what each round's certificate asked (``_stuck``)
         while c.rounds < max_rounds:
             c.rounds += 1
             warm = c.rounds > 1  # a re-solve: from the small barrier, unless a start not near an optimum ended at a
@@ -238,6 +240,9 @@ class LocalSolve:
             if bound is not None and info.get("ok") and run.f > bound + 1e-9 * max(1.0, abs(bound)):
                 c.pruned = True  # more samples only raise this basin's NLP value: it cannot beat the incumbent
                 break
+            rounds.append((info.get("ok"), info.get("reason"), run.f, np.sort(add), np.sort(frac)))
+            if _stuck(rounds):
+                break  # the same design and the same angles to add, STUCK rounds running: the next ones are too
             used = place(samples, used, add, TWO_PI, 0.05, form.n_base)
             used_f = place(fractions, used_f, frac, 1.0, 0.01, form.n_base)
             if form.n_box and m is not None:  # each box side lifted at the coordinate that reaches it now
@@ -355,6 +360,23 @@ def _meets(problem, values, branch, targets, build, tol: float = 1e-9) -> bool:
     except QroptError:
         return False
     return all(abs(got[k] - v) <= tol * max(1.0, abs(v)) for k, v in targets.items() if k in got)
+
+
+def _stuck(rounds) -> bool:
+    """Whether the exchange loop's last STUCK rounds ended alike: the same verdict and reason, NLP values within
+    1e-9 (relative) and the same angles and fractions to add (to 1e-9): the loop goes round without moving (the
+    coupler slider at TR 2.61: 25 rounds at one design whose dead centres are local)."""
+    if len(rounds) < STUCK:
+        return False
+    ok, why, f, add, frac = rounds[-1]
+    for ok2, why2, f2, add2, frac2 in rounds[-STUCK:-1]:
+        if (ok2, why2) != (ok, why) or abs(f2 - f) > 1e-9 * max(1.0, abs(f)):
+            return False
+        if add2.shape != add.shape or frac2.shape != frac.shape:
+            return False
+        if not (np.allclose(add2, add, rtol=0, atol=1e-9) and np.allclose(frac2, frac, rtol=0, atol=1e-9)):
+            return False
+    return True
 
 
 def place(slots, used, new, period, near, base):
