@@ -462,19 +462,28 @@ def _with_friction(m, t, a: _Parts, x, load, col: int, mu: float, sigma) -> tupl
     """The unknowns with the slide's friction (``friction_load``) and the friction force along x (N); raises
     SlideLocked (a DegenerateMechanism) where the slide locks (mu |dN/dF| >= 1: the guide's force grows with its
     own friction)."""
-    base = 0.0 if load is None else load
-    unit = a.solve(base + np.ones_like(sigma, dtype=float))
-    n1 = unit[col] - x[col]
+    unit = _per_newton(a, x, load)
+    n1 = unit[col]
     locked = (mu * np.abs(n1) >= 1.0) & (sigma != 0)
     if locked.any():
         i = int(np.flatnonzero(locked)[0])
-        raise SlideLocked(
-            f"{m!r}: friction mu = {mu:g} locks the slide at crank angle {math.degrees(t[i]) % 360:.6g} deg "
-            f"(the guide's force grows with its own friction: mu |dN/dF| = {mu * abs(n1[i]):.4g} >= 1)",
-            float(t[i] % (2 * math.pi)),
-        )
+        raise _locked(m, mu, n1[i], t[i])
     e = friction_load(np, x[col], n1, mu, sigma)
-    return [p + (q - p) * e for p, q in zip(x, unit, strict=True)], -e
+    return [p + q * e for p, q in zip(x, unit, strict=True)], -e
+
+
+def _per_newton(a: _Parts, x, load) -> list:
+    """The unknowns' change per newton on the ram's row (the solve is affine in that load): K rows of n."""
+    n = np.shape(x[0])[0]
+    return [q - p for p, q in zip(x, a.solve((0.0 if load is None else load) + np.ones(n)), strict=True)]
+
+
+def _locked(m, mu: float, n1: float, theta: float) -> SlideLocked:
+    return SlideLocked(
+        f"{m!r}: friction mu = {mu:g} locks the slide at crank angle {math.degrees(theta) % 360:.6g} deg "
+        f"(the guide's force grows with its own friction: mu |dN/dF| = {mu * abs(n1):.4g} >= 1)",
+        float(theta % (2 * math.pi)),
+    )
 
 
 def crank_acceleration(m, s: _System, theta: float, omega2: float, loads, torque: float, flywheel: float) -> float:
@@ -489,7 +498,7 @@ def crank_acceleration(m, s: _System, theta: float, omega2: float, loads, torque
         a0, load, col, sigma = _loaded(m, s, t, omega2, 0.0, loads)
         a1 = _loaded(m, s, t, omega2, 1.0, loads)[0]
         x0, x1 = a0.solve(load), a1.solve(load)
-        unit = [p - q for p, q in zip(a0.solve((0.0 if load is None else load) + np.ones(1)), x0, strict=True)]
+        unit = _per_newton(a0, x0, load)
     except np.linalg.LinAlgError:
         raise _singular(m) from None
     T0, dT, uT = float(x0[0][0]), float(x1[0][0] - x0[0][0]), float(unit[0][0])
@@ -501,11 +510,7 @@ def crank_acceleration(m, s: _System, theta: float, omega2: float, loads, torque
         float(sigma[0]),
     )
     if mu * abs(n1) >= 1.0 and sg:
-        raise SlideLocked(
-            f"{m!r}: friction mu = {mu:g} locks the slide at crank angle {math.degrees(theta) % 360:.6g} deg "
-            f"(mu |dN/dF| = {mu * abs(n1):.4g} >= 1)",
-            float(theta % (2 * math.pi)),
-        )
+        raise _locked(m, mu, n1, theta)
     found = []
     for side in (1.0, -1.0):  # on this side of the kink |N| = side N: e = c (N0 + alpha2 dN)
         c = mu * sg * side / (1.0 - mu * sg * n1 * side)

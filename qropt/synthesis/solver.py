@@ -146,6 +146,8 @@ class Solver:
         """
         t0 = time.perf_counter()
         asked = starts_n
+        if continue_from is not None and not isinstance(continue_from, Result):
+            raise ProblemError(f"continue_from is a qropt Result, got {type(continue_from).__name__}")
         problem, targets, extra, starts_n, seed, max_rounds = self._check(
             problem, targets, extra_starts, starts_n, seed, max_rounds
         )
@@ -170,8 +172,6 @@ class Solver:
         if asked is None:
             starts_n = starts_.grown(starts_n, problem, plan)
         designs = Designs()  # every mechanism this solve builds, built once
-        if continue_from is not None and not isinstance(continue_from, Result):
-            raise ProblemError(f"continue_from is a qropt Result, got {type(continue_from).__name__}")
         hint = continue_from.continuation if continue_from is not None and extra else None
         cands, claim, retry = self.multistart.candidates(
             problem, plan, extra, targets, starts_n, seed, max_rounds, designs, retry=not diagnose, hint=hint
