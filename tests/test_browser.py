@@ -173,7 +173,7 @@ def test_design_page(page, tmp_path):
     page.wait_for_function("location.hash === '#mechanism' && !window.qropt.inflight")
     page.wait_for_timeout(200)
     p = page.evaluate("window.qropt.params")
-    assert p == pytest.approx(want.rows[2].result.params)
+    assert p == pytest.approx(want.rows[2].result.params), (want.rows[2].type, want.rows[2].result.message)
 
 
 def test_synthesis_page(page, tmp_path):

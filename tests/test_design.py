@@ -488,11 +488,12 @@ def test_beyond_their_reach_the_shapers_are_infeasible_by_their_closed_forms():
     """At TR 1.116 every crank shaper has r2/r1 = sin(phi/2) = 0.0860, so a stroke of 1.871 m needs the lever
     r4 = 10.877 m (the slot-ram shaper the slide line at h = 10.837 m), beyond the row's bound of 5 strokes: the
     closed form that gives every design proves there is none (in milliseconds: a multi-start and its diagnosis
-    took 0.4 s to say only that no start converged). The tests' own simulation, at the largest lever and offset
-    the bounds allow, gives that TR and a shorter stroke."""
+    took 0.4 s to say only that no start converged, and 8 s with a rod). The tests' own simulation, at the
+    largest lever and offset the bounds allow, gives that TR and a shorter stroke."""
     tr, stroke = 1.116, 1.871
     ratio = math.sin(math.pi * (tr - 1) / (tr + 1) / 2)
-    for kind, name, needed in (("crank-shaper", "r4", stroke / (2 * ratio)), ("slot-ram-shaper", "h", None)):
+    rows = (("crank-shaper", "r4", stroke / (2 * ratio)), ("crank-shaper-rod", "r4", stroke / (2 * ratio)))
+    for kind, name, needed in (*rows, ("slot-ram-shaper", "h", None)):
         p = type_problem(kind, tr, stroke)
         r = qropt.solve(p)
         assert r.status == "infeasible", r.message
@@ -500,7 +501,33 @@ def test_beyond_their_reach_the_shapers_are_infeasible_by_their_closed_forms():
         top = p.free[name][1]
         if needed is not None:
             assert needed > top and f"{needed:.6g}" in r.message
-        built = p.build({"r1": 1.0, "r2": ratio, **({"r4": top} if name == "r4" else {"h": top})}, {})
-        b_tr, b_stroke, _ = brute.task_values(kind, dict(built.params))
+        given = {"r1": 1.0, "r2": ratio, **({"r4": top} if name == "r4" else {"h": top})}
+        given.update({"r6": top, "h": top} if kind == "crank-shaper-rod" else {})
+        built = p.build(given, {})
+        b_tr, b_stroke, _ = brute.task_values(p.mechanism.KIND, dict(built.params))
         assert b_tr == pytest.approx(tr, abs=1e-9)
         assert b_stroke < stroke
+
+
+def test_a_crank_shapers_rod_keeps_its_time_ratio_and_stroke():
+    """The closed form behind the rod row's proof: a crank shaper whose ram, driven by a rod r6 along any slide
+    line y = -r1 + h, reverses once a turn has the lever's TR, (pi + 2 beta) / (pi - 2 beta) with sin(beta) = r2/r1,
+    and stroke 2 r4 r2/r1 (the rod's end is at the same height at both lever extremes). Checked by the tests' own
+    simulation at random rods, offsets and branches: designs reversing more than once are left out, and at least
+    20 remain."""
+    rng = np.random.default_rng(31)
+    checked = 0
+    while checked < 20:
+        r2, r4, r6, h = rng.uniform(0.05, 0.9), rng.uniform(0.3, 3.0), rng.uniform(0.2, 4.0), rng.uniform(-3.0, 3.0)
+        p = {"r1": 1.0, "r2": r2, "r4": r4, "r6": r6, "h": h, "sigma_slider": float(rng.choice([-1.0, 1.0]))}
+        with np.errstate(invalid="ignore"):
+            x = brute.output("crank-shaper", p, brute.TH)
+        if not np.isfinite(x).all():
+            continue  # the rod does not reach the slide line somewhere in the turn
+        if np.count_nonzero((x > np.roll(x, 1)) & (x >= np.roll(x, -1))) != 1:
+            continue
+        b_tr, b_stroke, _ = brute.task_values("crank-shaper", p)
+        beta = math.asin(r2)
+        assert b_tr == pytest.approx((math.pi + 2 * beta) / (math.pi - 2 * beta), rel=1e-9)
+        assert b_stroke == pytest.approx(2 * r4 * r2, rel=1e-9)
+        checked += 1

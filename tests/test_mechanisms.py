@@ -206,3 +206,64 @@ def test_bounding_box_matches_brute_force(kind):
         assert b.x_min <= xs.min() + 1e-12 and b.x_max >= xs.max() - 1e-12
         assert abs(b.x_min - xs.min()) < tol and abs(b.x_max - xs.max()) < tol, (p, b)
         assert abs(b.y_min - ys.min()) < tol and abs(b.y_max - ys.max()) < tol, (p, b)
+
+
+def test_extremes_closer_than_a_grid_step_are_each_found():
+    """A crank shaper whose rod nears its reach: the ram has two equal maxima 0.08 rad apart with a dip of 5e-6 m
+    between, so the 180-angle grid's bracket around the first holds the dip too. Every stationary point is found,
+    as the tests' own simulation finds it: the design reverses twice a turn (the solver once returned it as a
+    design reversing once, at TR 1.116 and 1.871 m)."""
+    from scipy.optimize import brentq
+
+    import qropt
+
+    p = {"r1": 7.037198129315969, "r2": 0.7454177884015692, "r4": 8.831666533384407}
+    p.update({"r6": 0.5761765854962286, "h": 9.354999999993968, "sigma_slider": 1.0})
+    m = qropt.CrankShaper(**p)
+    dx = np.imag(brute.output("crank-shaper", p, brute.TH + 1j * brute.STEP)) / brute.STEP
+    cells = np.flatnonzero(np.sign(dx) != np.sign(np.roll(dx, -1)))
+    roots = [
+        brentq(lambda t: brute._dx("crank-shaper", p, t), brute.TH[i], brute.TH[i] + 2 * np.pi / brute.N, xtol=1e-15)
+        for i in cells
+    ]
+    (tmax, _), (tmin, _) = m._cycle["max"], m._cycle["min"]
+    assert m.dead_centres().reversals == 2 == tmax.size == tmin.size
+    assert np.sort(np.concatenate([tmax, tmin])) == pytest.approx(np.sort(roots), abs=1e-9)
+    assert max(roots) - min(r for r in roots if r > 6) < 0.09
+
+
+def test_a_turn_back_inside_a_stroke_smaller_than_a_dwell_is_not_a_reversal():
+    """cycle.dwells: a maximum and the minimum next to it that differ by less than DWELL of the travel, both inside
+    it, are a dwell; a deeper turn back, or one at an end of the travel, is a reversal. A coupler slider's
+    gamma_min optimum at TR 2.601, 0.9457 m turns back by 3.2e-6 m over 0.037 rad inside its return stroke (the
+    tests' own simulation finds the four stationary points): it reverses once, with the simulation's TR and
+    stroke from the global extremes."""
+    from scipy.optimize import brentq
+
+    import qropt
+    from qropt.kinematics import cycle
+
+    t, lo = np.array([0.5, 4.0]), np.array([3.0, 4.5])  # up to 1 at 0.5 rad, down to 0 at 3, up again (a turn back)
+    inside = (t, np.array([1.0, 0.4]), lo, np.array([0.0, 0.4 - 0.5 * cycle.DWELL]))
+    assert [a.size for a in cycle.dwells(*inside)] == [1, 1, 1, 1]
+    deeper = (t, np.array([1.0, 0.4]), lo, np.array([0.0, 0.4 - 2 * cycle.DWELL]))
+    assert [a.size for a in cycle.dwells(*deeper)] == [2, 2, 2, 2]
+    at_top = (t, np.array([1.0, 1.0]), lo, np.array([0.0, 1.0 - 0.5 * cycle.DWELL]))
+    assert [a.size for a in cycle.dwells(*at_top)] == [2, 2, 2, 2]
+    p = {"r1": 1.198195584921906, "r2": 0.3769383314548465, "r3": 0.9622750056248027, "r4": 0.849400025476614}
+    p.update({"r5": 4.728499999994298, "beta": 2.113737677334493, "r6": 3.58055534523629, "h": 1.084165444556271})
+    p.update({"sigma": -1.0, "sigma_slider": 1.0})
+
+    def dx(th):
+        return np.imag(brute.sixbar_x("coupler-slider", p, th + 1j * brute.STEP)) / brute.STEP
+
+    d = dx(brute.TH)
+    cells = np.flatnonzero(np.sign(d) != np.sign(np.roll(d, -1)))
+    roots = sorted(brentq(dx, brute.TH[i], brute.TH[i] + 2 * np.pi / brute.N, xtol=1e-15) for i in cells)
+    x = np.real(brute.sixbar_x("coupler-slider", p, np.array(roots)))
+    assert len(roots) == 4 and 2e-6 < np.abs(np.diff(x)).min() < 1e-5 * (x.max() - x.min())
+    m = qropt.CouplerSlider(**p)
+    assert m.dead_centres().reversals == 1
+    b_tr, b_stroke, _ = brute.task_values("coupler-slider", p)
+    assert (m.time_ratio(), m.stroke()) == pytest.approx((b_tr, b_stroke), abs=1e-9)
+    assert (b_tr, b_stroke) == pytest.approx((2.601, 0.9457), abs=1e-8)

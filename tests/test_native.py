@@ -35,7 +35,7 @@ def test_compiled_kernels_equal_the_vm(cls, cache):
     k = m._kernel
     p = k.vector(m.params)
     th = cycle.grid(180)
-    grid = k.grid_values(m.params, th)  # builds the Function
+    grid = k.grid_values(p, th)  # builds the Function
     vm_grid = Batched(k._groups["grid"].f)
     z = np.column_stack([th, np.broadcast_to(p, (th.size, p.size))])
     compiled = native.compiled(k._groups["grid"].f.map(th.size))

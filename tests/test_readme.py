@@ -133,7 +133,13 @@ def _serves(shell: str, cwd) -> None:
     import urllib.request
 
     env = {**os.environ, "BROWSER": "true"}  # webbrowser.open runs `true`: no browser here
-    p = subprocess.Popen(shlex.split(shell), cwd=cwd, env=env, stdout=subprocess.PIPE, text=True)
+
+    def ctrl_c_stops():  # as in a terminal (a shell's background job, and so pytest run as one, ignores SIGINT)
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+    p = subprocess.Popen(
+        shlex.split(shell), cwd=cwd, env=env, stdout=subprocess.PIPE, text=True, preexec_fn=ctrl_c_stops
+    )
     try:
         line = p.stdout.readline()
         url = re.search(r"http://\S+/", line)

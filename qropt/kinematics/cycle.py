@@ -18,6 +18,7 @@ TWO_PI = 2.0 * np.pi
 GRID = 720
 GRIDS = (180, 720, 2880)  # grids tried in turn for the compiled analysis (the first that resolves)
 MARGIN_TOL = 1e-12  # an assembly margin this far below zero is rounding (a change point), not a failure
+DWELL = 1e-5  # an output that turns back inside a stroke by less than this part of its travel dwells there
 
 
 @functools.lru_cache(maxsize=16)
@@ -108,3 +109,42 @@ def negative_intervals(margin, n: int = 3600):
         else:
             i += 1
     return out
+
+
+def dwells(tmax, xmax, tmin, xmin):
+    """The output's local maxima and minima (crank angles rad, values) without its dwells: a maximum and the
+    minimum next to it that differ by less than DWELL of the travel, both strictly inside it (neither within that
+    of the largest or the least value), are a turn back of the output inside a stroke too small to be a reversal
+    (an optimum whose velocity touches zero mid-stroke ends on either side of it by about 1e-6 of the stroke). A
+    pair at an end of the travel is kept: it moves the dead centre. Maxima and minima that do not alternate
+    around the turn are returned as they are."""
+    if tmax.size < 2 or tmax.size != tmin.size:
+        return tmax, xmax, tmin, xmin
+    points = sorted(
+        [(t, x, 1) for t, x in zip(tmax.tolist(), xmax.tolist(), strict=True)]
+        + [(t, x, -1) for t, x in zip(tmin.tolist(), xmin.tolist(), strict=True)]
+    )
+    if any(a[2] == b[2] for a, b in zip(points, points[1:] + points[:1], strict=True)):
+        return tmax, xmax, tmin, xmin
+    top, bottom = max(xmax.tolist()), min(xmin.tolist())
+    tol = DWELL * (top - bottom)
+    merged = True
+    while merged and len(points) > 2:
+        merged = False
+        for i in range(len(points)):
+            a, b = points[i], points[(i + 1) % len(points)]
+            hi, lo = max(a[1], b[1]), min(a[1], b[1])
+            if hi - lo < tol and hi < top - tol and lo > bottom + tol:
+                points = [q for k, q in enumerate(points) if k not in (i, (i + 1) % len(points))]
+                merged = True
+                break
+    if len(points) == tmax.size + tmin.size:
+        return tmax, xmax, tmin, xmin
+    kept_max = [(t, x) for t, x, kind in points if kind == 1]
+    kept_min = [(t, x) for t, x, kind in points if kind == -1]
+    return (
+        np.array([t for t, _ in kept_max]),
+        np.array([x for _, x in kept_max]),
+        np.array([t for t, _ in kept_min]),
+        np.array([x for _, x in kept_min]),
+    )

@@ -10,9 +10,9 @@ parameter; metres by default, see ``qropt.units``); theta2 counter-clockwise fro
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
-from functools import cached_property
 from types import MappingProxyType
 from typing import Any, ClassVar, NamedTuple
 
@@ -22,7 +22,7 @@ from qropt import units as units_
 from qropt.errors import AssemblyError, DegenerateMechanism, InvalidParameter, NoDeadCentres
 from qropt.kinematics import cycle
 from qropt.kinematics.closures import transmission_angle
-from qropt.kinematics.kernel import derivative_on_grid, kernel, resolved
+from qropt.kinematics.kernel import kernel, resolved_spectrum, spectral_derivative, spectrum
 from qropt.kinematics.ops import JET, NUMPY, Jet
 
 REQUIRED = object()  # a PARAMS default: the parameter has none and must be given
@@ -30,6 +30,22 @@ REGISTRY: dict[str, type[Mechanism]] = {}  # KIND -> the type (shipped types and
 PARAMETER_KINDS = ("length", "offset", "angle", "branch")  # what ``Mechanism.kinds()`` says of each parameter
 MAGNITUDE = 1e100  # lengths and offsets beyond this (or lengths below its inverse) overflow their squares
 MAX_ANGLES = 10_000_000  # crank angles evaluated in one call
+
+
+class cached_property:  # noqa: N801 - functools.cached_property without its lock (Python 3.11 takes one per read)
+    """A value computed on first read and kept in the instance's ``__dict__`` (later reads do not come here)."""
+
+    def __init__(self, func):
+        self.func, self.name, self.__doc__ = func, func.__name__, func.__doc__
+
+    def __set_name__(self, owner, name):
+        self.name = name
+
+    def __get__(self, obj, cls=None):
+        if obj is None:
+            return self
+        value = obj.__dict__[self.name] = self.func(obj)
+        return value
 
 
 def _finite(name: str, value) -> float:
@@ -47,6 +63,12 @@ def _finite(name: str, value) -> float:
     if abs(v) > MAGNITUDE:
         raise InvalidParameter(f"{name} = {v:g} is out of range (|value| <= 1e100)")
     return v
+
+
+@functools.cache
+def _scaled(cls) -> tuple[str, ...]:
+    """The parameters of a type that scale with its size: its lengths and offsets (``Mechanism.kinds()``)."""
+    return tuple(k for k, kind in cls.kinds().items() if kind in ("length", "offset"))
 
 
 def working_sign(max_to_min_is_slow: bool, omega2: float) -> float:
@@ -377,8 +399,8 @@ class Mechanism:
     def __init__(self, **params):
         name = type(self).__name__
         object.__setattr__(self, "units", units_.length_unit(params.pop("units", units_.DEFAULT)))
-        unknown = sorted(set(params) - set(self.PARAMS))
-        if unknown:
+        if params.keys() - self.PARAMS.keys():
+            unknown = sorted(params.keys() - self.PARAMS.keys())
             raise InvalidParameter(f"{name}: unknown parameter(s) {unknown}; it takes {list(self.PARAMS)}")
         values = {}
         for k, default in self.PARAMS.items():
@@ -387,7 +409,8 @@ class Mechanism:
                 raise InvalidParameter(f"{name}: missing parameter {k!r}; it needs {self.required()}")
             if v is None:
                 continue
-            v = _finite(f"{name}: {k}", v)
+            if type(v) is not float or not -MAGNITUDE <= v <= MAGNITUDE:  # the name only where it is needed
+                v = _finite(f"{name}: {k}", v)
             if k in self.LENGTHS and v <= 0:
                 raise InvalidParameter(f"{name}: length {k} must be positive, got {v:g}")
             if abs(v) > MAGNITUDE or (k in self.LENGTHS and v < 1 / MAGNITUDE):
@@ -442,8 +465,8 @@ class Mechanism:
 
     def broken_rules(self, grashof: str | None = None) -> list[str]:
         """Names of the rules these parameters break (beyond rounding)."""
-        kinds = self.kinds()
-        scale = max((abs(v) for k, v in self.params.items() if kinds[k] in ("length", "offset")), default=1.0)
+        p, scaled = self.params, _scaled(type(self))
+        scale = max([abs(p[k]) for k in scaled if k in p], default=1.0)
         broken = [r.name for r in self.rules(NUMPY, self.params, grashof) if r.value < -1e-12 * scale]
         return list(dict.fromkeys(broken))
 
@@ -536,19 +559,35 @@ class Mechanism:
         return kernel(type(self), tuple(self.params))
 
     @cached_property
-    def _grid(self):
+    def _vector(self) -> np.ndarray:
+        """The parameters as the kernel's vector (``params`` order)."""
+        p = np.array(list(self.params.values()))
+        p.flags.writeable = False
+        return p
+
+    @cached_property
+    def _sampled(self) -> tuple[np.ndarray, np.ndarray | None]:
         """Cycle quantities (x, cos^2 of each varying joint, margins) on the coarsest grid of GRIDS that
-        resolves them (or shows an assembly failure): (Q, n) on ``cycle.grid(n)``."""
+        resolves them (or shows an assembly failure): (Q, n) on ``cycle.grid(n)``; and their spectra (``spectrum``;
+        None where not computed or not finite)."""
         k = self._kernel
         for n in cycle.GRIDS:
-            q = k.grid_values(self.params, cycle.grid(n))
+            q = k.grid_values(self._vector, cycle.grid(n))
             margins = q[1 + len(k.joints) :]
             least = margins.min(initial=np.inf)
             if least != least:  # a nan sample: the least of the others
                 least = np.nanmin(margins, initial=np.inf)
-            if least < -cycle.MARGIN_TOL or resolved(q):
+            if least < -cycle.MARGIN_TOL:
+                return q, None
+            c = spectrum(q)
+            if c is not None and resolved_spectrum(c):
                 break
-        return q
+        return q, c
+
+    @cached_property
+    def _grid(self) -> np.ndarray:
+        """The cycle quantities on the coarsest grid that resolves them: (Q, n) (``_sampled``)."""
+        return self._sampled[0]
 
     @cached_property
     def _cycle(self) -> dict:
@@ -556,24 +595,26 @@ class Mechanism:
         k, q = self._kernel, self._grid
         nj, nm = len(k.joints), len(k.margin_names)
         margins_grid = q[1 + nj :]
-        least = np.fmin.reduce(margins_grid, axis=1, initial=np.inf)  # the least sample of each, nan left out
-        least[least == np.inf] = -np.inf  # no sample closes (every one nan): it cannot assemble anywhere
-        at = (margins_grid == least[:, None]).argmax(axis=1)
-        if (least < -cycle.MARGIN_TOL).any():  # cannot assemble: nothing else is defined
-            return {"margins": [(float(v), 0.0) for v in least]}
-        res = k.refine("cycle", q, k.cycle_requests, k.vector(self.params))
+        least = np.fmin.reduce(margins_grid, axis=1, initial=np.inf).tolist()  # the least sample of each, nan left out
+        least = [-math.inf if v == math.inf else v for v in least]  # no sample closes (every one nan): none anywhere
+        if min(least, default=0.0) < -cycle.MARGIN_TOL:  # cannot assemble: nothing else is defined
+            return {"margins": [(v, 0.0) for v in least]}
+        res = k.refine("cycle", q, k.cycle_requests, self._vector)
         gammas = {j: (res[2 + i].theta, res[2 + i].value) for i, j in enumerate(k.joints)}
         gammas.update({j: (np.zeros(1), np.full(1, math.pi / 2)) for j in k.right_joints})
         margins = []
         for m in range(nm):
             e = res[2 + nj + m]
             if e.value.size and e.value.min() < least[m]:
-                margins.append((float(e.value.min()), float(e.theta[np.argmin(e.value)])))
-            else:
-                margins.append((float(least[m]), float(cycle.grid(q.shape[1])[at[m]])))
+                i = int(e.value.argmin())
+                margins.append((float(e.value[i]), float(e.theta[i])))
+            else:  # the least sample's crank angle
+                at = int((margins_grid[m] == least[m]).argmax())
+                margins.append((least[m], float(cycle.grid(q.shape[1])[at])))
+        tmax, xmax, tmin, xmin = cycle.dwells(res[0].theta, res[0].value, res[1].theta, res[1].value)
         return {
-            "max": (res[0].theta, res[0].value),
-            "min": (res[1].theta, res[1].value),
+            "max": (tmax, xmax),
+            "min": (tmin, xmin),
             "gamma": gammas,
             "margins": margins,
         }
@@ -593,7 +634,7 @@ class Mechanism:
                 f"{self!r}: the output has no regular extremes over a crank turn (it turns fully, "
                 "or a dead centre falls on a singular position such as a change point)"
             )
-        i, j = int(np.argmax(xmax)), int(np.argmin(xmin))
+        i, j = int(xmax.argmax()), int(xmin.argmin())
         return DeadCentres(float(tmax[i]), float(tmin[j]), float(xmax[i]), float(xmin[j]), int(tmax.size))
 
     def dead_centres(self) -> DeadCentres:
@@ -639,11 +680,11 @@ class Mechanism:
         self._require_full_turn()
         best = None
         for joint, (t, v) in self._cycle["gamma"].items():
-            ok = np.flatnonzero(np.isfinite(v))
-            if ok.size:
-                k = ok[np.argmin(v[ok])]
-                if best is None or v[k] < best.value:
-                    best = GammaMin(float(v[k]), float(t[k]), joint)
+            finite = [(g, th) for g, th in zip(v.tolist(), t.tolist(), strict=True) if math.isfinite(g)]
+            if finite:
+                g, th = min(finite)  # the least; of equal ones, the first
+                if best is None or g < best.value:
+                    best = GammaMin(g, th, joint)
         if best is None:  # no finite refined minimum: a singular configuration; fall back to the grid
             th = cycle.grid()
             for joint, g in self.transmission_angles(th).items():
@@ -682,7 +723,7 @@ class Mechanism:
             lo, length = self.working_arc(omega2)
             inside = [(t, v) for t, v in cand if (t - lo) % cycle.TWO_PI <= length]
             ends = np.array([lo % cycle.TWO_PI, (lo + length) % cycle.TWO_PI])
-            acc = self._kernel.group("accel")[0].at(ends, self._kernel.vector(self.params))[0]
+            acc = self._kernel.group("accel")[0].at(ends, self._vector)[0]
             cand = inside + list(zip(ends.tolist(), acc.tolist(), strict=True))
         t, v = max(cand, key=lambda tv: abs(tv[1]))
         return PeakAcceleration(abs(v) * omega2 * omega2, float(t))
@@ -708,11 +749,16 @@ class Mechanism:
     def _derivative_extremes(self, group: str, order: int):
         # bracketed on the coarsest grid whose spectral derivative is resolved (exactly evaluated on the
         # finest grid otherwise), refined by Newton with exact higher derivatives
-        k, p = self._kernel, self._kernel.vector(self.params)
+        k, p = self._kernel, self._vector
         for n in cycle.GRIDS:
-            x = self._grid[0] if self._grid.shape[1] == n else k.grid_values(self.params, cycle.grid(n))[0]
-            d = derivative_on_grid(x, order)
-            if resolved(d[None, :]):
+            q, c = self._sampled
+            if q.shape[1] != n or c is None:
+                c = spectrum(k.grid_values(p, cycle.grid(n))[:1])
+            if c is None:
+                continue
+            c = c[:1] * spectral_derivative(n, order)
+            if resolved_spectrum(c):
+                d = np.fft.irfft(c[0], n)
                 break
         else:
             d = k.group(group)[0].at(cycle.grid(), p)[0]
@@ -730,7 +776,7 @@ class Mechanism:
         inside = (ts - lo) % cycle.TWO_PI <= length
         if not inside.any():  # no interior extreme: the largest of a fine grid over the arc (not expected)
             ts = lo + length * np.linspace(0.0, 1.0, 721)
-            vs = self._kernel.group("velocity")[0].at(ts, self._kernel.vector(self.params))[0]
+            vs = self._kernel.group("velocity")[0].at(ts, self._vector)[0]
             inside = np.ones(ts.size, bool)
         i = np.flatnonzero(inside)[np.argmax(np.abs(vs[inside]))]
         v = abs(float(vs[i]))
@@ -752,7 +798,7 @@ class Mechanism:
         k = self._kernel
         c = k.grid_coords(self.params, cycle.grid())
         q = c.shape[0]
-        res = k.refine("coords", c, [(i, kind) for i in range(q) for kind in ("max", "min")], k.vector(self.params))
+        res = k.refine("coords", c, [(i, kind) for i in range(q) for kind in ("max", "min")], self._vector)
         grid = cycle.grid()
         box, angles, coords = [], [], []
         for axis in (0, 1):
@@ -823,7 +869,7 @@ class Mechanism:
         if quantity == "peak_acceleration" and (omega2 is None or _finite("omega2", omega2) == 0.0):
             raise InvalidParameter(f"the peak acceleration's sensitivity needs a nonzero omega2 (rad/s), got {omega2}")
         self._require_full_turn()
-        k, p = self._kernel, self._kernel.vector(self.params)
+        k, p = self._kernel, self._vector
         n = p.size
         names = tuple(q for q in self.params if q not in self.BRANCHES)
         cols = [list(self.params).index(q) for q in names]
@@ -962,7 +1008,7 @@ class Mechanism:
         slack = 1e-12 * max(abs(lo_x), abs(hi_x), hi_x - lo_x)
         if np.any(target < lo_x - slack) or np.any(target > hi_x + slack):
             raise InvalidParameter(f"working_angle_at: x must lie within the stroke [{lo_x:.12g}, {hi_x:.12g}]")
-        q, p = self._kernel.group("cycle")[0], self._kernel.vector(self.params)
+        q, p = self._kernel.group("cycle")[0], self._vector
         x0, x1 = (d.x_max, d.x_min) if start == d.theta_max else (d.x_min, d.x_max)
         rising = x1 > x0
         a, b = np.full(target.shape, start), np.full(target.shape, start + length)

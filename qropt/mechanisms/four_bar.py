@@ -3,6 +3,7 @@ and the shared loop of the four-bar-driven sliders (C on ray O4->B at r5, rod CD
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import ClassVar, NamedTuple
 
@@ -71,11 +72,21 @@ def grashof_rules(xp, p, kind: str) -> list[Rule]:
     s = SHORTEST[kind]
     total = p["r1"] + p["r2"] + p["r3"] + p["r4"]
     out = []
-    for k in LINKS:
-        if k != s:
-            out.append(Rule(f"grashof {kind}: {s} <= {k}", p[k] - p[s]))
-            out.append(Rule(f"grashof {kind}: 2({s} + {k}) <= r1 + r2 + r3 + r4", total - 2 * (p[s] + p[k])))
+    for k, shorter, sum_ in _grashof_names(kind):
+        out.append(Rule(shorter, p[k] - p[s]))
+        out.append(Rule(sum_, total - 2 * (p[s] + p[k])))
     return out
+
+
+@functools.cache
+def _grashof_names(kind: str) -> tuple[tuple[str, str, str], ...]:
+    """(link, name of 'shortest <= link', name of the sum rule) for each link but the shortest of a class."""
+    s = SHORTEST[kind]
+    return tuple(
+        (k, f"grashof {kind}: {s} <= {k}", f"grashof {kind}: 2({s} + {k}) <= r1 + r2 + r3 + r4")
+        for k in LINKS
+        if k != s
+    )
 
 
 class _FourBarBase(Mechanism):
@@ -152,9 +163,9 @@ class FourBarSlider(_FourBarBase):
         return grashof_rules(xp, p, grashof or cls.CLASS)
 
     def validate(self):
-        g = self.grashof()
-        p = {k: self.params[k] for k in LINKS}
         if self.broken_rules():
+            g = self.grashof()
+            p = {k: self.params[k] for k in LINKS}
             raise GrashofError(
                 f"{type(self).__name__} needs a Grashof {self.CLASS} ({self.SHORTEST} shortest, s + l <= p + q); "
                 f"got {g.kind}: shortest {g.shortest}={p[g.shortest]:g}, s + l = {g.s_plus_l:g}, "

@@ -477,6 +477,11 @@ def _crank_shaper(c: _Context):
             for r1 in np.geomspace(lo, hi, FAMILY_POINTS):
                 emit(r1=float(r1), r2=float(ratio * r1), **lever)
             return result("family", how)
+        missing = _lever_outside(free, val, ratio, lever)
+        if missing:  # with a rod too: its slider reverses where the lever does (or more than once a turn)
+            return result(
+                "enumeration", f"sin(beta) = r2/r1 fixes the TR and stroke = 2 r4 r2/r1 (with a rod too): {missing}"
+            )
         rod = "r6" in free and "h" not in free and stroke is not None and len(free) == 3 and "r4" in free
         if rod and ("r2" in free) != ("r1" in free):  # the rod's slider reverses where the lever does
             for r6 in np.geomspace(*free["r6"], FAMILY_POINTS):
@@ -508,6 +513,21 @@ def slot_ram_shaper_gamma_min(r1: float, r2: float) -> float:
     """gamma_min = acos(r2/r1) of a slot-ram shaper: at D, the lever at its extremes meets the slide line at
     pi/2 - beta (the block at A transmits at 90 degrees)."""
     return math.acos(r2 / r1)
+
+
+def _lever_outside(free, val, ratio, lever) -> str:
+    """Why no crank-shaper (with or without a rod) with r2/r1 = ``ratio`` and the ``lever`` r4 it needs lies inside
+    the bounds, or '' (also where r4 is not free or neither crank link is)."""
+    if not lever:
+        return ""
+    if "r1" in free and "r2" in free:
+        lo, hi = max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1], free["r2"][1] / ratio)
+        return _outside(free, lever, lo, hi, "r1")
+    if "r2" in free:
+        return _outside(free, {**lever, "r2": ratio * val["r1"]}, 0.0, 0.0, "r1")
+    if "r1" in free:
+        return _outside(free, {**lever, "r1": val["r2"] / ratio}, 0.0, 0.0, "r1")
+    return ""
 
 
 def _outside(free, fixed_along, lo, hi, walker) -> str:

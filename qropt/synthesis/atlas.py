@@ -24,6 +24,8 @@ from qropt.synthesis import criteria, scaling
 
 PATH = Path(__file__).with_name("atlas.json")
 SHAPE_CONDITIONS = ("grashof", "gamma_min")  # conditions that do not change with the scale
+SAME = 0.02  # a node's designs this close in every parameter (strokes for lengths and offsets, rad for angles) are
+# one start: the solve from the second ended where the first's did (docs/benchmarks.md)
 
 
 def _round(x: float) -> float:
@@ -77,6 +79,11 @@ def _entries() -> dict:
     return {e["signature"]: e for e in data["entries"]}
 
 
+def _same(a: dict, b: dict) -> bool:
+    """Whether two designs of a node are one start: the same branch and every parameter within SAME."""
+    return a["branch"] == b["branch"] and all(abs(x - b["params"][k]) < SAME for k, x in a["params"].items())
+
+
 def starts(problem) -> Starts:
     """The atlas's designs at the nodes around the problem's time ratio, scaled to its stroke and clipped to its
     bounds; empty where its signature is not in the atlas or its TR is outside the nodes."""
@@ -92,7 +99,11 @@ def starts(problem) -> Starts:
     s = float(problem.targets["stroke"])
     out, node = [], []
     for n, j in enumerate(around):
+        kept = []
         for d in entry["designs"][j]:
+            if any(_same(d, e) for e in kept):
+                continue
+            kept.append(d)
             v = {k: x * s if scaling.scales(problem, k) else x for k, x in d["params"].items()}
             v = {k: min(max(v[k], lo), hi) for k, (lo, hi) in problem.free.items()}
             out.append((v, {k: float(b) for k, b in d["branch"].items()}))
