@@ -267,3 +267,18 @@ def test_a_turn_back_inside_a_stroke_smaller_than_a_dwell_is_not_a_reversal():
     b_tr, b_stroke, _ = brute.task_values("coupler-slider", p)
     assert (m.time_ratio(), m.stroke()) == pytest.approx((b_tr, b_stroke), abs=1e-9)
     assert (b_tr, b_stroke) == pytest.approx((2.601, 0.9457), abs=1e-8)
+
+
+def test_of_equal_transmission_minima_the_first_found_is_named():
+    """A centred slider-crank has its least transmission angle at theta2 = pi/2 and 3 pi/2, exactly equal: the
+    first refined minimum is named (as numpy's argmin did), not the smaller crank angle."""
+    import qropt
+
+    m = qropt.SliderCrank(r2=0.1, r3=0.3, e=0.0)
+    t, v = m._cycle["gamma"]["C"]
+    assert v.size == 2 and v[0] == v[1]
+    assert m.gamma_min().theta2 == t[0]
+    swapped = {"C": (t[::-1].copy(), v[::-1].copy())}
+    m.__dict__.pop("_gamma_min")  # the cached value, computed again from the minima in the other order
+    m.__dict__["_cycle"] = {**m._cycle, "gamma": swapped}
+    assert m.gamma_min().theta2 == t[1]

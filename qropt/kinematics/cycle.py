@@ -121,8 +121,8 @@ def dwells(tmax, xmax, tmin, xmin):
     if tmax.size < 2 or tmax.size != tmin.size:
         return tmax, xmax, tmin, xmin
     points = sorted(
-        [(t, x, 1) for t, x in zip(tmax.tolist(), xmax.tolist(), strict=True)]
-        + [(t, x, -1) for t, x in zip(tmin.tolist(), xmin.tolist(), strict=True)]
+        [(t, x, 1, i) for i, (t, x) in enumerate(zip(tmax.tolist(), xmax.tolist(), strict=True))]
+        + [(t, x, -1, i) for i, (t, x) in enumerate(zip(tmin.tolist(), xmin.tolist(), strict=True))]
     )
     if any(a[2] == b[2] for a, b in zip(points, points[1:] + points[:1], strict=True)):
         return tmax, xmax, tmin, xmin
@@ -140,11 +140,7 @@ def dwells(tmax, xmax, tmin, xmin):
                 break
     if len(points) == tmax.size + tmin.size:
         return tmax, xmax, tmin, xmin
-    kept_max = [(t, x) for t, x, kind in points if kind == 1]
-    kept_min = [(t, x) for t, x, kind in points if kind == -1]
-    return (
-        np.array([t for t, _ in kept_max]),
-        np.array([x for _, x in kept_max]),
-        np.array([t for t, _ in kept_min]),
-        np.array([x for _, x in kept_min]),
-    )
+    keep_max, keep_min = np.zeros(tmax.size, bool), np.zeros(tmin.size, bool)  # the kept ones, in their order
+    for *_, kind, i in points:
+        (keep_max if kind == 1 else keep_min)[i] = True
+    return tmax[keep_max], xmax[keep_max], tmin[keep_min], xmin[keep_min]

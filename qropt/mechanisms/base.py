@@ -682,7 +682,7 @@ class Mechanism:
         for joint, (t, v) in self._cycle["gamma"].items():
             finite = [(g, th) for g, th in zip(v.tolist(), t.tolist(), strict=True) if math.isfinite(g)]
             if finite:
-                g, th = min(finite)  # the least; of equal ones, the first
+                g, th = min(finite, key=lambda gt: gt[0])  # the least; of equal ones, the first
                 if best is None or g < best.value:
                     best = GammaMin(g, th, joint)
         if best is None:  # no finite refined minimum: a singular configuration; fall back to the grid
