@@ -497,12 +497,6 @@ def resolved_spectrum(c) -> bool:
     return bool((a[:, -(a.shape[1] // 4) :].max(axis=1) <= scale).all())
 
 
-def resolved(q) -> bool:
-    """Whether the uniform periodic samples q (Q, n) resolve every row (``resolved_spectrum``)."""
-    c = spectrum(q)
-    return c is not None and resolved_spectrum(c)
-
-
 @functools.cache
 def spectral_derivative(n: int, order: int) -> np.ndarray:
     """The factors (i k)^order that turn the rfft of n uniform periodic samples into their order-th derivative's
@@ -515,4 +509,4 @@ def spectral_derivative(n: int, order: int) -> np.ndarray:
     return f
 
 
-__all__ = ["kernel", "Kernel", "Extremes", "resolved", "resolved_spectrum", "spectrum", "spectral_derivative"]
+__all__ = ["kernel", "Kernel", "Extremes", "resolved_spectrum", "spectrum", "spectral_derivative"]

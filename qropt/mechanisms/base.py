@@ -66,8 +66,7 @@ def _finite(name: str, value) -> float:
 
 
 @functools.cache
-def _scaled(cls) -> tuple[str, ...]:
-    """The parameters of a type that scale with its size: its lengths and offsets (``Mechanism.kinds()``)."""
+def _scalable(cls) -> tuple[str, ...]:
     return tuple(k for k, kind in cls.kinds().items() if kind in ("length", "offset"))
 
 
@@ -343,6 +342,12 @@ class Mechanism:
         return out
 
     @classmethod
+    def scalable(cls) -> tuple[str, ...]:
+        """The parameters that scale with the mechanism's size, in PARAMS order: its lengths and offsets (``kinds``;
+        not the angles or branch signs). Kept per type."""
+        return _scalable(cls)
+
+    @classmethod
     def warm_starts(cls, problem):
         """Starting designs for a synthesis problem of this type (override): a ``WarmStarts`` of
         ``qropt.synthesis.analytic`` (free-parameter dicts, their kind and how they were found), or None for the
@@ -465,8 +470,8 @@ class Mechanism:
 
     def broken_rules(self, grashof: str | None = None) -> list[str]:
         """Names of the rules these parameters break (beyond rounding)."""
-        p, scaled = self.params, _scaled(type(self))
-        scale = max([abs(p[k]) for k in scaled if k in p], default=1.0)
+        p = self.params
+        scale = max([abs(p[k]) for k in self.scalable() if k in p], default=1.0)
         broken = [r.name for r in self.rules(NUMPY, self.params, grashof) if r.value < -1e-12 * scale]
         return list(dict.fromkeys(broken))
 
@@ -750,9 +755,10 @@ class Mechanism:
         # bracketed on the coarsest grid whose spectral derivative is resolved (exactly evaluated on the
         # finest grid otherwise), refined by Newton with exact higher derivatives
         k, p = self._kernel, self._vector
+        sampled, spectra = self._sampled
         for n in cycle.GRIDS:
-            q, c = self._sampled
-            if q.shape[1] != n or c is None:
+            c = spectra if sampled.shape[1] == n else None
+            if c is None:
                 c = spectrum(k.grid_values(p, cycle.grid(n))[:1])
             if c is None:
                 continue

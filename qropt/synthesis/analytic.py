@@ -468,16 +468,14 @@ def _crank_shaper(c: _Context):
         ratio = crank_shaper_ratio(tr)
         lever = {"r4": stroke / (2 * ratio)} if stroke is not None and "r4" in free else {}
         yoke = "r6" not in fixed and "r6" not in free
+        missing = _lever_outside(free, val, ratio, lever)  # every design shares r2/r1 and r4: none in the bounds
         if yoke and stroke is not None and set(free) == {"r1", "r2", "r4"}:  # r1 walks the family, r4 fixed
             how = "sin(beta) = r2/r1 fixes the TR; stroke = 2 r4 r2/r1; r1 walks the family"
-            lo, hi = max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1], free["r2"][1] / ratio)
-            missing = _outside(free, lever, lo, hi, "r1")
-            if missing:  # the family holds every design: none lies inside the bounds
+            if missing:
                 return result("enumeration", f"{how}: {missing}")
-            for r1 in np.geomspace(lo, hi, FAMILY_POINTS):
+            for r1 in np.geomspace(*_crank_range(free, ratio), FAMILY_POINTS):
                 emit(r1=float(r1), r2=float(ratio * r1), **lever)
             return result("family", how)
-        missing = _lever_outside(free, val, ratio, lever)
         if missing:  # with a rod too: its slider reverses where the lever does (or more than once a turn)
             return result(
                 "enumeration", f"sin(beta) = r2/r1 fixes the TR and stroke = 2 r4 r2/r1 (with a rod too): {missing}"
@@ -515,14 +513,18 @@ def slot_ram_shaper_gamma_min(r1: float, r2: float) -> float:
     return math.acos(r2 / r1)
 
 
+def _crank_range(free, ratio) -> tuple[float, float]:
+    """(lo, hi): the r1 in its bounds whose crank r2 = ratio r1 lies in r2's (lo > hi where none does)."""
+    return max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1], free["r2"][1] / ratio)
+
+
 def _lever_outside(free, val, ratio, lever) -> str:
     """Why no crank-shaper (with or without a rod) with r2/r1 = ``ratio`` and the ``lever`` r4 it needs lies inside
     the bounds, or '' (also where r4 is not free or neither crank link is)."""
     if not lever:
         return ""
     if "r1" in free and "r2" in free:
-        lo, hi = max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1], free["r2"][1] / ratio)
-        return _outside(free, lever, lo, hi, "r1")
+        return _outside(free, lever, *_crank_range(free, ratio), "r1")
     if "r2" in free:
         return _outside(free, {**lever, "r2": ratio * val["r1"]}, 0.0, 0.0, "r1")
     if "r1" in free:
@@ -567,7 +569,7 @@ def _slot_ram_shaper(c: _Context):
     h = {"h": stroke * math.sqrt(1.0 - ratio * ratio) / (2.0 * ratio)} if both and "h" in free else {}
     how = "sin(beta) = r2/r1 fixes the TR; h = stroke sqrt(r1^2 - r2^2) / (2 r2)"
     if len(crank) == 2:  # the family: r1 over its bounds (and r2's over the ratio)
-        lo, hi = max(free["r1"][0], free["r2"][0] / ratio), min(free["r1"][1], free["r2"][1] / ratio)
+        lo, hi = _crank_range(free, ratio)
         exact = len(free) == len(tg) + 1 and ("h" in free) == both
         missing = _outside(free, {"h": (h["h"], -h["h"])}, lo, hi, "r1") if h else ""
         if missing and exact:  # the family holds every design: none inside the bounds

@@ -42,9 +42,9 @@ def factor(problem) -> float:
 
 
 def scales(problem, name: str) -> bool:
-    """Whether a parameter scales with the lengths: a length or an offset (``Mechanism.kinds()``), not an angle or
-    a branch sign."""
-    return problem.mechanism.kinds().get(name) in ("length", "offset")
+    """Whether a parameter scales with the lengths: a length or an offset (``Mechanism.scalable()``), not an angle
+    or a branch sign."""
+    return name in problem.mechanism.scalable()
 
 
 def scaled(problem, k: float):

@@ -252,10 +252,13 @@ class Solver:
         if not ties or c is None or c.size or not c.kinematic or r.status != "optimal":
             return r
         tol = TIE_TOL * max(1.0, abs(r.objective))
-        bound = r.objective - tol if c.maximise else r.objective + tol
         old = problem.conditions.get(c.bound)
-        if old is not None and c.better(old, bound):
-            bound = old
+
+        def within(k):  # k tol worse than the optimum, or the problem's own bound where that is stricter
+            v = r.objective - k * tol if c.maximise else r.objective + k * tol
+            return old if old is not None and c.better(old, v) else v
+
+        bound = within(1)
         start = [{k: r.params[k] for k in problem.free}]
         kw = {"targets": targets, "seed": seed, "max_rounds": max_rounds, "diagnose": False}
         bounded = problem.replace(objective="min_size", conditions={**problem.conditions, c.bound: bound})
@@ -266,9 +269,7 @@ class Solver:
             tries += [(bounded, {}), (alone, {})]
         # the bound holds at the sub-solve's design to rounding (1e-13 at the Whitworth's): accepted within 2 tol
         # of the optimum, so that a bit either way (a kernel compiled or not) does not decide
-        accept = r.objective - 2 * tol if c.maximise else r.objective + 2 * tol
-        if old is not None and c.better(old, accept):
-            accept = old
+        accept = within(2)
         for sub, how in tries:
             s = self.solve(sub, starts_n=0, **how, **kw)
             if s.status == "optimal" and not c.better(accept, s.quantities[c.name]):

@@ -160,7 +160,7 @@ def screen(problem, n: int, seed: int, build) -> list[dict]:
     if good.size == 0:
         return []
     target = problem.targets.get("stroke")
-    scalable = [k for k, kind in problem.mechanism.kinds().items() if kind in ("length", "offset")]
+    scalable = list(problem.mechanism.scalable())
     if target is not None and not any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable):
         k = target / stroke[good]  # designs that fit the bounds once scaled to the stroke go first
         fits = np.ones(good.size, bool)
@@ -235,7 +235,7 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
     target, best first by the objective's grid value (gamma_min, the peak acceleration at omega2 or the
     footprint). [] where scaling is not free or the objective has no grid value here. Grid values choose starts;
     results come from the local solves."""
-    scalable = [k for k, kind in problem.mechanism.kinds().items() if kind in ("length", "offset")]
+    scalable = list(problem.mechanism.scalable())
     grid_objective = {"max_gamma_min": 0, "min_peak_accel": 1}.get(problem.objective)
     if problem.objective == "min_size" and problem.size == "footprint":
         grid_objective = 2
@@ -338,7 +338,7 @@ def _to_stroke(problem, values, branch, build, stroke: float | None = None) -> d
     """The design scaled so that its stroke (given, or evaluated) meets the target, if scaling is free and stays
     in bounds."""
     target = problem.targets.get("stroke")
-    scalable = [k for k, kind in problem.mechanism.kinds().items() if kind in ("length", "offset")]
+    scalable = list(problem.mechanism.scalable())
     if target is None or any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable):
         return values
     try:
