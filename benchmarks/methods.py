@@ -75,9 +75,10 @@ def local_starts(problem, seed, starts_n=STARTS, solver=DEFAULT):
                 th0, way = starts.dead_centre_start(problem, v, br, targets, way, None)
                 form = solver.formulation(problem, br, way)
                 samples, fractions = form.base_samples()
-                phi, box = form.lifted_start(problem, v)  # the lifted extremes, as qropt starts them
+                phi, box, turn = form.lifted_start(problem, v, theta=th0)  # the lifted angles, as qropt starts them
                 p = form.param_vector(problem, targets, samples, fractions, box=box)
-                yield origin, v, br, way, form, form.epigraph_start(form.pack(v, th0, phi=phi, box=box), p), p
+                w0 = form.pack(v, th0, phi=phi, box=box, turn=turn)
+                yield origin, v, br, way, form, form.epigraph_start(w0, p), p
 
 
 def local_solve(problem, form, w0, p, method="SLSQP"):

@@ -117,8 +117,9 @@ class _Curve:
         self.form = form = solver.formulation(problem.replace(objective=None), branch, orientation)
         u = form.design_sym  # the free parameters and the dead centres
         n = u.numel()
-        eq = np.flatnonzero(form.lbg == form.ubg)
-        ineq = np.flatnonzero(form.lbg != form.ubg)
+        mine = form.design_rows  # a guarded NLP's turn-back rows are in its lifted angles, not in u
+        eq = mine[form.lbg[mine] == form.ubg[mine]]
+        ineq = mine[form.lbg[mine] != form.ubg[mine]]
         f = form.g_sym[eq.tolist()] - casadi.DM(form.lbg[eq])
         g = form.g_sym[ineq.tolist()]
         self.fun = casadi.Function("F", [u, form.p_sym], [f, casadi.jacobian(f, u), g])

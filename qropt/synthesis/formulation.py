@@ -4,7 +4,9 @@ Decision variables (named blocks, see ``Point``): the free parameters, the dead-
 theta_min), the criteria's epigraph variables z, their lifted crank angles phi and the footprint's box sides psi.
 The dead centres are lifted: the output velocity vanishes there and its curvature has the right sign, so TR is
 the linear equality ``theta_min - theta_max = 2 pi TR / (TR + 1)`` (or ``2 pi / (TR + 1)``, by orientation) and
-the stroke a difference of two positions. Continuous-cycle quantities enter through sample angles that are CasADi
+the stroke a difference of two positions. A guarded NLP (a type whose output can reverse more than once a turn)
+lifts the output's turn-backs too: crank angles inside each stroke where the output velocity is stationary and
+keeps the stroke's sign. Continuous-cycle quantities enter through sample angles that are CasADi
 parameters, so the exchange loop adds angles without a rebuild; a type's exact transmission hints
 (``EXACT_TRANSMISSION``) are evaluated where they are. Parameters (named blocks too): fixed values, targets, sample
 angles, working-arc fractions, bound values and the box sides' coordinate picks. Each criterion states its own
@@ -32,7 +34,9 @@ TWO_PI = 2.0 * math.pi
 BASE_SAMPLES = 8  # uniform sample angles of the epigraphs; the exchange loop adds what binds
 EXTRA_SAMPLES = 8  # slots for the exchange loop's angles
 EXTREME_SLACK = 1e-6  # of the travel: how far the output may pass a dead centre's in the NLP (the certifier: 0)
-MONOTONE = 2  # crank angles per stroke where the output's velocity keeps the stroke's sign (placed by the certifier)
+MONOTONE = 2  # lifted turn-back angles per stroke of a guarded NLP (placed where the certifier finds a turn-back)
+TURN_GRID = 362  # points per stroke where a design's turn-backs are looked for (the start of the lifted angles)
+TURN_NEAR = 0.05  # rad: a turn-back found this close to a lifted one is that one, moved
 BOX_SIDES = ("x_max", "-x_min", "y_max", "-y_min")  # the footprint's epigraph order (BoundingBox order differs)
 
 
@@ -106,13 +110,14 @@ class Blocks:
 
 class Point(NamedTuple):
     """A point of the NLP: free parameter values (dict), the dead centres (theta_max, theta_min), epigraph
-    values z, lifted angles phi and box-side angles psi (arrays)."""
+    values z, lifted angles phi, box-side angles psi and a guarded NLP's turn-back angles (arrays)."""
 
     values: dict
     theta: np.ndarray
     z: np.ndarray
     phi: np.ndarray
     psi: np.ndarray
+    turn: np.ndarray
 
 
 IPOPT = {
@@ -183,10 +188,10 @@ class Formulation:
         self._start = TH[0] if orientation > 0 else TH[1]
         self._length = (TH[1] - TH[0]) if orientation > 0 else TWO_PI - (TH[1] - TH[0])
         self._W, self._working, self._returning, self._strokes = W, None, None, None
-        MONO = casadi.SX.sym("mono", 2 * MONOTONE if guarded else 0)  # fractions of the falling, rising strokes
+        TURN = casadi.SX.sym("turn", 2 * MONOTONE if guarded else 0)  # turn-back angles: falling, rising strokes
         travel, span = self._core_rows(TH, PT)
         if guarded:
-            self._guard_rows(TH, MONO)
+            self._guard_rows(TH, TURN)
         self._condition_rows(problem)
 
         # auxiliary variables first (the epigraph groups may use them), each above its expressions
@@ -262,7 +267,9 @@ class Formulation:
             self.row(f"{key} bound", self._measure(c, Z) - PB[i], -casadi.inf, 0.0, RowKind.BOUND)
         f = self._objective(Z, travel, span)
 
-        self.w_blocks = Blocks(free=len(self.free), theta=2, z=len(self.z_names), phi=len(self.lifts), psi=n_box)
+        self.w_blocks = Blocks(
+            free=len(self.free), theta=2, z=len(self.z_names), phi=len(self.lifts), psi=n_box, turn=TURN.numel()
+        )
         self.p_blocks = Blocks(
             fixed=len(self.fixed),
             targets=len(self.targets),
@@ -271,10 +278,9 @@ class Formulation:
             bounds=len(self.bound_keys),
             select=n_box * self.n_coords,
             caps=CAP.numel(),
-            monotone=MONO.numel(),
         )
-        self.w_sym = casadi.vertcat(X, TH, Z, PHI, PSI)
-        self.p_sym = casadi.vertcat(PF, PT, S, W, PB, SEL, CAP, MONO)
+        self.w_sym = casadi.vertcat(X, TH, Z, PHI, PSI, TURN)
+        self.p_sym = casadi.vertcat(PF, PT, S, W, PB, SEL, CAP)
         self.caps_fun = casadi.Function("caps", [self.w_sym, self.p_sym], [self._capped])
         self.g_sym, self.f_sym = casadi.vertcat(*[r.expr for r in self.rows]), f
         self.design_sym = casadi.vertcat(X, TH)  # the free parameters and the dead centres
@@ -282,6 +288,11 @@ class Formulation:
         self.nlp = {"x": self.w_sym, "p": self.p_sym, "f": f, "g": self.g_sym}
         self.epi_fun = casadi.Function("epi", [self.w_sym, self.p_sym], [casadi.vertcat(*[e for _, e in epi], 0)])
         self.epi_index = np.array([zi for zi, _ in epi], int)
+        # the rows of the design alone (free parameters, dead centres): all but the turn-backs' (a family's curve)
+        self.design_rows = np.array(
+            [i for i, r in enumerate(self.rows) if not TURN.numel() or not casadi.depends_on(casadi.SX(r.expr), TURN)],
+            int,
+        )
         self.lbg = np.array([r.lb for r in self.rows], float)
         self.ubg = np.array([r.ub for r in self.rows], float)
         self.nx, self.nz, self.n_lift, self.n_box = len(self.free), len(self.z_names), len(self.lifts), n_box
@@ -389,21 +400,63 @@ class Formulation:
                 self.row(k, travel - tgt[k], 0.0, 0.0, RowKind.TARGET)
         return travel, span
 
-    def _guard_rows(self, TH, MONO):
-        """Rows a solve adds where the certifier found the output reversing away from the NLP's dead centres: at
-        every sample angle the output is below its maximum and above its minimum (the certifier's extremes are
-        sampled), and at the fractions MONO of the falling stroke (theta_max to theta_min, ccw) then of the rising
-        one its velocity keeps the stroke's sign."""
+    def _guard_rows(self, TH, TURN):
+        """The rows of a type whose output can reverse more than once a turn: at every sample angle the output is
+        below its maximum and above its minimum (the certifier's extremes are sampled), and at each lifted
+        turn-back angle TURN (MONOTONE in the falling stroke, theta_max to theta_min ccw, then MONOTONE in the
+        rising one) the output velocity is stationary and keeps the stroke's sign. A lifted angle follows its
+        turn-back as the design moves, so a design whose velocity touches zero inside a stroke is a regular
+        point of the NLP (fixed angles there trade one turn-back for another, round after round)."""
         (x_max, *_), (x_min, *_) = self.dead
         slack = EXTREME_SLACK * (x_max - x_min)  # a sample at a dead centre: not an active row without a gradient
         for k, out in enumerate(self.sampled):
             self.row(f"sample {k}: output below its maximum", x_max - out.x + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
             self.row(f"sample {k}: output above its minimum", out.x - x_min + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
-        fall = TH[1] - TH[0]  # the output falls from theta_max to theta_min (ccw) and rises on the rest of the turn
-        for k in range(MONOTONE):
-            down, up = self.at(TH[0] + MONO[k] * fall).v, self.at(TH[1] + MONO[MONOTONE + k] * (TWO_PI - fall)).v
-            self.row(f"falling stroke, point {k}: output velocity <= 0", down, -casadi.inf, 0.0, RowKind.DEAD_CENTRE)
-            self.row(f"rising stroke, point {k}: output velocity >= 0", up, 0.0, casadi.inf, RowKind.DEAD_CENTRE)
+        for k in range(2 * MONOTONE):
+            falling = k < MONOTONE  # the output falls from theta_max to theta_min (ccw), rises on the rest of the turn
+            lo, hi = (TH[0], TH[1]) if falling else (TH[1], TH[0] + TWO_PI)
+            name, out = f"{'falling' if falling else 'rising'} stroke, turn-back {k % MONOTONE}", self.at(TURN[k])
+            self.row(f"{name}: output velocity stationary", out.a, 0.0, 0.0, RowKind.LIFT)
+            self.row(f"{name}: inside the stroke", TURN[k] - lo, 0.0, casadi.inf, RowKind.LIFT)
+            self.row(f"{name}: inside the stroke", hi - TURN[k], 0.0, casadi.inf, RowKind.LIFT)
+            if falling:
+                self.row(f"{name}: output velocity <= 0", out.v, -casadi.inf, 0.0, RowKind.DEAD_CENTRE)
+            else:
+                self.row(f"{name}: output velocity >= 0", out.v, 0.0, casadi.inf, RowKind.DEAD_CENTRE)
+
+    def turn_start(self, m, theta, turned=(), now=None) -> np.ndarray:
+        """The lifted turn-back angles (MONOTONE per stroke, falling then rising) at mechanism m for the NLP's
+        dead centres ``theta``: in each stroke the velocity's worst turn back (its stationary point nearest to the
+        wrong sign) and its fastest point (both where it has no turn back), and the
+        certifier's turn-backs ``turned`` ((stroke, fraction along it), ``certificate.wrong_way``) in the slot
+        whose angle in ``now`` (the current ones) is within TURN_NEAR of it, else in the other one of its
+        stroke."""
+        th0, th1 = float(theta[0]), float(theta[1])
+        fall = th1 - th0
+        spans = ((th0, fall), (th1, TWO_PI - fall))
+        if now is None:
+            now = np.zeros(2 * MONOTONE)
+            grid = np.linspace(0.0, 1.0, TURN_GRID)[1:-1]
+            for s, (lo, arc) in enumerate(spans):
+                t = lo + grid * arc
+                v = np.asarray(m.slider(t).v, float) * (1.0 if s == 0 else -1.0)  # > 0: against the stroke
+                v = np.where(np.isfinite(v), v, -np.inf)
+                fastest = int(np.argmin(np.where(np.isfinite(v), v, np.inf)))
+                bumps = np.flatnonzero((v[1:-1] > v[:-2]) & (v[1:-1] >= v[2:])) + 1  # the velocity's turns back
+                worst = int(bumps[np.argmax(v[bumps])]) if bumps.size else fastest
+                now[s * MONOTONE : (s + 1) * MONOTONE] = t[worst], t[fastest]
+        else:
+            now = np.array(now, float)
+        for s, fraction in turned:
+            lo, arc = spans[s]
+            t = lo + fraction * arc
+            slots = range(s * MONOTONE, (s + 1) * MONOTONE)
+            gaps = [abs((now[i] - t + math.pi) % TWO_PI - math.pi) for i in slots]
+            i = min(slots, key=lambda i: gaps[i - s * MONOTONE])
+            if gaps[i - s * MONOTONE] > TURN_NEAR:  # a new turn-back: in the slot not holding the nearest one
+                i = max(slots, key=lambda i: gaps[i - s * MONOTONE])
+            now[i] = t
+        return now
 
     def _condition_rows(self, problem):
         p, c = self.params, problem.conditions
@@ -430,19 +483,26 @@ class Formulation:
     def unpack(self, w) -> Point:
         """The named blocks of an NLP point."""
         b = self.w_blocks.split(w)
-        return Point(dict(zip(self.free, b["free"].tolist(), strict=True)), b["theta"], b["z"], b["phi"], b["psi"])
+        values = dict(zip(self.free, b["free"].tolist(), strict=True))
+        return Point(values, b["theta"], b["z"], b["phi"], b["psi"], b["turn"])
 
-    def pack(self, values: dict, theta, z=None, phi=None, box=None) -> np.ndarray:
+    def pack(self, values: dict, theta, z=None, phi=None, box=None, turn=None) -> np.ndarray:
         """w from free values, dead-centre angles, epigraph values and the lifted angles: ``phi`` (the criteria's
-        lifted extremes, spread over the turn where missing) and ``box`` (a BoundingBox, for the sides' angles)."""
+        lifted extremes, spread over the turn where missing), ``box`` (a BoundingBox, for the sides' angles) and
+        ``turn`` (a guarded NLP's turn-back angles, ``turn_start``; mid-stroke where missing)."""
         phi = list(phi if phi is not None else np.linspace(0.0, math.pi, self.n_lift))[: self.n_lift]
         phi += [0.0] * (self.n_lift - len(phi))
+        if turn is None:
+            fall = float(theta[1] - theta[0])
+            mid = (float(theta[0]) + 0.5 * fall, float(theta[1]) + 0.5 * (TWO_PI - fall))
+            turn = np.repeat(mid, MONOTONE) if self.guarded else []
         return self.w_blocks.join(
             free=[values[k] for k in self.free],
             theta=list(theta),
             z=np.concatenate([self.aux_start, np.zeros(self.nz - self.n_aux)]) if z is None else z,
             phi=phi,
             psi=self.box_angles(box),
+            turn=turn,
         )
 
     def concrete(self, problem, z=None):
@@ -463,18 +523,33 @@ class Formulation:
         i, j = self.aux_index[CW_X], self.aux_index[CW_Y]
         return problem.replace(masses=problem.masses.replace(counterweight=cw.with_moment(z[i], z[j])))
 
+    def with_turns(self, w, m, turned=()) -> np.ndarray:
+        """w (of this NLP, or of its unguarded sibling: then the turn-back block is added) with the certifier's
+        turn-backs at mechanism m placed (``turn_start``)."""
+        w = np.asarray(w, float)
+        if not self.guarded:
+            return w
+        fresh = w.size < self.w_blocks.size
+        if fresh:
+            w = np.concatenate([w, np.zeros(self.w_blocks.size - w.size)])
+        b = self.w_blocks.split(w)
+        b["turn"] = self.turn_start(m, b["theta"], turned, None if fresh else b["turn"])
+        return self.w_blocks.join(**b)
+
     def with_box(self, w, box) -> np.ndarray:
         """w with its box sides moved to a BoundingBox's angles."""
         b = self.w_blocks.split(w)
         b["psi"] = self.box_angles(box)
         return self.w_blocks.join(**b)
 
-    def lifted_start(self, problem, values: dict, build=None) -> tuple:
-        """(phi, box): the lifted angles' start at the design with free parameters ``values`` on this branch
-        (built by ``build(problem, values, branch)``, default ``Problem.build``; (None, None) where it does not
-        build or turn): each lifting criterion's worst angles, and the design's bounding box."""
-        if not (self.n_lift or self.n_box):
-            return None, None
+    def lifted_start(self, problem, values: dict, build=None, theta=None) -> tuple:
+        """(phi, box, turn): the lifted angles' start at the design with free parameters ``values`` on this branch
+        (built by ``build(problem, values, branch)``, default ``Problem.build``; (None, None, None) where it does
+        not build or turn): each lifting criterion's worst angles, the design's bounding box, and for a guarded
+        NLP with dead centres at ``theta`` its turn-back angles (``turn_start``)."""
+        guarded = self.guarded and theta is not None
+        if not (self.n_lift or self.n_box or guarded):
+            return None, None, None
         try:
             m = (build or type(problem).build)(problem, values, self.branch)
             box = m.bounding_box() if self.n_box else None
@@ -482,9 +557,9 @@ class Formulation:
             for c in dict.fromkeys(c for c, _ in self.lifts):
                 n = sum(1 for c2, _ in self.lifts if c2 is c)
                 phi += (c.lift_start(self, problem, m, n) + [float(a) for a in np.linspace(0.0, math.pi, n)])[:n]
-            return (phi or None), box
+            return (phi or None), box, (self.turn_start(m, theta) if guarded else None)
         except QroptError:
-            return None, None
+            return None, None, None
 
     def box_angles(self, box=None) -> list:
         """The lifted box sides' angles (BOX_SIDES order) from a BoundingBox's angles."""
@@ -510,14 +585,10 @@ class Formulation:
         pad = np.zeros(self.n_extra)
         return np.concatenate([angles, pad]), np.concatenate([fractions, pad])
 
-    def param_vector(
-        self, problem, targets: dict, samples, fractions, box=None, caps=None, monotone=None
-    ) -> np.ndarray:
+    def param_vector(self, problem, targets: dict, samples, fractions, box=None, caps=None) -> np.ndarray:
         """p from the problem's fixed values and bound values (in the NLP's terms), the targets, the sample angles
         and working-arc fractions, the box sides' coordinates (from ``box``, a BoundingBox of the design the
-        solve is at), ``caps`` (``Formulation.caps``; default loose) and ``monotone``: the fractions of the
-        falling then the rising stroke where the output's velocity keeps its sign (default mid-stroke; a guarded
-        formulation's only)."""
+        solve is at) and ``caps`` (``Formulation.caps``; default loose)."""
         bounds = [criteria.bounds()[k].to_nlp(problem.conditions[k], problem.omega2) for k in self.bound_keys]
         return self.p_blocks.join(
             fixed=[problem.fixed[k] for k in self.fixed],
@@ -527,7 +598,6 @@ class Formulation:
             bounds=bounds,
             select=self._box_select(box),
             caps=np.ones(sum(self.cap_sizes)) if caps is None else caps,
-            monotone=(np.full(2 * MONOTONE, 0.5) if monotone is None else monotone) if self.guarded else [],
         )
 
     def caps(self, w, p) -> np.ndarray:
@@ -572,6 +642,7 @@ class Formulation:
             z=-np.inf,
             phi=-2 * TWO_PI,
             psi=-2 * TWO_PI,
+            turn=-2 * TWO_PI,
         )
         hi = self.w_blocks.join(
             free=[problem.free[k][1] for k in self.free],
@@ -579,6 +650,7 @@ class Formulation:
             z=np.inf,
             phi=3 * TWO_PI,
             psi=3 * TWO_PI,
+            turn=4 * TWO_PI,
         )
         return lo, hi
 

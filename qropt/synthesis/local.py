@@ -17,7 +17,7 @@ from qropt.synthesis import criteria, newton
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import CONVERGED, Status
 from qropt.synthesis.certificate import Designs, certify, residuals, target_values
-from qropt.synthesis.formulation import MONOTONE, TWO_PI, Formulation
+from qropt.synthesis.formulation import TWO_PI, Formulation
 
 STUCK = 3  # exchange rounds that end alike, in a row, after which the loop stops (``_stuck``)
 RESTARTS = 2  # runs continued from their last iterate when they hit the iteration limit near a design
@@ -173,16 +173,13 @@ class LocalSolve:
             form = self.formulations.get(problem, branch, orientation, range_target, sense)
             samples, fractions = form.base_samples()
             used = used_f = form.n_base
-            phi, box = form.lifted_start(form.concrete(problem), values0, designs)
+            phi, box, turn = form.lifted_start(form.concrete(problem), values0, designs, th0)
             p = form.param_vector(problem, targets, samples, fractions, box=box)
-            w = form.epigraph_start(form.pack(values0, th0, phi=phi, box=box), p)
+            w = form.epigraph_start(form.pack(values0, th0, phi=phi, box=box, turn=turn), p)
         else:  # the start's optimum continued here: its samples, its point (a box is set from the design later)
             form, p, _ = continued
             samples, fractions = hint.blocks["samples"].copy(), hint.blocks["fractions"].copy()
             (used, used_f), box = hint.used, None
-        mono, mono_next = np.full(2 * MONOTONE, 0.5), [0, 0]
-        if continued is not None and hint.blocks["monotone"].size:  # a guarded NLP: the hint's reversal rows
-            mono = hint.blocks["monotone"].copy()
         lbx, ubx = form.bounds(problem)
         c = Candidate(False, dict(values0), branch, orientation)
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
@@ -223,14 +220,14 @@ class LocalSolve:
                 break
             caps = form.caps(w, p)
             tightened = not np.array_equal(caps, form.p_blocks.split(p)["caps"])
-            turned = info.get("monotone", [])  # where the output reversed inside a stroke: its velocity's sign stated
-            for stroke, fraction in turned:
-                mono[stroke * MONOTONE + mono_next[stroke]] = fraction
-                mono_next[stroke] = (mono_next[stroke] + 1) % MONOTONE
+            turned = info.get("monotone", [])  # where the output turned back inside a stroke: a lifted angle there
             guarding = bool(info.get("guard")) and not form.guarded
             if guarding:  # the same NLP with the rows that state where the output reverses (the certifier's angles
                 # sampled), from where it is
                 form = self.formulations.get(problem, branch, orientation, range_target, sense, guarded=True)
+                lbx, ubx = form.bounds(problem)
+            if (turned or guarding) and m is not None:
+                w = form.with_turns(w, m, turned)
             if not add and not frac and not tightened and not turned and not guarding:
                 if run.status is Status.ACCEPTABLE and not polished and c.rounds < max_rounds:
                     # IPOPT's looser tolerance: once more from there, warm, to its own (the acceptable point kept)
@@ -248,7 +245,7 @@ class LocalSolve:
             if form.n_box and m is not None:  # each box side lifted at the coordinate that reaches it now
                 box = m.bounding_box()
                 w = form.with_box(w, box)
-            p = form.param_vector(problem, targets, samples, fractions, box=box, caps=caps, monotone=mono)
+            p = form.param_vector(problem, targets, samples, fractions, box=box, caps=caps)
             w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
         c.mechanism, c.info = m, info
         c.residuals = residuals(c.problem or problem, ran.violations(g), m, {k: targets[k] for k in form.targets})

@@ -32,15 +32,16 @@ NLP_LIMIT = 2_000  # NLPs (objective and rows) of at most this many instructions
 CURVED = 1e-10  # an eigenvalue of the KKT matrix counts as nonzero above this, relative to the largest
 
 
-BLOCKS = ("samples", "fractions", "select", "caps", "monotone")  # the exchange loop's blocks of p a hint keeps
+BLOCKS = ("samples", "fractions", "select", "caps")  # the exchange loop's blocks of p a hint keeps
 
 
 @dataclass(frozen=True)
 class Hint:
-    """A certified optimum to continue from: its design (free values), the NLP point, its multipliers (rows,
-    bounds; IPOPT's signs: positive at an upper bound), the exchange loop's parameter blocks (sample angles,
-    fractions, the box's selection, caps, the monotone rows' fractions) with how many sample slots it used, and
-    a weak reference to its formulation, which stays in this process (a pickled hint fits no formulation)."""
+    """A certified optimum to continue from: its design (free values), the NLP point (a guarded NLP's lifted
+    turn-back angles in it), its multipliers (rows, bounds; IPOPT's signs: positive at an upper bound), the
+    exchange loop's parameter blocks (sample angles, fractions, the box's selection, caps) with how many sample
+    slots it used, and a weak reference to its formulation, which stays in this process (a pickled hint fits no
+    formulation)."""
 
     values: tuple
     w: np.ndarray
