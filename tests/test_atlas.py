@@ -398,3 +398,43 @@ def test_a_lifted_turn_back_follows_the_optimum_to_the_next_time_ratio():
     assert (b_tr, b_stroke) == pytest.approx((2.16, 1.0), abs=1e-8)
     assert b_gamma == pytest.approx(c.info["certified"], abs=1e-7)
     assert brute.sixbar_reversals("coupler-slider", par) == 1
+
+
+def test_a_turn_back_the_certifier_finds_takes_the_slot_that_holds_least():
+    """The lifted turn-back angles of a guarded NLP: added to an unguarded NLP's point (the switch a solve makes
+    where the certifier sees a reversal), they start at a stationary point of the velocity inside each stroke; a
+    turn-back found near a lifted one moves it, and one found elsewhere takes the slot where the velocity is
+    farthest from turning back (the stroke's fastest point), keeping the one that holds a turn-back."""
+    from qropt.synthesis.formulation import MONOTONE, TURN_GRID, TURN_NEAR
+
+    p = type_problem("coupler-slider", 2.185, 0.567)
+    r = Solver().solve(p)
+    m, branch = r.mechanism, {k: r.params[k] for k in p.branches}
+    d = m.dead_centres()
+    theta = np.array([d.theta_max, d.theta_min if d.theta_min > d.theta_max else d.theta_min + 2 * np.pi])
+    solver = Solver()
+    plain = solver._formulations.get(p, branch, r.stats["orientation"], guarded=False)
+    guarded = solver._formulations.get(p, branch, r.stats["orientation"], guarded=True)
+    values = {k: r.params[k] for k in p.free}
+    w = guarded.with_turns(plain.pack(values, theta), m)
+    assert w.size == guarded.w_blocks.size > plain.w_blocks.size
+    turn = guarded.unpack(w).turn
+    assert turn.size == 2 * MONOTONE
+    fall = theta[1] - theta[0]
+    for s in range(2):
+        lo, hi = (theta[0], theta[1]) if s == 0 else (theta[1], theta[0] + 2 * np.pi)
+        step = (hi - lo) / (TURN_GRID - 1)  # the grid's: the velocity is stationary within a step of each
+        for t in turn[s * MONOTONE : (s + 1) * MONOTONE]:
+            assert lo < t < hi
+            a = np.ravel(m.slider(np.array([t - step, t + step])).a)
+            assert a[0] * a[1] <= 0
+    held, fastest = turn[0], turn[1]  # the falling stroke's touching turn-back, and its fastest point
+    assert abs(float(np.ravel(m.slider(held).v)[0])) < 1e-3 < abs(float(np.ravel(m.slider(fastest).v)[0]))
+    near = guarded.turn_start(m, theta, [(0, (held + 0.5 * TURN_NEAR - theta[0]) / fall)], turn)
+    assert near[0] == pytest.approx(held + 0.5 * TURN_NEAR) and near[1] == fastest
+    at = fastest + 3 * TURN_NEAR * np.sign(held - fastest)  # nearer the fastest point, far from both
+    assert min(abs(at - held), abs(at - fastest)) > TURN_NEAR
+    far = (at - theta[0]) / fall
+    moved = guarded.turn_start(m, theta, [(0, far)], turn)
+    assert moved[0] == held and moved[1] == pytest.approx(theta[0] + far * fall)
+    assert np.array_equal(moved[2:], turn[2:])  # the rising stroke's untouched

@@ -402,7 +402,8 @@ class Formulation:
 
     def _guard_rows(self, TH, TURN):
         """The rows of a type whose output can reverse more than once a turn: at every sample angle the output is
-        below its maximum and above its minimum (the certifier's extremes are sampled), and at each lifted
+        below its maximum and above its minimum (the certifier's extremes are sampled), mid-stroke its velocity has
+        the stroke's sign (rows of the design alone: a family's curve keeps them), and at each lifted
         turn-back angle TURN (MONOTONE in the falling stroke, theta_max to theta_min ccw, then MONOTONE in the
         rising one) the output velocity is stationary and keeps the stroke's sign. A lifted angle follows its
         turn-back as the design moves, so a design whose velocity touches zero inside a stroke is a regular
@@ -412,8 +413,12 @@ class Formulation:
         for k, out in enumerate(self.sampled):
             self.row(f"sample {k}: output below its maximum", x_max - out.x + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
             self.row(f"sample {k}: output above its minimum", out.x - x_min + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
+        fall = TH[1] - TH[0]  # the output falls from theta_max to theta_min (ccw), rises on the rest of the turn
+        down, up = self.at(TH[0] + 0.5 * fall).v, self.at(TH[1] + 0.5 * (TWO_PI - fall)).v
+        self.row("falling stroke, mid-stroke: output velocity <= 0", down, -casadi.inf, 0.0, RowKind.DEAD_CENTRE)
+        self.row("rising stroke, mid-stroke: output velocity >= 0", up, 0.0, casadi.inf, RowKind.DEAD_CENTRE)
         for k in range(2 * MONOTONE):
-            falling = k < MONOTONE  # the output falls from theta_max to theta_min (ccw), rises on the rest of the turn
+            falling = k < MONOTONE
             lo, hi = (TH[0], TH[1]) if falling else (TH[1], TH[0] + TWO_PI)
             name, out = f"{'falling' if falling else 'rising'} stroke, turn-back {k % MONOTONE}", self.at(TURN[k])
             self.row(f"{name}: output velocity stationary", out.a, 0.0, 0.0, RowKind.LIFT)
@@ -429,8 +434,8 @@ class Formulation:
         dead centres ``theta``: in each stroke the velocity's worst turn back (its stationary point nearest to the
         wrong sign) and its fastest point (both where it has no turn back), and the
         certifier's turn-backs ``turned`` ((stroke, fraction along it), ``certificate.wrong_way``) in the slot
-        whose angle in ``now`` (the current ones) is within TURN_NEAR of it, else in the other one of its
-        stroke."""
+        whose angle in ``now`` (the current ones) is within TURN_NEAR of it, else in the slot of its stroke
+        where m's velocity is farthest from turning back (the one that holds least)."""
         th0, th1 = float(theta[0]), float(theta[1])
         fall = th1 - th0
         spans = ((th0, fall), (th1, TWO_PI - fall))
@@ -450,11 +455,12 @@ class Formulation:
         for s, fraction in turned:
             lo, arc = spans[s]
             t = lo + fraction * arc
-            slots = range(s * MONOTONE, (s + 1) * MONOTONE)
-            gaps = [abs((now[i] - t + math.pi) % TWO_PI - math.pi) for i in slots]
-            i = min(slots, key=lambda i: gaps[i - s * MONOTONE])
-            if gaps[i - s * MONOTONE] > TURN_NEAR:  # a new turn-back: in the slot not holding the nearest one
-                i = max(slots, key=lambda i: gaps[i - s * MONOTONE])
+            slots = np.arange(s * MONOTONE, (s + 1) * MONOTONE)
+            gaps = np.abs((now[slots] - t + math.pi) % TWO_PI - math.pi)
+            i = slots[int(np.argmin(gaps))]
+            if gaps.min() > TURN_NEAR:  # a new turn-back: in place of the slot that holds least
+                against = np.asarray(m.slider(now[slots]).v, float) * (1.0 if s == 0 else -1.0)
+                i = slots[int(np.argmin(np.where(np.isfinite(against), against, np.inf)))]
             now[i] = t
         return now
 
