@@ -227,3 +227,28 @@ def test_a_slider_crank_near_a_toggle_is_refined_along_its_family():
     assert x_max - x_min == pytest.approx(0.834, abs=1e-9)
     assert brute.gamma_min("slider-crank", params) < math.radians(0.5)
     assert _peak_accel(params) == pytest.approx(r.objective, rel=1e-6)
+
+
+def test_a_guarded_types_curve_checks_the_velocity_mid_stroke():
+    """A family's curve holds the design's rows (the free parameters and the dead centres): for a type whose output
+    may reverse more than once a turn (the coupler slider), also the output velocity mid-stroke of each stroke's
+    sign, which its NLP holds by lifted turn-backs instead. Its values are the exact velocity there."""
+    from qropt import Solver
+    from qropt.studies._design import type_problem
+    from qropt.studies._family import _Curve
+
+    p = type_problem("coupler-slider", 2.185, 0.567)
+    r = Solver().solve(p)
+    branch = {k: r.params[k] for k in p.branches}
+    curve = _Curve(p.replace(objective=None), branch, r.stats["orientation"], Solver())
+    names = [row.name for row in curve.ineq_rows]
+    mid = [i for i, n in enumerate(names) if "mid-stroke" in n]
+    assert len(mid) == 2 and not any("turn-back" in n for n in names)
+    d = r.mechanism.dead_centres()
+    t0, t1 = d.theta_max, d.theta_min if d.theta_min > d.theta_max else d.theta_min + 2 * math.pi
+    u = np.array([r.params[k] for k in curve.free] + [t0, t1])
+    _, _, g = curve.eval(u)
+    fall = t1 - t0
+    v = np.ravel(r.mechanism.slider(np.array([t0 + 0.5 * fall, t1 + 0.5 * (2 * math.pi - fall)])).v)
+    assert g[mid] == pytest.approx(v, rel=1e-9, abs=1e-12)
+    assert v[0] < 0 < v[1] and curve.violation(g)[0] <= 1e-9

@@ -292,6 +292,55 @@ def test_a_continuum_of_optima_is_broken_by_the_least_size(kind):
         gammas.append(m.gamma_min().value)
     assert max(gammas) - min(gammas) < 1e-9 and abs(row.objective - gammas[0]) <= 2e-9  # the tie: 1e-9 relative
     assert row.quantities["size"] <= min(sizes) * (1 + 1e-6), (row.quantities["size"], min(sizes))
+    # where the footprint is flat along the family, the largest r1 of the least footprint (to a scan step)
+    least = [r1 for r1, size in zip(_family_r1(kind, tr, s), sizes, strict=True) if size <= min(sizes) * (1 + 1e-9)]
+    assert row.params["r1"] >= max(least) * (1 - 2e-3)
+
+
+def _family_r1(kind, tr, s):
+    """The r1 of the closed-form family's designs inside the bounds, in the order of the test above."""
+    lo, hi = (s / 20, 5 * s)
+    k = analytic.crank_shaper_ratio(tr)
+    out = []
+    for r1 in np.geomspace(lo, hi, 4001):
+        q = {"r1": r1, "r2": k * r1}
+        q |= {"h": s * math.sqrt(1 - k * k) / (2 * k)} if kind == "slot-ram-shaper" else {"r4": s / (2 * k)}
+        if all(lo <= v <= hi for n, v in q.items() if n != "h"):
+            out.append(r1)
+    return out
+
+
+@pytest.mark.parametrize("kind", ["crank-shaper-rod", "whitworth"])
+def test_the_least_peak_acceleration_of_a_continuum_takes_its_least_size(kind, monkeypatch):
+    """By min_peak_accel too, the crank shaper with a rod and the Whitworth (whose least-size solves under a
+    bound at the optimum end at degenerate designs) take the least size of the continuum: r1 and r2 of the tie-free
+    optimum scaled together by one factor, the same motion (TR, stroke and peak acceleration by the tests' own
+    simulation), a smaller footprint, and none smaller nearby along the continuum."""
+    from qropt.studies._design import type_problem
+    from qropt.synthesis.solver import Solver
+
+    p = type_problem(kind, 2.373, 2.3207, objective="min_peak_accel")
+    row = Solver().solve(p)
+    assert row.status == "optimal" and "scaled together" in row.message, row.message
+    monkeypatch.setattr(Solver, "least_size", lambda self, problem, r, *a: r)
+    tied = Solver().solve(p)
+    assert row.params["r2"] / row.params["r1"] == pytest.approx(tied.params["r2"] / tied.params["r1"], rel=1e-9)
+    assert row.quantities["size"] < tied.quantities["size"]
+    assert abs(row.objective - tied.objective) <= 2e-9 * abs(tied.objective)
+    mech = row.mechanism.KIND  # the row's mechanism (the crank shaper's, with its rod)
+    tr, stroke, _ = brute.task_values(mech, dict(row.params))
+    assert (tr, stroke) == pytest.approx((2.373, 2.3207), abs=1e-8)
+    th, h = np.linspace(0, 2 * np.pi, 7200, endpoint=False), 1e-3  # the whole turn (accel_over "cycle")
+    x = [brute.output(mech, dict(row.params), th + k * h) for k in (-1, 0, 1)]
+    a = (x[0] - 2 * x[1] + x[2]) / h**2  # error about 1e-7 of the peak
+    assert np.max(np.abs(a)) == pytest.approx(row.quantities["peak_accel"], rel=1e-4)
+    for f in (0.98, 0.995):  # smaller along the continuum: a larger footprint, or no design
+        q = {**row.params, "r1": f * row.params["r1"], "r2": f * row.params["r2"]}
+        try:
+            bigger = qropt.mechanism_type(mech)(**q).size("footprint")
+        except qropt.QroptError:
+            continue
+        assert bigger >= row.quantities["size"] * (1 - 1e-9)
 
 
 # a crank-rocker whose coupler point (r5 = 1.169 at beta = 1.796 rad) folds the ram's x-motion: two reversals a turn

@@ -308,8 +308,8 @@ class Mechanism:
     EXACT_TRANSMISSION: ClassVar[dict[str, tuple[float, ...]]] = {}  # joint -> crank angles of its extremes
     RULED_MARGINS: ClassVar[tuple[str, ...]] = ()  # closures that assemble wherever the type's rules hold
     ACCEL_EXTREMES: ClassVar[int] = 2  # acceleration extremes the NLP lifts for the peak acceleration
-    # parameters along which, at given targets, the motion and so every kinematic criterion stay the same (the
-    # others following): such optima form a continuum, and a solve breaks the tie by the least size
+    # lengths that, scaled together by one factor, leave the motion and so every kinematic criterion the same: such
+    # optima form a continuum, and a solve breaks the tie by the least size
     TIES: ClassVar[tuple[str, ...]] = ()
     # whether every design of the type that turns has an output reversing exactly once a turn (driven, through
     # links that each move one way, by a crank that turns once); else the synthesis NLP states it (guard rows)
@@ -809,16 +809,16 @@ class Mechanism:
         box, angles, coords = [], [], []
         for axis in (0, 1):
             for kind, pick in (("min", np.argmin), ("max", np.argmax)):
-                vals, ths, which = [], [], []
+                best = None  # (value, angle, coordinate): the first of equal extremes, coordinates in order
                 for i in range(axis, q, 2):
                     e = res[2 * i + (kind == "min")]
-                    vals += [*e.value.tolist(), *c[i].tolist()]
-                    ths += [*e.theta.tolist(), *grid.tolist()]
-                    which += [i] * (e.value.size + c.shape[1])
-                j = int(pick(vals))
-                box.append(float(vals[j]))
-                angles.append(float(ths[j]))
-                coords.append(which[j])
+                    vals, ths = np.concatenate([e.value, c[i]]), np.concatenate([e.theta, grid])
+                    j = int(pick(vals))
+                    if best is None or (vals[j] < best[0] if kind == "min" else vals[j] > best[0]):
+                        best = (float(vals[j]), float(ths[j]), i)
+                box.append(best[0])
+                angles.append(best[1])
+                coords.append(best[2])
         return BoundingBox(*box, tuple(angles), tuple(coords))
 
     def footprint(self) -> float:

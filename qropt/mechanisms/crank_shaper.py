@@ -35,7 +35,7 @@ class CrankShaper(Mechanism):
     KIND = "crank-shaper"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r4": REQUIRED, "r6": None, "h": None, "sigma_slider": 1.0}
     LENGTHS = ("r1", "r2", "r4", "r6")
-    TIES = ("r1",)  # the motion depends on r2/r1 (the lever), r4, r6 and h only
+    TIES = ("r1", "r2")  # the motion depends on r2/r1 (the lever), r4, r6 and h only
     BODIES = YOKE.bodies()  # with the yoke (no rod r6): the yoke-ram moves along x with x_C
     ROD_BODIES = ROD.bodies()  # with a rod r6
     GROUND = YOKE.ground_joints()

@@ -23,7 +23,7 @@ class SlotRamShaper(Mechanism):
     KIND = "slot-ram-shaper"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "h": REQUIRED}
     LENGTHS = ("r1", "r2")  # h is the slide line's offset (positive by a rule), as the crank-shaper's
-    TIES = ("r1",)  # the motion depends on r2/r1 and h only
+    TIES = ("r1", "r2")  # the motion depends on r2/r1 and h only
     BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
 
     @classmethod

@@ -17,7 +17,7 @@ class Whitworth(Mechanism):
     KIND = "whitworth"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r5": REQUIRED, "r6": REQUIRED, "h": 0.0, "sigma_slider": 1.0}
     LENGTHS = ("r1", "r2", "r5", "r6")
-    TIES = ("r1",)  # the motion depends on r1/r2 (the lever), r5, r6 and h only
+    TIES = ("r1", "r2")  # the motion depends on r1/r2 (the lever), r5, r6 and h only
     BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
 
     @classmethod

@@ -121,11 +121,13 @@ class _Curve:
         eq = mine[form.lbg[mine] == form.ubg[mine]]
         ineq = mine[form.lbg[mine] != form.ubg[mine]]
         f = form.g_sym[eq.tolist()] - casadi.DM(form.lbg[eq])
-        g = form.g_sym[ineq.tolist()]
+        mid = form.midstroke_rows()  # a guarded type's velocity of the stroke's sign mid-stroke
+        g = casadi.vertcat(form.g_sym[ineq.tolist()], *[r.expr for r in mid])
         self.fun = casadi.Function("F", [u, form.p_sym], [f, casadi.jacobian(f, u), g])
         self.fj = casadi.Function("FJ", [u, form.p_sym], [f, casadi.jacobian(f, u)])
-        self.ineq_rows = [form.rows[i] for i in ineq]
-        self.glo, self.ghi = form.lbg[ineq], form.ubg[ineq]
+        self.ineq_rows = [form.rows[i] for i in ineq] + mid
+        self.glo = np.concatenate([form.lbg[ineq], [r.lb for r in mid]])
+        self.ghi = np.concatenate([form.ubg[ineq], [r.ub for r in mid]])
         self.n = n
         lo, hi = form.bounds(problem)
         self.lo, self.hi = lo[form.design], hi[form.design]

@@ -402,8 +402,7 @@ class Formulation:
 
     def _guard_rows(self, TH, TURN):
         """The rows of a type whose output can reverse more than once a turn: at every sample angle the output is
-        below its maximum and above its minimum (the certifier's extremes are sampled), mid-stroke its velocity has
-        the stroke's sign (rows of the design alone: a family's curve keeps them), and at each lifted
+        below its maximum and above its minimum (the certifier's extremes are sampled), and at each lifted
         turn-back angle TURN (MONOTONE in the falling stroke, theta_max to theta_min ccw, then MONOTONE in the
         rising one) the output velocity is stationary and keeps the stroke's sign. A lifted angle follows its
         turn-back as the design moves, so a design whose velocity touches zero inside a stroke is a regular
@@ -413,10 +412,6 @@ class Formulation:
         for k, out in enumerate(self.sampled):
             self.row(f"sample {k}: output below its maximum", x_max - out.x + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
             self.row(f"sample {k}: output above its minimum", out.x - x_min + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
-        fall = TH[1] - TH[0]  # the output falls from theta_max to theta_min (ccw), rises on the rest of the turn
-        down, up = self.at(TH[0] + 0.5 * fall).v, self.at(TH[1] + 0.5 * (TWO_PI - fall)).v
-        self.row("falling stroke, mid-stroke: output velocity <= 0", down, -casadi.inf, 0.0, RowKind.DEAD_CENTRE)
-        self.row("rising stroke, mid-stroke: output velocity >= 0", up, 0.0, casadi.inf, RowKind.DEAD_CENTRE)
         for k in range(2 * MONOTONE):
             falling = k < MONOTONE
             lo, hi = (TH[0], TH[1]) if falling else (TH[1], TH[0] + TWO_PI)
@@ -428,6 +423,19 @@ class Formulation:
                 self.row(f"{name}: output velocity <= 0", out.v, -casadi.inf, 0.0, RowKind.DEAD_CENTRE)
             else:
                 self.row(f"{name}: output velocity >= 0", out.v, 0.0, casadi.inf, RowKind.DEAD_CENTRE)
+
+    def midstroke_rows(self) -> list[Row]:
+        """A guarded NLP's output velocity mid-stroke, of the stroke's sign: rows of the design alone (free
+        parameters, dead centres) that a family's curve checks; the NLP holds the lifted turn-backs instead."""
+        if not self.guarded:
+            return []
+        th0, th1 = self.design_sym[self.nx], self.design_sym[self.nx + 1]
+        fall = th1 - th0
+        down, up = self.at(th0 + 0.5 * fall).v, self.at(th1 + 0.5 * (TWO_PI - fall)).v
+        return [
+            Row("falling stroke, mid-stroke: output velocity <= 0", RowKind.DEAD_CENTRE, down, -casadi.inf, 0.0),
+            Row("rising stroke, mid-stroke: output velocity >= 0", RowKind.DEAD_CENTRE, up, 0.0, casadi.inf),
+        ]
 
     def turn_start(self, m, theta, turned=(), now=None) -> np.ndarray:
         """The lifted turn-back angles (MONOTONE per stroke, falling then rising) at mechanism m for the NLP's

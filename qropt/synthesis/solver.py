@@ -32,6 +32,8 @@ TIE_TOL = 1e-9  # relative: designs this close to an optimum tie with it (see So
 RANGE_SAMPLES = 64  # designs spread over the bounds whose exact target values start a reachable range
 RANGE_SOLVES = 4  # local solves that push a reachable range's ends out from the samples
 RANGE_FREE = (RowKind.DEAD_CENTRE, RowKind.ORIENTATION, RowKind.TARGET)  # rows a range's designs need not meet
+TIE_SCAN = 24  # common scales of a continuum's tied lengths evaluated exactly, log-spaced over what the bounds allow
+TIE_BISECT = 24  # bisections of the least scale whose size is the least (to 2^-24 of a scan step)
 
 
 class Solver:
@@ -190,8 +192,8 @@ class Solver:
             kw = {"starts_n": starts_n, "seed": seed, "targets": targets, "max_rounds": max_rounds}
             return self.solve(problem, use_analytic=False, diagnose=False, **kw)
         if good:
-            r = self.best(problem, cands, claim, plan, t0)
-            return self.least_size(problem, r, targets, seed, max_rounds)
+            r = self.least_size(problem, self.best(problem, cands, claim, plan, t0), targets, seed, max_rounds)
+            return dataclasses.replace(r, stats={**r.stats, "t_total": time.perf_counter() - t0})
         if not diagnose:
             stats = self._stats(problem, cands, plan)
             stats["t_total"] = time.perf_counter() - t0
@@ -242,14 +244,16 @@ class Solver:
 
     def least_size(self, problem, r: Result, targets, seed, max_rounds) -> Result:
         """Where the type's optima form a continuum (``Mechanism.TIES`` free) and the objective is kinematic, the
-        design of least size (the problem's size measure) among those within TIE_TOL of the optimum: min_size
-        under a bound at the optimum, and alone (where the targets fix the criterion, the bound is redundant and
-        degenerate, and the design stays within TIE_TOL anyway); local solves from the optimum first, then along
-        the closed forms' family, a design accepted within 2 TIE_TOL of the optimum. ``r`` where none is optimal and
-        that close."""
+        design of least size (the problem's size measure) among those within TIE_TOL of the optimum: along the
+        continuum by exact evaluation (``_least_along``), else min_size under a bound at the optimum, and alone
+        (where the targets fix the criterion, the bound is redundant and degenerate, and the design stays within
+        TIE_TOL anyway), local solves from the optimum first, then along the closed forms' family; a design
+        accepted within 2 TIE_TOL of the optimum. ``r`` where none is optimal and that close."""
         c = criteria.of_problem(problem)
-        ties = [k for k in problem.mechanism.TIES if k in problem.free]
-        if not ties or c is None or c.size or not c.kinematic or r.status != "optimal":
+        ties = list(problem.mechanism.TIES)
+        if not ties or not set(ties) <= set(problem.free) or c is None or c.size or not c.kinematic:
+            return r
+        if r.status != "optimal":
             return r
         tol = TIE_TOL * max(1.0, abs(r.objective))
         old = problem.conditions.get(c.bound)
@@ -270,6 +274,9 @@ class Solver:
         # the bound holds at the sub-solve's design to rounding (1e-13 at the Whitworth's): accepted within 2 tol
         # of the optimum, so that a bit either way (a kernel compiled or not) does not decide
         accept = within(2)
+        along = self._least_along(problem, r, ties, targets, c, accept, tol)
+        if along is not None:
+            return along
         for sub, how in tries:
             s = self.solve(sub, starts_n=0, **how, **kw)
             if s.status == "optimal" and not c.better(accept, s.quantities[c.name]):
@@ -283,6 +290,75 @@ class Solver:
                 )
                 return dataclasses.replace(best, local_optima=(best, *r.local_optima[1:]))
         return r
+
+    def _least_along(self, problem, r: Result, ties, targets, c, accept, tol) -> Result | None:
+        """The least-size design of the continuum through the optimum ``r``: its tied lengths scaled together by
+        one factor leave the motion, and so every kinematic criterion, the same (``Mechanism.TIES``); the size at
+        TIE_SCAN factors log-spaced over what the bounds allow (each design built, its rules, one reversal and the
+        bound conditions checked), the least refined by a bounded 1-D search between its neighbours, and of
+        designs that small (within TIE_TOL) the one of the largest tied lengths, then certified by exact
+        evaluation like any design. None where it is not certified within ``accept`` of the
+        optimum (the NLP's way is tried then)."""
+        from scipy.optimize import minimize_scalar  # imported here: only a continuum's tie needs it
+
+        from qropt.synthesis.multistart import score
+
+        v0 = {k: r.params[k] for k in problem.free}
+        branch = {k: r.params[k] for k in problem.branches}
+        if any(v0[k] <= 0 for k in ties):
+            return None
+        lo = max(math.log(problem.free[k][0] / v0[k]) for k in ties)
+        hi = min(math.log(problem.free[k][1] / v0[k]) for k in ties)
+        if not lo < hi:
+            return None
+        designs, sized = Designs(), problem.replace(objective="min_size")
+
+        def at(u):
+            v = dict(v0)
+            for k in ties:
+                v[k] = min(max(v0[k] * math.exp(u), problem.free[k][0]), problem.free[k][1])
+            return v
+
+        def size(u):
+            f, _ = score(sized, at(float(u)), branch, designs)
+            return math.inf if f is None else f
+
+        us = np.linspace(lo, hi, TIE_SCAN)
+        sizes = np.array([size(u) for u in us])
+        i = int(np.argmin(sizes))
+        if not np.isfinite(sizes[i]):
+            return None
+        a, b = us[max(i - 1, 0)], us[min(i + 1, TIE_SCAN - 1)]
+        found = minimize_scalar(size, bounds=(a, b), method="bounded", options={"xatol": 1e-9 * max(1.0, hi - lo)})
+        u, least = (float(found.x), float(found.fun)) if found.fun <= sizes[i] else (float(us[i]), float(sizes[i]))
+        # the size can be flat along the continuum (the lever's sweep spans the box): of the least, the largest
+        # tied lengths (the same motion and torque with the least crank-pin force), their edge found by bisection
+        # from the last scale within TIE_TOL of the least size
+        level = least * (1.0 + TIE_TOL)
+        small = np.flatnonzero(sizes <= level)
+        if small.size and us[small[-1]] > u:
+            j = int(small[-1])
+            u = float(us[j])
+            if j < TIE_SCAN - 1:
+                inside, out = u, float(us[j + 1])
+                for _ in range(TIE_BISECT):
+                    mid = 0.5 * (out + inside)
+                    inside, out = (mid, out) if size(mid) <= level else (inside, mid)
+                u = inside
+        cand = self.local_solve.evaluate(problem, at(u), branch, targets, designs)
+        if not cand.ok:
+            return None
+        cand.q = quantities(problem, cand.mechanism)
+        if c.better(accept, cand.q[c.name]):
+            return None
+        claim = (
+            f"{r.certificate.global_claim}; optima form a continuum along {' and '.join(ties)} scaled together: "
+            f"the least {problem.size} ({cand.q['size']:.6g}) by exact evaluation at {TIE_SCAN} scales and a "
+            f"bounded 1-D search, within {2 * tol:.1e} of the optimum"
+        )
+        best = self._result(problem, cand, None, claim, r.stats)
+        best = dataclasses.replace(best, certificate=dataclasses.replace(best.certificate, global_claim=claim))
+        return dataclasses.replace(best, local_optima=(best, *r.local_optima[1:]))
 
     def _check(self, problem, targets, extra_starts, starts_n, seed, max_rounds):
         if not isinstance(problem, Problem):
