@@ -40,6 +40,14 @@ TURN_NEAR = 0.05  # rad: a turn-back found this close to a lifted one is that on
 BOX_SIDES = ("x_max", "-x_min", "y_max", "-y_min")  # the footprint's epigraph order (BoundingBox order differs)
 
 
+def strokes(theta_max, theta_min) -> tuple[tuple, tuple]:
+    """((start, end, arc) of the falling stroke, the same of the rising one), rad, for dead centres theta_max <
+    theta_min (unwrapped): the output falls from theta_max to theta_min (ccw) and rises on the rest of the turn.
+    Numbers or CasADi expressions alike."""
+    fall = theta_min - theta_max
+    return (theta_max, theta_min, fall), (theta_min, theta_max + TWO_PI, TWO_PI - fall)
+
+
 def slow_interval(time_ratio, orientation):
     """theta_min - theta_max (rad): the slow interval if orientation = +1, else the fast one."""
     return TWO_PI * (time_ratio if orientation > 0 else 1.0) / (time_ratio + 1.0)
@@ -188,6 +196,7 @@ class Formulation:
         self._start = TH[0] if orientation > 0 else TH[1]
         self._length = (TH[1] - TH[0]) if orientation > 0 else TWO_PI - (TH[1] - TH[0])
         self._W, self._working, self._returning, self._strokes = W, None, None, None
+        self._turn_rows = range(0)  # the rows of the lifted turn-back angles (``_guard_rows``)
         TURN = casadi.SX.sym("turn", 2 * MONOTONE if guarded else 0)  # turn-back angles: falling, rising strokes
         travel, span = self._core_rows(TH, PT)
         if guarded:
@@ -289,10 +298,8 @@ class Formulation:
         self.epi_fun = casadi.Function("epi", [self.w_sym, self.p_sym], [casadi.vertcat(*[e for _, e in epi], 0)])
         self.epi_index = np.array([zi for zi, _ in epi], int)
         # the rows of the design alone (free parameters, dead centres): all but the turn-backs' (a family's curve)
-        self.design_rows = np.array(
-            [i for i, r in enumerate(self.rows) if not TURN.numel() or not casadi.depends_on(casadi.SX(r.expr), TURN)],
-            int,
-        )
+        turn_rows = set(self._turn_rows)
+        self.design_rows = np.array([i for i in range(len(self.rows)) if i not in turn_rows], int)
         self.lbg = np.array([r.lb for r in self.rows], float)
         self.ubg = np.array([r.ub for r in self.rows], float)
         self.nx, self.nz, self.n_lift, self.n_box = len(self.free), len(self.z_names), len(self.lifts), n_box
@@ -412,9 +419,10 @@ class Formulation:
         for k, out in enumerate(self.sampled):
             self.row(f"sample {k}: output below its maximum", x_max - out.x + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
             self.row(f"sample {k}: output above its minimum", out.x - x_min + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
+        first = len(self.rows)
         for k in range(2 * MONOTONE):
             falling = k < MONOTONE
-            lo, hi = (TH[0], TH[1]) if falling else (TH[1], TH[0] + TWO_PI)
+            lo, hi, _ = strokes(TH[0], TH[1])[k // MONOTONE]
             name, out = f"{'falling' if falling else 'rising'} stroke, turn-back {k % MONOTONE}", self.at(TURN[k])
             self.row(f"{name}: output velocity stationary", out.a, 0.0, 0.0, RowKind.LIFT)
             self.row(f"{name}: inside the stroke", TURN[k] - lo, 0.0, casadi.inf, RowKind.LIFT)
@@ -423,15 +431,15 @@ class Formulation:
                 self.row(f"{name}: output velocity <= 0", out.v, -casadi.inf, 0.0, RowKind.DEAD_CENTRE)
             else:
                 self.row(f"{name}: output velocity >= 0", out.v, 0.0, casadi.inf, RowKind.DEAD_CENTRE)
+        self._turn_rows = range(first, len(self.rows))
 
     def midstroke_rows(self) -> list[Row]:
         """A guarded NLP's output velocity mid-stroke, of the stroke's sign: rows of the design alone (free
         parameters, dead centres) that a family's curve checks; the NLP holds the lifted turn-backs instead."""
         if not self.guarded:
             return []
-        th0, th1 = self.design_sym[self.nx], self.design_sym[self.nx + 1]
-        fall = th1 - th0
-        down, up = self.at(th0 + 0.5 * fall).v, self.at(th1 + 0.5 * (TWO_PI - fall)).v
+        (a, _, fall), (b, _, rise) = strokes(self.design_sym[self.nx], self.design_sym[self.nx + 1])
+        down, up = self.at(a + 0.5 * fall).v, self.at(b + 0.5 * rise).v
         return [
             Row("falling stroke, mid-stroke: output velocity <= 0", RowKind.DEAD_CENTRE, down, -casadi.inf, 0.0),
             Row("rising stroke, mid-stroke: output velocity >= 0", RowKind.DEAD_CENTRE, up, 0.0, casadi.inf),
@@ -444,13 +452,11 @@ class Formulation:
         certifier's turn-backs ``turned`` ((stroke, fraction along it), ``certificate.wrong_way``) in the slot
         whose angle in ``now`` (the current ones) is within TURN_NEAR of it, else in the slot of its stroke
         where m's velocity is farthest from turning back (the one that holds least)."""
-        th0, th1 = float(theta[0]), float(theta[1])
-        fall = th1 - th0
-        spans = ((th0, fall), (th1, TWO_PI - fall))
+        spans = strokes(float(theta[0]), float(theta[1]))
         if now is None:
             now = np.zeros(2 * MONOTONE)
             grid = np.linspace(0.0, 1.0, TURN_GRID)[1:-1]
-            for s, (lo, arc) in enumerate(spans):
+            for s, (lo, _, arc) in enumerate(spans):
                 t = lo + grid * arc
                 v = np.asarray(m.slider(t).v, float) * (1.0 if s == 0 else -1.0)  # > 0: against the stroke
                 v = np.where(np.isfinite(v), v, -np.inf)
@@ -461,7 +467,7 @@ class Formulation:
         else:
             now = np.array(now, float)
         for s, fraction in turned:
-            lo, arc = spans[s]
+            lo, _, arc = spans[s]
             t = lo + fraction * arc
             slots = np.arange(s * MONOTONE, (s + 1) * MONOTONE)
             gaps = np.abs((now[slots] - t + math.pi) % TWO_PI - math.pi)
@@ -507,8 +513,7 @@ class Formulation:
         phi = list(phi if phi is not None else np.linspace(0.0, math.pi, self.n_lift))[: self.n_lift]
         phi += [0.0] * (self.n_lift - len(phi))
         if turn is None:
-            fall = float(theta[1] - theta[0])
-            mid = (float(theta[0]) + 0.5 * fall, float(theta[1]) + 0.5 * (TWO_PI - fall))
+            mid = [lo + 0.5 * arc for lo, _, arc in strokes(float(theta[0]), float(theta[1]))]
             turn = np.repeat(mid, MONOTONE) if self.guarded else []
         return self.w_blocks.join(
             free=[values[k] for k in self.free],

@@ -23,7 +23,7 @@ from qropt.synthesis.certificate import Certificate, Designs, objective_value, q
 from qropt.synthesis.diagnosis import Diagnosis
 from qropt.synthesis.formulation import BASE_SAMPLES, EXTRA_SAMPLES, Formulation, RowKind
 from qropt.synthesis.local import Candidate, Formulations, LocalSolve
-from qropt.synthesis.multistart import MultiStart, distinct
+from qropt.synthesis.multistart import MultiStart, distinct, score
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import Result
 
@@ -253,7 +253,7 @@ class Solver:
         ties = list(problem.mechanism.TIES)
         if not ties or not set(ties) <= set(problem.free) or c is None or c.size or not c.kinematic:
             return r
-        if r.status != "optimal":
+        if r.status != "optimal":  # a tie of what the certificate does not prove optimal is not broken
             return r
         tol = TIE_TOL * max(1.0, abs(r.objective))
         old = problem.conditions.get(c.bound)
@@ -262,21 +262,20 @@ class Solver:
             v = r.objective - k * tol if c.maximise else r.objective + k * tol
             return old if old is not None and c.better(old, v) else v
 
-        bound = within(1)
-        start = [{k: r.params[k] for k in problem.free}]
-        kw = {"targets": targets, "seed": seed, "max_rounds": max_rounds, "diagnose": False}
-        bounded = problem.replace(objective="min_size", conditions={**problem.conditions, c.bound: bound})
-        alone = problem.replace(objective="min_size")
-        local = {"use_analytic": False, "extra_starts": start}
-        tries = [(bounded, local), (alone, local)]  # from the optimum first, then along a closed-form family
-        if starts_.plan(bounded).kind in ("family", "enumeration"):
-            tries += [(bounded, {}), (alone, {})]
         # the bound holds at the sub-solve's design to rounding (1e-13 at the Whitworth's): accepted within 2 tol
         # of the optimum, so that a bit either way (a kernel compiled or not) does not decide
         accept = within(2)
         along = self._least_along(problem, r, ties, targets, c, accept, tol)
         if along is not None:
             return along
+        start = [{k: r.params[k] for k in problem.free}]
+        kw = {"targets": targets, "seed": seed, "max_rounds": max_rounds, "diagnose": False}
+        bounded = problem.replace(objective="min_size", conditions={**problem.conditions, c.bound: within(1)})
+        alone = problem.replace(objective="min_size")
+        local = {"use_analytic": False, "extra_starts": start}
+        tries = [(bounded, local), (alone, local)]  # from the optimum first, then along a closed-form family
+        if starts_.plan(bounded).kind in ("family", "enumeration"):
+            tries += [(bounded, {}), (alone, {})]
         for sub, how in tries:
             s = self.solve(sub, starts_n=0, **how, **kw)
             if s.status == "optimal" and not c.better(accept, s.quantities[c.name]):
@@ -300,8 +299,6 @@ class Solver:
         evaluation like any design. None where it is not certified within ``accept`` of the
         optimum (the NLP's way is tried then)."""
         from scipy.optimize import minimize_scalar  # imported here: only a continuum's tie needs it
-
-        from qropt.synthesis.multistart import score
 
         v0 = {k: r.params[k] for k in problem.free}
         branch = {k: r.params[k] for k in problem.branches}
@@ -357,7 +354,6 @@ class Solver:
             f"bounded 1-D search, within {2 * tol:.1e} of the optimum"
         )
         best = self._result(problem, cand, None, claim, r.stats)
-        best = dataclasses.replace(best, certificate=dataclasses.replace(best.certificate, global_claim=claim))
         return dataclasses.replace(best, local_optima=(best, *r.local_optima[1:]))
 
     def _check(self, problem, targets, extra_starts, starts_n, seed, max_rounds):
