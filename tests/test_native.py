@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import qropt
-from qropt.kinematics import cycle, native
+from qropt.kinematics import cycle, driver, native
 from qropt.kinematics.kernel import Batched
 from qropt.mechanisms import TYPES
 from tests.randmech import random_mechanisms
@@ -61,6 +61,43 @@ def test_compiled_kernels_equal_the_vm(cls, cache):
     for name in ang:
         np.testing.assert_allclose(mo.omega[name], om[name], rtol=0, atol=1e-12 * max(1.0, np.abs(om[name]).max()))
         np.testing.assert_allclose(mo.alpha[name], al[name], rtol=0, atol=1e-11 * max(1.0, np.abs(al[name]).max()))
+
+
+@needs_compiler
+@pytest.mark.parametrize("cls", TYPES, ids=lambda c: c.KIND)
+def test_the_refinement_in_c_equals_numpys(cls, cache):
+    """The driver's bracketing and Newton loop (one C call, ``qropt.kinematics.driver``) gives the numpy route's
+    extremes to the last bit, for every group at random mechanisms of every type: the cycle quantities on their
+    grid, the exact acceleration and velocity and every joint coordinate on a grid, and samples that are not the
+    quantity's (noise: most Newton starts fail and go on to the safeguarded iteration)."""
+    rng = np.random.default_rng(3)
+    for _, m in random_mechanisms(cls.KIND, 3, seed=31):
+        k, p = m._kernel, m._vector
+        th = cycle.grid(180)
+        coords = k.grid_coords(m.params, th)
+        cases = [
+            ("cycle", m._grid, k.cycle_requests),
+            ("accel", k.group("accel")[0].at(th, p)[0][None, :], [(0, "max"), (0, "min")]),
+            ("velocity", k.group("velocity")[0].at(th, p)[0][None, :], [(0, "max"), (0, "min")]),
+            ("coords", coords, [(i, kind) for i in range(coords.shape[0]) for kind in ("max", "min")]),
+            ("cycle", rng.normal(size=m._grid.shape), k.cycle_requests),
+        ]
+        for j, (group, q, requests) in enumerate(cases):
+            with pytest.MonkeyPatch.context() as mp:
+                mp.setitem(k._drivers, group, None)  # the numpy route
+                ref = k.refine(group, q, requests, p)
+            d = driver.build(k._switch(group).f, f"{group}_refine")
+            rows, sgn, *_ = k._plan(requests)
+            not_converged = d.refine(np.ascontiguousarray(q), 2 * np.pi / q.shape[1], rows, sgn, p)[1][-1]
+            assert not_converged > 0 or j != 4, "the noise sends starts to the safeguarded iteration"
+            with pytest.MonkeyPatch.context() as mp:
+                mp.setitem(k._drivers, group, d)
+                got = k.refine(group, q, requests, p)
+            assert len(got) == len(ref) == len(requests)
+            for a, b in zip(got, ref, strict=True):
+                np.testing.assert_array_equal(a.theta, b.theta)
+                np.testing.assert_array_equal(a.value, b.value)
+    assert any(e.theta.size for e in got), "the noise has extremes the safeguarded iteration confirms"
 
 
 @needs_compiler

@@ -23,7 +23,7 @@ from typing import NamedTuple
 import casadi
 import numpy as np
 
-from qropt.kinematics import cycle, native
+from qropt.kinematics import cycle, driver, native
 from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle, transmission_cos2
 from qropt.kinematics.ops import CASADI, NUMPY, Jet
 
@@ -196,6 +196,8 @@ class Kernel:
         )
         self._t, self._P, self._lp = t, P, lp
         self._groups: dict = {}
+        self._drivers: dict = {}  # group -> its refinement in C (``driver``), built once the group is refined HOT times
+        self._refines: dict = {}  # group -> refinements made so far (up to HOT)
 
     def group(self, name: str) -> list[_Quantity]:
         """'cycle': x, cos^2 of each varying joint (precise value: its transmission angle), margins;
@@ -307,10 +309,20 @@ class Kernel:
         key = ("plan", tuple(requests))
         plan = self._groups.get(key)
         if plan is None:
-            rows = np.array([q for q, _ in requests], int)
+            rows = np.array([q for q, _ in requests], np.int64)
             sgn = np.array([1.0 if kind == "max" else -1.0 for _, kind in requests])
             plan = self._groups[key] = (rows, sgn, sgn[:, None], np.arange(rows.size + 1))
         return plan
+
+    def _driver(self, group: str) -> driver.Driver | None:
+        """The group's refinement in C once refined Batched.HOT times (None before, or without a compiler)."""
+        if group in self._drivers:
+            return self._drivers[group]
+        uses = self._refines[group] = self._refines.get(group, 0) + 1
+        if uses < Batched.HOT:
+            return None
+        d = self._drivers[group] = driver.build(self._switch(group).f, f"{group}_refine")
+        return d
 
     def refine(self, group: str, grid_q, requests, p):
         """Extremes of a group's quantities. requests: [(quantity index, 'max' | 'min')].
@@ -320,6 +332,47 @@ class Kernel:
         n = grid_q.shape[1]
         h = TWO_PI / n
         rows, sgn, sgn_col, edges = self._plan(requests)
+        d = self._driver(group)
+        found = None
+        if d is not None and _is_c_float(grid_q) and _is_c_float(p):  # the driver reads them as C arrays
+            found = d.refine(grid_q, h, rows, sgn, p)
+        if found is None:
+            r, theta0, x, ok, val = self._newton(group, grid_q, h, rows, sgn, sgn_col, p)
+            if r is None:
+                return [Extremes(np.zeros(0), np.zeros(0)) for _ in requests]
+            bounds = np.searchsorted(r, edges).tolist()  # r is sorted: each request's slice
+            bad = not ok.all()
+        else:
+            hits, bounds = found
+            bad = bounds.pop()  # how many did not converge
+            x, val = hits[2].copy(), hits[4].copy()
+            if bad:
+                r, theta0, ok = hits[0].astype(np.intp), hits[1] * h, hits[3].copy()
+        keep = None
+        if bad:  # rare: flat, narrow or no extremes; the safeguarded iteration
+            quantity_of, keep = rows[r], np.ones(r.size, bool)
+            lo, hi = theta0 - h, theta0 + h
+            failed = ok == 0
+            for q in np.unique(quantity_of[failed]):
+                j = np.flatnonzero(failed & (quantity_of == q))
+                quantity = self.group(group)[q]
+                # a true extreme turns the slope inside its bracket; a jump (an angle wrapping at +-pi) does not
+                a, b, turns = _turning(quantity, lo[j], hi[j], sgn[r[j]], p)
+                keep[j[~turns]] = False
+                j, a, b = j[turns], a[turns], b[turns]
+                if j.size:
+                    xj = np.mod(self._safeguarded(quantity, a, b, p), TWO_PI)
+                    xj[xj > TWO_PI - 1e-12] = 0.0
+                    x[j] = xj
+                    val[j] = quantity.value(np.column_stack([xj, np.broadcast_to(p, (j.size, p.size))]))[:, 0]
+        if keep is None:
+            return [Extremes(x[a:b], val[a:b]) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+        return [Extremes(x[a:b][keep[a:b]], val[a:b][keep[a:b]]) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+
+    def _newton(self, group, grid_q, h, rows, sgn, sgn_col, p):
+        """The refinement in numpy around one batched Newton call (the driver's loops where none is compiled):
+        (request of each hit, its grid angle, theta, converged, value), or Nones where nothing is sampled."""
+        n = grid_q.shape[1]
         ext = np.empty((rows.size, n + 2))  # every request as a search for maxima, padded cyclically
         v = ext[:, 1:-1]
         np.multiply(grid_q[rows], sgn_col, out=v)
@@ -328,7 +381,7 @@ class Kernel:
         hit &= v > ext[:, 2:]
         r, i = np.nonzero(hit)
         if not r.size:
-            return [Extremes(np.zeros(0), np.zeros(0)) for _ in requests]
+            return None, None, None, None, None
         switch = self._switch(group)
         if r.size <= switch.MAX_ROWS:  # the rows written in place
             z, res, evaluate = switch.buffers(r.size)
@@ -344,28 +397,7 @@ class Kernel:
             res = switch(z)
         else:
             evaluate()
-        x, ok, val = res[:, 0].copy(), res[:, 1], res[:, 2].copy()
-        keep = None
-        if not ok.all():  # rare: flat, narrow or no extremes; the safeguarded iteration
-            quantity_of, keep = rows[r], np.ones(r.size, bool)
-            lo, hi = z[:, 1] - h, z[:, 1] + h
-            failed = ok == 0
-            for q in np.unique(quantity_of[failed]):
-                j = np.flatnonzero(failed & (quantity_of == q))
-                quantity = self.group(group)[q]
-                # a true extreme turns the slope inside its bracket; a jump (an angle wrapping at +-pi) does not
-                a, b, turns = _turning(quantity, lo[j], hi[j], sgn[r[j]], p)
-                keep[j[~turns]] = False
-                j, a, b = j[turns], a[turns], b[turns]
-                if j.size:
-                    xj = np.mod(self._safeguarded(quantity, a, b, p), TWO_PI)
-                    xj[xj > TWO_PI - 1e-12] = 0.0
-                    x[j] = xj
-                    val[j] = quantity.value(np.column_stack([xj, np.broadcast_to(p, (j.size, p.size))]))[:, 0]
-        bounds = np.searchsorted(r, edges).tolist()  # r is sorted: each request's slice
-        if keep is None:
-            return [Extremes(x[a:b], val[a:b]) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
-        return [Extremes(x[a:b][keep[a:b]], val[a:b][keep[a:b]]) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+        return r, z[:, 1].copy(), res[:, 0].copy(), res[:, 1].copy(), res[:, 2].copy()
 
     @staticmethod
     def _safeguarded(quantity, lo, hi, p):
@@ -449,6 +481,10 @@ class Kernel:
         return np.broadcast_to(lp.x, shape), gammas, margins
 
 
+def _is_c_float(a) -> bool:
+    return type(a) is np.ndarray and a.dtype == np.float64 and a.flags.c_contiguous
+
+
 TURN_SAMPLES = 16  # slopes sampled across a bracket whose ends do not turn (another extreme inside it)
 
 
@@ -477,12 +513,13 @@ def _turning(quantity: _Quantity, lo, hi, sign, p):
 
 
 RESOLVED = 1e-9  # spectrum tail / largest mode below which the grid resolves a quantity
+_ALL, _MAX = np.logical_and.reduce, np.maximum.reduce  # the ufuncs' reductions (the array methods wrap them)
 
 
 def spectrum(q) -> np.ndarray | None:
     """The discrete Fourier spectrum (rfft) of each row of uniform periodic samples q (Q, n); None if a sample
     is nan or inf."""
-    if not np.isfinite(q).all():
+    if not _ALL(np.isfinite(q), axis=None):
         return None
     return np.fft.rfft(q, axis=1)
 
@@ -492,9 +529,9 @@ def resolved_spectrum(c) -> bool:
     modes is below RESOLVED times its largest non-constant mode (so the trigonometric interpolant matches the
     function to that relative level and no extreme hides between samples)."""
     a = np.abs(c)
-    scale = a[:, 1:].max(axis=1)
+    scale = _MAX(a[:, 1:], axis=1)
     scale *= RESOLVED
-    return bool((a[:, -(a.shape[1] // 4) :].max(axis=1) <= scale).all())
+    return bool(_ALL(_MAX(a[:, -(a.shape[1] // 4) :], axis=1) <= scale))
 
 
 @functools.cache

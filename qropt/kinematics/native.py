@@ -50,23 +50,35 @@ def compiled(f: casadi.Function) -> casadi.Function:
     try:
         gen = casadi.CodeGenerator(f.name() + ".c", {"with_header": False})
         gen.add(f)
-        source = gen.dump()
-        key = hashlib.sha256("\n".join([source, _compiler(), *FLAGS, casadi.__version__]).encode()).hexdigest()[:24]
-        lib = cache_dir() / f"{f.name()}_{key}.so"
-        if not lib.exists():
-            lib.parent.mkdir(parents=True, exist_ok=True)
-            with tempfile.TemporaryDirectory(dir=lib.parent) as tmp:
-                src, out = Path(tmp) / "kernel.c", Path(tmp) / "kernel.so"
-                src.write_text(source)
-                done = subprocess.run(
-                    [_compiler(), *FLAGS, str(src), "-o", str(out), "-lm"], capture_output=True, timeout=120
-                )
-                if done.returncode != 0:
-                    return f
-                os.replace(out, lib)
-        return casadi.external(f.name(), str(lib))
-    except (OSError, RuntimeError, subprocess.SubprocessError):
+        lib = library(f.name(), gen.dump())
+        return f if lib is None else casadi.external(f.name(), str(lib))
+    except (OSError, RuntimeError):
         return f
 
 
-__all__ = ["compiled", "enabled", "cache_dir"]
+def library(name: str, source: str) -> Path | None:
+    """The shared library of C ``source`` (compiled once per machine into the cache, named ``name`` and a hash of
+    the source, the compiler command and CasADi's version), or None where it cannot be built."""
+    if not enabled():
+        return None
+    key = hashlib.sha256("\n".join([source, _compiler(), *FLAGS, casadi.__version__]).encode()).hexdigest()[:24]
+    lib = cache_dir() / f"{name}_{key}.so"
+    if lib.exists():
+        return lib
+    try:
+        lib.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=lib.parent) as tmp:
+            src, out = Path(tmp) / "kernel.c", Path(tmp) / "kernel.so"
+            src.write_text(source)
+            done = subprocess.run(
+                [_compiler(), *FLAGS, str(src), "-o", str(out), "-lm"], capture_output=True, timeout=120
+            )
+            if done.returncode != 0:
+                return None
+            os.replace(out, lib)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return lib
+
+
+__all__ = ["compiled", "library", "enabled", "cache_dir"]

@@ -408,8 +408,11 @@ class Mechanism:
             unknown = sorted(params.keys() - self.PARAMS.keys())
             raise InvalidParameter(f"{name}: unknown parameter(s) {unknown}; it takes {list(self.PARAMS)}")
         values = {}
-        for k, default in self.PARAMS.items():
+        for k, default, lo, hi in self._ranges():
             v = params.get(k, default)
+            if type(v) is float and lo <= v <= hi:  # the common case: a float in its range
+                values[k] = v
+                continue
             if v is REQUIRED or (v is None and default is REQUIRED):
                 raise InvalidParameter(f"{name}: missing parameter {k!r}; it needs {self.required()}")
             if v is None:
@@ -429,6 +432,29 @@ class Mechanism:
         failures = self.assembly_failures()
         if failures and (self.REQUIRES_FULL_TURN or failures[0][1:] == (0.0, cycle.TWO_PI)):
             raise AssemblyError(name, self.params, failures)
+
+    @classmethod
+    def _ranges(cls) -> tuple:
+        """(name, default, least, largest) of each parameter in PARAMS order: the floats taken without further
+        checks (a branch sign never: its range is empty)."""
+        r = cls.__dict__.get("_RANGES")
+        if r is None:
+            r = tuple(
+                (
+                    k,
+                    d,
+                    *(
+                        (1.0, -1.0)
+                        if k in cls.BRANCHES
+                        else (1 / MAGNITUDE, MAGNITUDE)
+                        if k in cls.LENGTHS
+                        else (-MAGNITUDE, MAGNITUDE)
+                    ),
+                )
+                for k, d in cls.PARAMS.items()
+            )
+            cls._RANGES = r
+        return r
 
     def __setattr__(self, k, v):
         # cached properties write to __dict__ directly, so only user assignments arrive here
@@ -579,7 +605,7 @@ class Mechanism:
         for n in cycle.GRIDS:
             q = k.grid_values(self._vector, cycle.grid(n))
             margins = q[1 + len(k.joints) :]
-            least = margins.min(initial=np.inf)
+            least = np.minimum.reduce(margins, axis=None, initial=np.inf)
             if least != least:  # a nan sample: the least of the others
                 least = np.nanmin(margins, initial=np.inf)
             if least < -cycle.MARGIN_TOL:
@@ -610,9 +636,10 @@ class Mechanism:
         margins = []
         for m in range(nm):
             e = res[2 + nj + m]
-            if e.value.size and e.value.min() < least[m]:
-                i = int(e.value.argmin())
-                margins.append((float(e.value[i]), float(e.theta[i])))
+            values = e.value.tolist()
+            if values and min(values) < least[m]:
+                i = values.index(min(values))  # the first of equal ones
+                margins.append((values[i], float(e.theta[i])))
             else:  # the least sample's crank angle
                 at = int((margins_grid[m] == least[m]).argmax())
                 margins.append((least[m], float(cycle.grid(q.shape[1])[at])))
