@@ -439,21 +439,13 @@ class Mechanism:
         checks (a branch sign never: its range is empty)."""
         r = cls.__dict__.get("_RANGES")
         if r is None:
-            r = tuple(
-                (
-                    k,
-                    d,
-                    *(
-                        (1.0, -1.0)
-                        if k in cls.BRANCHES
-                        else (1 / MAGNITUDE, MAGNITUDE)
-                        if k in cls.LENGTHS
-                        else (-MAGNITUDE, MAGNITUDE)
-                    ),
-                )
-                for k, d in cls.PARAMS.items()
-            )
-            cls._RANGES = r
+
+            def span(k):
+                if k in cls.BRANCHES:
+                    return 1.0, -1.0
+                return (1 / MAGNITUDE, MAGNITUDE) if k in cls.LENGTHS else (-MAGNITUDE, MAGNITUDE)
+
+            r = cls._RANGES = tuple((k, d, *span(k)) for k, d in cls.PARAMS.items())
         return r
 
     def __setattr__(self, k, v):
