@@ -98,6 +98,10 @@ def test_the_refinement_in_c_equals_numpys(cls, cache):
                 np.testing.assert_array_equal(a.theta, b.theta)
                 np.testing.assert_array_equal(a.value, b.value)
     assert any(e.theta.size for e in got), "the noise has extremes the safeguarded iteration confirms"
+    params = random_mechanisms(cls.KIND, 1, seed=32)[0][0]
+    for _ in range(Batched.HOT):  # a type analysed often: its cycle's refinement runs in C from then on
+        cls(**params).gamma_min()
+    assert isinstance(cls(**params)._kernel._drivers.get("cycle"), driver.Driver)
 
 
 @needs_compiler
