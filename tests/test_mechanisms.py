@@ -282,3 +282,28 @@ def test_of_equal_transmission_minima_the_first_found_is_named():
     m.__dict__.pop("_gamma_min")  # the cached value, computed again from the minima in the other order
     m.__dict__["_cycle"] = {**m._cycle, "gamma": swapped}
     assert m.gamma_min().theta2 == t[1]
+
+
+def test_mechanisms_results_and_comparisons_pickle():
+    """A mechanism pickles as its type, parameters and unit (rebuilt and checked when loaded): every type, a
+    unit other than metres, a Result with its local optima and a design() comparison (for another process)."""
+    import pickle
+
+    import qropt
+    from qropt.examples import paper_problem
+    from qropt.mechanisms import TYPES
+
+    for cls in TYPES:
+        _, m = random_mechanisms(cls.KIND, 1, seed=41)[0]
+        back = pickle.loads(pickle.dumps(m))
+        assert back == m and type(back) is type(m)
+        assert back.gamma_min() == m.gamma_min() and back.dead_centres() == m.dead_centres()
+    mm = qropt.SliderCrank(r2=100.0, r3=350.0, e=20.0, units="mm")
+    assert pickle.loads(pickle.dumps(mm)).units == "mm"
+    r = qropt.solve(paper_problem())
+    b = pickle.loads(pickle.dumps(r))
+    assert (b.status, b.params, b.objective, b.mechanism) == (r.status, r.params, r.objective, r.mechanism)
+    assert [o.params for o in b.local_optima] == [o.params for o in r.local_optima]
+    c = qropt.design(1.5, 0.3, types=["slider-crank", "whitworth"])
+    d = pickle.loads(pickle.dumps(c))
+    assert d.markdown() == c.markdown()

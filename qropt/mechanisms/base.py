@@ -207,6 +207,10 @@ def _motion_of(theta2, x, v, a, rates) -> Motion:
     return Motion(theta2, x, v, a, lambda: rates)
 
 
+def _rebuilt(cls, params: dict, units: str) -> Mechanism:
+    return cls(**params, units=units)
+
+
 class DeadCentres(NamedTuple):
     """Crank angles (rad, in [0, 2pi)) of the largest and smallest output, and those outputs.
 
@@ -447,6 +451,9 @@ class Mechanism:
 
             r = cls._RANGES = tuple((k, d, *span(k)) for k, d in cls.PARAMS.items())
         return r
+
+    def __reduce__(self):  # pickled as its type, parameters and unit; rebuilt (and checked) when loaded
+        return (_rebuilt, (type(self), dict(self.params), self.units))
 
     def __setattr__(self, k, v):
         # cached properties write to __dict__ directly, so only user assignments arrive here
