@@ -307,3 +307,16 @@ def test_mechanisms_results_and_comparisons_pickle():
     c = qropt.design(1.5, 0.3, types=["slider-crank", "whitworth"])
     d = pickle.loads(pickle.dumps(c))
     assert d.markdown() == c.markdown()
+    # and a problem, as its plain values: a dynamic one in mm, and one of a type of one's own
+    from qropt.studies._design import type_problem
+    from tests.test_bodies import PlateSlider
+
+    masses, loads = qropt.Masses.steel(4e-4, ram=20.0), qropt.Loads(1000.0)
+    for p in (
+        type_problem(
+            "drag-link-slider", 1.5, 300.0, objective="min_peak_torque", masses=masses, loads=loads, units="mm"
+        ),
+        type_problem(PlateSlider, 1.5, 0.3, conditions={"gamma_min": 0.5}),
+    ):
+        q = pickle.loads(pickle.dumps(p))
+        assert q == p and q.to_dict() == p.to_dict()

@@ -315,6 +315,9 @@ class Problem:
             **({} if self.loads is None else {"loads": self.loads.to_dict()}),
         }
 
+    def __reduce__(self):  # pickled as its plain values (``to_dict``), validated again when loaded
+        return (type(self).from_dict, (self.to_dict(),))
+
     @classmethod
     def from_dict(cls, d) -> Problem:
         """The Problem of ``to_dict`` (or a hand-written dict, TOML or JSON table), validated as always."""
