@@ -270,3 +270,33 @@ def test_min_peak_bearing_force_with_a_cutting_force_solves_and_its_peak_is_the_
     ends = CycleDynamics(m, 10.0, masses=masses, loads=loads).at([dc.theta_max, dc.theta_min], True).joint_forces
     best = max(max(np.hypot(*forces[k].T).max(), np.hypot(*ends[k].T).max()) for k in forces if k != "slide")
     assert best * (1 - 1e-12) <= r.objective <= best * (1 + 1e-9)
+
+
+def test_the_crank_rocker_sliders_least_peak_torque_lies_at_a_dead_point():
+    """At TR 2.135, 0.1797 m (a task of ``benchmarks.tasks``, steel bars and a 20 kg ram) the crank-rocker slider's
+    least peak torque falls as a gamma_min bound is loosened, the bound active each time: its infimum lies at a
+    dead point (gamma_min 0), not attained, which is why the unbounded row fails there (docs/benchmarks.md)."""
+    import math
+
+    masses, loads = qropt.Masses.steel(4e-4, ram=20.0), qropt.Loads(1000.0)
+    got = []
+    for deg in (10.0, 5.0):
+        p = type_problem(
+            "crank-rocker-slider",
+            2.135,
+            0.1797,
+            objective="min_peak_torque",
+            masses=masses,
+            loads=loads,
+            omega2=10.0,
+            conditions={"gamma_min": math.radians(deg)},
+        )
+        r = qropt.solve(p)
+        assert r.status == "optimal", r.message
+        assert r.quantities["gamma_min"] == pytest.approx(math.radians(deg), abs=1e-7)  # the bound is active
+        th = np.linspace(0.0, 2 * np.pi, 20001)  # the certified peak against the torque on a dense grid
+        peak = np.abs(r.mechanism.dynamics(th, 10.0, masses=masses, loads=loads).torque).max()
+        assert r.objective * (1 - 1e-5) <= peak <= r.objective * (1 + 1e-12)
+        got.append(r.objective)
+    assert got[1] < got[0]  # looser bound, lower torque
+    assert got == pytest.approx([45.477, 45.176], abs=1e-3)
