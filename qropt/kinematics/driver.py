@@ -109,15 +109,13 @@ def build(newton: casadi.Function, name: str) -> Driver | None:
     works."""
     if not native.enabled():
         return None
-    gen = casadi.CodeGenerator(name + ".c", {"with_header": False})
-    z = newton.mx_in(0)
-    gen.add(casadi.Function("qropt_newton", [z], [newton(z)]))
-    lib = native.library(name, gen.dump() + _DRIVER)
-    if lib is None:
-        return None
     try:
-        return Driver(ctypes.CDLL(str(lib)))
-    except OSError:
+        gen = casadi.CodeGenerator(name + ".c", {"with_header": False})
+        z = newton.mx_in(0)
+        gen.add(casadi.Function("qropt_newton", [z], [newton(z)]))
+        lib = native.library(name, gen.dump() + _DRIVER)
+        return None if lib is None else Driver(ctypes.CDLL(str(lib)))
+    except (OSError, RuntimeError):  # as native.compiled: the numpy route instead
         return None
 
 

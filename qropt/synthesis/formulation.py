@@ -419,10 +419,10 @@ class Formulation:
         for k, out in enumerate(self.sampled):
             self.row(f"sample {k}: output below its maximum", x_max - out.x + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
             self.row(f"sample {k}: output above its minimum", out.x - x_min + slack, 0, casadi.inf, RowKind.DEAD_CENTRE)
-        first = len(self.rows)
+        first, spans = len(self.rows), strokes(TH[0], TH[1])
         for k in range(2 * MONOTONE):
             falling = k < MONOTONE
-            lo, hi, _ = strokes(TH[0], TH[1])[k // MONOTONE]
+            lo, hi, _ = spans[k // MONOTONE]
             name, out = f"{'falling' if falling else 'rising'} stroke, turn-back {k % MONOTONE}", self.at(TURN[k])
             self.row(f"{name}: output velocity stationary", out.a, 0.0, 0.0, RowKind.LIFT)
             self.row(f"{name}: inside the stroke", TURN[k] - lo, 0.0, casadi.inf, RowKind.LIFT)
@@ -453,17 +453,24 @@ class Formulation:
         whose angle in ``now`` (the current ones) is within TURN_NEAR of it, else in the slot of its stroke
         where m's velocity is farthest from turning back (the one that holds least)."""
         spans = strokes(float(theta[0]), float(theta[1]))
+
+        def against(s, t):  # m's output velocity at crank angles t, > 0 against stroke s's way; nan where undefined
+            return np.asarray(m.slider(t).v, float) * (1.0 if s == 0 else -1.0)
+
+        def fastest(v):  # the index of the fastest finite velocity along the stroke
+            return int(np.argmin(np.where(np.isfinite(v), v, np.inf)))
+
         if now is None:
             now = np.zeros(2 * MONOTONE)
             grid = np.linspace(0.0, 1.0, TURN_GRID)[1:-1]
             for s, (lo, _, arc) in enumerate(spans):
                 t = lo + grid * arc
-                v = np.asarray(m.slider(t).v, float) * (1.0 if s == 0 else -1.0)  # > 0: against the stroke
+                v = against(s, t)
+                k = fastest(v)
                 v = np.where(np.isfinite(v), v, -np.inf)
-                fastest = int(np.argmin(np.where(np.isfinite(v), v, np.inf)))
                 bumps = np.flatnonzero((v[1:-1] > v[:-2]) & (v[1:-1] >= v[2:])) + 1  # the velocity's turns back
-                worst = int(bumps[np.argmax(v[bumps])]) if bumps.size else fastest
-                now[s * MONOTONE : (s + 1) * MONOTONE] = t[worst], t[fastest]
+                worst = int(bumps[np.argmax(v[bumps])]) if bumps.size else k
+                now[s * MONOTONE : (s + 1) * MONOTONE] = t[worst], t[k]
         else:
             now = np.array(now, float)
         for s, fraction in turned:
@@ -473,8 +480,7 @@ class Formulation:
             gaps = np.abs((now[slots] - t + math.pi) % TWO_PI - math.pi)
             i = slots[int(np.argmin(gaps))]
             if gaps.min() > TURN_NEAR:  # a new turn-back: in place of the slot that holds least
-                against = np.asarray(m.slider(now[slots]).v, float) * (1.0 if s == 0 else -1.0)
-                i = slots[int(np.argmin(np.where(np.isfinite(against), against, np.inf)))]
+                i = slots[fastest(against(s, now[slots]))]
             now[i] = t
         return now
 
