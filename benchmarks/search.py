@@ -9,7 +9,9 @@ For a task (TR, stroke) and a row of ``design`` (its problem ``type_problem(kind
    (Grashof class), its output reverses twice a turn and, scaled to the task's stroke (TR, gamma_min and the
    shape do not change with scale; the peak acceleration grows with it, the footprint with its square), stays
    inside the box. Its TR, stroke, gamma_min, peak acceleration (spectral second derivative) and footprint come
-   from the grid (dead centres refined by the grid parabola).
+   from the grid (dead centres refined by the grid parabola). An objective the grid does not give (the dynamic
+   ones: their loads and the ram do not scale with the stroke) is the exact analysis of each scaled design near
+   the task (``criteria.objective_of``: the inverse dynamics over the turn), a few hundred a million shapes.
 2. **Polish.** The ``polish`` designs within ``window`` of the TR that are best by the objective start local
    solves (the row's NLP, no closed forms, no Sobol points): each ends at an exact, certified design.
 3. **Multi-start.** The row's problem solved with ``starts`` Sobol starts (default: many times the default),
@@ -29,11 +31,13 @@ import time
 import numpy as np
 
 from qropt import Solver
+from qropt.errors import QroptError
 from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle
 from qropt.kinematics.ops import NUMPY
 from qropt.mechanisms import REQUIRED
 from qropt.studies._design import TYPES, design, type_problem
-from qropt.synthesis.criteria import sense
+from qropt.synthesis import criteria
+from qropt.synthesis.criteria import objective_of, sense
 from qropt.synthesis.result import SOLUTION_PRESENT
 
 M = 64  # crank angles of the grid
@@ -138,12 +142,27 @@ def shapes(problem, n: int, seed: int, window: float = 0.02):
             "max_gamma_min": -g["gamma_min"],
             "min_size": g["footprint"] * s**2,
             "min_peak_accel": g["peak_accel"] * s * problem.omega2**2,
-        }[problem.objective]
+        }.get(problem.objective)
         for i in np.flatnonzero(keep):
-            found.append({k: float(p[k][i] * (s[i] if k in scaled_names else 1.0)) for k in problem.free})
-            values.append(float(value[i]))
+            design = {k: float(p[k][i] * (s[i] if k in scaled_names else 1.0)) for k in problem.free}
+            v = _exact(problem, design) if value is None else float(value[i])
+            if v is not None:
+                found.append(design)
+                values.append(v)
     order = np.argsort(values)
     return [found[i] for i in order], [values[i] for i in order], counted
+
+
+def _exact(problem, design: dict) -> float | None:
+    """The problem's objective of a design (free parameters), exactly, minimised; None where it does not
+    assemble or its analysis fails."""
+    cls = problem.mechanism
+    try:
+        m = cls(**design, **dict(problem.fixed), **{k: b[0] for k, b in problem.branches.items()}, units=problem.units)
+        v = objective_of(problem, m)
+    except QroptError:
+        return None
+    return -sense(problem.objective) * v if v is not None and math.isfinite(v) else None
 
 
 def reference(problem, n: int, seed: int, polish: int = 16, starts: int = 256, solver=None) -> dict:
@@ -171,12 +190,13 @@ def reference(problem, n: int, seed: int, polish: int = 16, starts: int = 256, s
     }
 
 
-def compare(time_ratio: float, stroke: float, objective: str, n: int, seed: int, types=None, starts: int = 256):
-    """Every row of ``design(time_ratio, stroke, objective)`` against its reference: one dict per row."""
-    c = design(time_ratio, stroke, objective=objective, types=types)
+def compare(time_ratio: float, stroke: float, objective: str, n: int, seed: int, types=None, starts: int = 256, **kw):
+    """Every row of ``design(time_ratio, stroke, objective, **kw)`` against its reference: one dict per row
+    (``kw``: masses, loads, omega2 of a dynamic objective)."""
+    c = design(time_ratio, stroke, objective=objective, types=types, **kw)
     out = []
     for row in c.rows:
-        problem = type_problem(row.type, time_ratio, stroke, objective=objective)
+        problem = type_problem(row.type, time_ratio, stroke, objective=objective, **kw)
         ref = reference(problem, n, seed, starts=starts)
         mine = row.result.objective if row.result.status in SOLUTION_PRESENT else None
         worse = -sense(objective)  # larger is worse
@@ -204,21 +224,24 @@ def compare(time_ratio: float, stroke: float, objective: str, n: int, seed: int,
 
 def main(argv=None) -> int:
     from benchmarks.report import RESULTS, save
-    from benchmarks.tasks import tasks
+    from benchmarks.tasks import LOADS, MASSES, OMEGA2, tasks
 
     ap = argparse.ArgumentParser(prog="python -m benchmarks.search", description=__doc__.split("\n\n")[0])
     ap.add_argument("--tasks", type=int, default=4)
     ap.add_argument("--shapes", type=int, default=1_000_000)
     ap.add_argument("--starts", type=int, default=256)
     ap.add_argument("--objectives", nargs="+", default=["max_gamma_min", "min_peak_accel"])
+    ap.add_argument("--types", nargs="+", default=None, help="rows of design() (default: every row)")
     ap.add_argument("--seed", type=int, default=20261124)
     ap.add_argument("--name", default="search", help="results/<name>.json and .md")
     a = ap.parse_args(argv)
     task_list = tasks(a.tasks, seed=a.seed + 1)  # not the benchmark's tasks
     rows = []
     for objective in a.objectives:
+        # a dynamic objective with benchmarks.tasks' default mass model (steel links, a 20 kg ram, 1,000 N)
+        kw = {"masses": MASSES, "loads": LOADS, "omega2": OMEGA2} if criteria.of(objective).needs_masses else {}
         for tr, s in task_list:
-            got = compare(tr, s, objective, a.shapes, a.seed, starts=a.starts)
+            got = compare(tr, s, objective, a.shapes, a.seed, types=a.types, starts=a.starts, **kw)
             rows += got
             for r in got:
                 ref = r["reference"]
