@@ -11,7 +11,8 @@ For a task (TR, stroke) and a row of ``design`` (its problem ``type_problem(kind
    inside the box. Its TR, stroke, gamma_min, peak acceleration (spectral second derivative) and footprint come
    from the grid (dead centres refined by the grid parabola). An objective the grid does not give (the dynamic
    ones: their loads and the ram do not scale with the stroke) is the exact analysis of each scaled design near
-   the task (``criteria.objective_of``: the inverse dynamics over the turn), a few hundred a million shapes.
+   the task (``criteria.objective_of``: the inverse dynamics over the turn), up to a few thousand a million
+   shapes.
 2. **Polish.** The ``polish`` designs within ``window`` of the TR that are best by the objective start local
    solves (the row's NLP, no closed forms, no Sobol points): each ends at an exact, certified design.
 3. **Multi-start.** The row's problem solved with ``starts`` Sobol starts (default: many times the default),
