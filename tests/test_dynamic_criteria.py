@@ -300,3 +300,26 @@ def test_the_crank_rocker_sliders_least_peak_torque_lies_at_a_dead_point():
         got.append(r.objective)
     assert got[1] < got[0]  # looser bound, lower torque
     assert got == pytest.approx([45.477, 45.176], abs=1e-3)
+
+
+def test_a_dynamic_optimum_is_solved_again_from_itself():
+    """The exchange loop's samples can hold a design that a fresh NLP started at it leaves for a better one
+    nearby: the Whitworth's least peak torque at TR 1.796, 1.5711 m (a task tests/test_global.py drew) ended at
+    3578.882 N m, and a solve from that design gives 3578.109. The best design is solved again from itself
+    (``Solver.refreshed``); the answer is checked against the torque on a 20,001-angle grid."""
+    from benchmarks.tasks import LOADS as loads
+    from benchmarks.tasks import MASSES as masses
+
+    p = type_problem("whitworth", 1.796, 1.5711, objective="min_peak_torque", masses=masses, loads=loads, omega2=10.0)
+    r = qropt.Solver().solve(p)
+    assert r.status == "optimal", r.message
+    assert r.objective == pytest.approx(3578.10864, rel=1e-8)
+    th = np.linspace(0.0, 2 * np.pi, 20_001)
+    peak = np.abs(r.mechanism.dynamics(th, 10.0, masses=masses, loads=loads).torque).max()
+    assert peak == pytest.approx(r.objective, rel=1e-6) and peak <= r.objective * (1 + 1e-12)
+    worse = {"r1": 0.5013653941987694, "r2": 3.7978268031009095, "r5": 0.6616108600710846}
+    worse |= {"r6": 1.4047279049273311, "h": 0.627835901548651}  # the design it ended at before
+    m = p.build(worse, {"sigma_slider": 1.0})
+    assert criteria.objective_of(p, m) == pytest.approx(3578.88227, rel=1e-8)
+    again = qropt.Solver().solve(p, starts_n=0, use_analytic=False, extra_starts=[worse], diagnose=False)
+    assert again.objective == pytest.approx(r.objective, rel=1e-8)
