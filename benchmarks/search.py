@@ -157,10 +157,8 @@ def shapes(problem, n: int, seed: int, window: float = 0.02):
 def _exact(problem, design: dict) -> float | None:
     """The problem's objective of a design (free parameters), exactly, minimised; None where it does not
     assemble or its analysis fails."""
-    cls = problem.mechanism
     try:
-        m = cls(**design, **dict(problem.fixed), **{k: b[0] for k, b in problem.branches.items()}, units=problem.units)
-        v = objective_of(problem, m)
+        v = objective_of(problem, problem.build(design, {k: b[0] for k, b in problem.branches.items()}))
     except QroptError:
         return None
     return -sense(problem.objective) * v if v is not None and math.isfinite(v) else None

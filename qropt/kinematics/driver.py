@@ -110,10 +110,8 @@ def build(newton: casadi.Function, name: str) -> Driver | None:
     if not native.enabled():
         return None
     try:
-        gen = casadi.CodeGenerator(name + ".c", {"with_header": False})
         z = newton.mx_in(0)
-        gen.add(casadi.Function("qropt_newton", [z], [newton(z)]))
-        lib = native.library(name, gen.dump() + _DRIVER)
+        lib = native.library(name, native.source(casadi.Function("qropt_newton", [z], [newton(z)])) + _DRIVER)
         return None if lib is None else Driver(ctypes.CDLL(str(lib)))
     except (OSError, RuntimeError):  # as native.compiled: the numpy route instead
         return None

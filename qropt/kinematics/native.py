@@ -48,20 +48,25 @@ def compiled(f: casadi.Function) -> casadi.Function:
     if not enabled():
         return f
     try:
-        gen = casadi.CodeGenerator(f.name() + ".c", {"with_header": False})
-        gen.add(f)
-        lib = library(f.name(), gen.dump())
+        lib = library(f.name(), source(f))
         return f if lib is None else casadi.external(f.name(), str(lib))
     except (OSError, RuntimeError):
         return f
 
 
-def library(name: str, source: str) -> Path | None:
-    """The shared library of C ``source`` (compiled once per machine into the cache, named ``name`` and a hash of
+def source(f: casadi.Function) -> str:
+    """f as C, by CasADi's code generator (no header), for ``library``."""
+    gen = casadi.CodeGenerator(f.name() + ".c", {"with_header": False})
+    gen.add(f)
+    return gen.dump()
+
+
+def library(name: str, code: str) -> Path | None:
+    """The shared library of C ``code`` (compiled once per machine into the cache, named ``name`` and a hash of
     the source, the compiler command and CasADi's version), or None where it cannot be built."""
     if not enabled():
         return None
-    key = hashlib.sha256("\n".join([source, _compiler(), *FLAGS, casadi.__version__]).encode()).hexdigest()[:24]
+    key = hashlib.sha256("\n".join([code, _compiler(), *FLAGS, casadi.__version__]).encode()).hexdigest()[:24]
     lib = cache_dir() / f"{name}_{key}.so"
     if lib.exists():
         return lib
@@ -69,7 +74,7 @@ def library(name: str, source: str) -> Path | None:
         lib.parent.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(dir=lib.parent) as tmp:
             src, out = Path(tmp) / "kernel.c", Path(tmp) / "kernel.so"
-            src.write_text(source)
+            src.write_text(code)
             done = subprocess.run(
                 [_compiler(), *FLAGS, str(src), "-o", str(out), "-lm"], capture_output=True, timeout=120
             )
@@ -81,4 +86,4 @@ def library(name: str, source: str) -> Path | None:
     return lib
 
 
-__all__ = ["compiled", "library", "enabled", "cache_dir"]
+__all__ = ["compiled", "source", "library", "enabled", "cache_dir"]

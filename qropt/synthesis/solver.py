@@ -267,9 +267,8 @@ class Solver:
         again = "once" if times == 1 else f"{times} times"
         claim = f"{r.certificate.global_claim}; its best design solved again from itself, better {again}"
         cert = dataclasses.replace(best.certificate, global_claim=claim)
-        best = dataclasses.replace(
-            best, certificate=cert, message=f"certified optimum; global: {claim}", local_optima=(), stats=r.stats
-        )
+        message = best.message.replace(best.certificate.global_claim, claim)
+        best = dataclasses.replace(best, certificate=cert, message=message, local_optima=(), stats=r.stats)
         return dataclasses.replace(best, local_optima=(best, *r.local_optima[1:]))
 
     def least_size(self, problem, r: Result, targets, seed, max_rounds) -> Result:
