@@ -139,6 +139,27 @@ def test_compiled_dynamics_equal_the_jets_route(kind, cache):
     assert used == ({False} if kind == "four-bar" else {False, True})
 
 
+@needs_compiler
+@pytest.mark.parametrize("kind", ["crank-shaper", "four-bar"])
+def test_dynamics_are_the_same_from_the_first_call_to_the_compiled_ones(kind, cache):
+    """A structure's dynamics give the same numbers to the last bit at every call, on CasADi's VM and then
+    compiled, so that a dynamic solve does not depend on what the process evaluated before."""
+    from qropt.dynamics import compiled
+    from qropt.dynamics.inverse import system_of
+    from tests.test_dynamics import _case, _designs
+
+    t = np.linspace(0.0, 2 * np.pi, 97, endpoint=False) + 0.02
+    m = _designs(kind)[0]
+    masses, loads, omega2, alpha2 = _case(kind, 0, m)
+    runs = [m.dynamics(t, omega2, alpha2, masses=masses, loads=loads) for _ in range(Batched.HOT + 2)]
+    f = compiled.kernel(m, system_of(m, masses), False)
+    assert f._entry(t.size)[5], "the last calls ran compiled"
+    for r in runs[1:]:
+        np.testing.assert_array_equal(r.torque, runs[0].torque)
+        for j in r.joint_forces:
+            np.testing.assert_array_equal(r.joint_forces[j], runs[0].joint_forces[j])
+
+
 def test_slider_gives_link_rates_on_demand():
     """slider() computes x, v, a; its link rates, asked for, equal motion()'s."""
     _, m = random_mechanisms("whitworth", 1, seed=4)[0]
@@ -180,3 +201,25 @@ def test_analysis_without_a_compiler_is_the_same():
         assert done.returncode == 0, done.stderr
         runs[flag] = ast.literal_eval(done.stdout.strip())
     np.testing.assert_allclose(runs["0"], runs["1"], rtol=1e-13, atol=0)
+
+
+def test_threads_calling_one_kernel_each_get_their_own_rows():
+    """Four threads evaluate one Batched with the same K at once (CasADi runs a buffer without Python's lock): each
+    gets its own rows, bit for bit, and the process does not crash (it did with buffers shared by K). In a
+    subprocess, so that a crash is this test's failure."""
+    code = (
+        "import threading, casadi, numpy as np\n"
+        "from qropt.kinematics.kernel import Batched\n"
+        "x = casadi.MX.sym('z', 4); y = x\n"
+        "for _ in range(100): y = casadi.sin(y) * 1.0001 + casadi.cos(y[::-1])\n"
+        "b = Batched(casadi.Function('threads', [x], [y]), compiled=False)\n"
+        "z = np.random.default_rng(0).standard_normal((2800, 4)); ref = b(z); wrong = []\n"
+        "def work(i):\n"
+        "    for _ in range(30): wrong.append(not np.array_equal(b(z[i::4]), ref[i::4]))\n"
+        "ts = [threading.Thread(target=work, args=(i,)) for i in range(4)]\n"
+        "[t.start() for t in ts]; [t.join() for t in ts]\n"
+        "print(len(wrong), sum(wrong))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, f"exit {done.returncode}: {done.stderr[-2000:]}"
+    assert done.stdout.split() == ["120", "0"]

@@ -1,8 +1,12 @@
 """The inverse dynamics of one linkage structure as one compiled call per crank angle: the loop's exact rates
 (CasADi's derivatives of the same loop code), each body's motion (``rigid.body_motion``), the Newton-Euler system
 (``_System.assemble``) and its elimination in the structure's order (``Elimination``), as one CasADi function
-compiled to machine code once it is used often (``kinematics.kernel.Batched``); until then, and without a
-compiler, the jets and numpy compute the same numbers (``inverse._numpy_parts``).
+compiled to machine code once it is used often (``kinematics.kernel.Batched``), on CasADi's virtual machine until
+then and without a compiler: the same numbers to the last bit, so that a result does not depend on how often the
+process evaluated the structure before (the jets' numbers differ in the last bits, and a dynamic solve's path can
+follow them: the drag-link slider's least peak torque at TR 2.479, 0.2952 m was 126.013 N m in a fresh process and
+145.074 after two other tasks). Where a row is not finite (a singular angle) the jets and numpy
+(``inverse._numpy_parts``) compute it and report where.
 
 One function serves every design and mass model of a type: the parameters, the bodies' masses, centres and
 inertias, omega2, alpha2, gravity, the length unit and a load known beforehand (a constant cutting force, a
@@ -16,12 +20,10 @@ import casadi
 import numpy as np
 
 from qropt.dynamics.rigid import body_motion
-from qropt.kinematics import native
 from qropt.kinematics.kernel import CSE, Batched
 from qropt.kinematics.ops import CASADI
 
 _KERNELS: dict = {}
-_CALLS: dict = {}  # (structure, rows) -> calls made before the structure's Function was built
 
 
 def _key(m, s, superposed: bool) -> tuple:
@@ -83,20 +85,11 @@ def _function(m, s, superposed: bool) -> casadi.Function:
 
 
 def parts(m, s, t, omega2, alpha2, g, k, known=None, superposed=False):
-    """``inverse._Parts`` from the compiled call (``known``: the load that does not depend on the motion, (n,) on
-    the load's row, or None), or None while it is not machine code (or where a row is not finite: a singular
-    angle, which the numpy route reports)."""
+    """``inverse._Parts`` from the structure's Function (``known``: the load that does not depend on the motion,
+    (n,) on the load's row, or None), or None where a row is not finite (a singular angle, which the numpy route
+    reports)."""
     n = t.size
-    key = _key(m, s, superposed)
-    f = _KERNELS.get(key)
-    if f is None:  # built (about 15 ms) only once its calls would run compiled
-        calls = _CALLS[key, n] = _CALLS.get((key, n), 0) + 1
-        if calls < Batched.HOT or not native.enabled():
-            return None
-        f = kernel(m, s, superposed)
-        f.credit(n, calls - 1)
-    if not f.hot(n):
-        return None
+    f = kernel(m, s, superposed)  # CasADi's VM until its calls are HOT, then machine code: the same numbers
     z = np.empty((n, f.m))
     z[:] = [0.0, omega2, alpha2, g, k, 0.0, *m.params.values(), *(v for b in s.bodies for v in _body(s.props[b.name]))]
     z[:, 0] = t

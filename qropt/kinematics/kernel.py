@@ -18,6 +18,7 @@ numbers, so they are kept per type for the life of the process.
 from __future__ import annotations
 
 import functools
+import threading
 from typing import NamedTuple
 
 import casadi
@@ -70,7 +71,7 @@ class Batched:
             z = f.mx_in(0)
             f = casadi.Function(f.name() + "_dense", [z], [casadi.densify(f(z))])
         self.f, self.m, self.r = f, f.size1_in(0), f.size1_out(0)
-        self._by_k: dict = {}  # K -> [z buffer, out buffer, evaluate, FunctionBuffer, uses when built, native?]
+        self._local = threading.local()  # .by_k: K -> [z, out, evaluate, FunctionBuffer, uses when built, native?]
         self._uses: dict = {}
         self._native = None
         self.may_compile = compiled  # False: a Function of one problem (its constants in the code)
@@ -84,6 +85,14 @@ class Batched:
         if self._native is None:
             self._native = native.compiled(self.f)
         return self._native.map(k), self._native is not self.f
+
+    @property
+    def _by_k(self) -> dict:
+        """This thread's buffers by K."""
+        by_k = getattr(self._local, "by_k", None)
+        if by_k is None:
+            by_k = self._local.by_k = {}
+        return by_k
 
     def _entry(self, k: int) -> list:
         e = self._by_k.get(k)
