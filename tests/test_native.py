@@ -17,6 +17,7 @@ from qropt.kinematics.kernel import Batched
 from qropt.mechanisms import TYPES
 from tests.randmech import random_mechanisms
 
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 needs_compiler = pytest.mark.skipif(not native.enabled(), reason="no C compiler (the VM is used)")
 
 
@@ -137,6 +138,33 @@ def test_compiled_dynamics_equal_the_jets_route(kind, cache):
         ]:
             np.testing.assert_allclose(b, a, rtol=0, atol=1e-12 * max(1.0, np.abs(a).max()))
     assert used == ({False} if kind == "four-bar" else {False, True})
+
+
+def test_threads_analysing_mechanisms_get_the_numbers_of_one_thread():
+    """Four threads analyse the same designs at once, past the calls that compile (the cycle's kernels, the
+    refinement's C loop, the dynamics): every number equals the one-thread run's to the last bit (as a web server's
+    request threads do)."""
+    code = (
+        "import threading, numpy as np, qropt\n"
+        "from tests.randmech import random_mechanisms\n"
+        "designs = [p for p, _ in random_mechanisms('drag-link-slider', 6, seed=5)]\n"
+        "t = np.linspace(0, 6, 50)\n"
+        "masses = qropt.Masses.steel(4e-4, ram=20.0)\n"
+        "def run(p):\n"
+        "    m = qropt.DragLinkSlider(**p)\n"
+        "    d = m.dynamics(t, 10.0, masses=masses, loads=qropt.Loads(1000.0))\n"
+        "    return (m.gamma_min().value, m.peak_acceleration(10.0).value, *d.torque)\n"
+        "ref = [run(p) for p in designs]\n"
+        "wrong = []\n"
+        "def work(i):\n"
+        "    for k in range(20): wrong.append(run(designs[(i + k) % 6]) != ref[(i + k) % 6])\n"
+        "ts = [threading.Thread(target=work, args=(i,)) for i in range(4)]\n"
+        "[x.start() for x in ts]; [x.join() for x in ts]\n"
+        "print(len(wrong), sum(wrong))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=ROOT)
+    assert done.returncode == 0, f"exit {done.returncode}: {done.stderr[-2000:]}"
+    assert done.stdout.split() == ["80", "0"]
 
 
 @needs_compiler

@@ -11,6 +11,7 @@ flags and cache); None where no compiler works.
 from __future__ import annotations
 
 import ctypes
+import threading
 
 import casadi
 import numpy as np
@@ -75,14 +76,15 @@ def _pointer(a: np.ndarray) -> int:
 
 
 class Driver:
-    """The C loop of one kernel group's refinement (``refine``), with its buffers kept per request list and grid."""
+    """The C loop of one kernel group's refinement (``refine``), with its buffers kept per request list and grid,
+    per thread (ctypes runs the call without Python's lock)."""
 
     def __init__(self, lib: ctypes.CDLL):
         self._refine = lib.qropt_refine
         self._refine.restype = _I
         self._refine.argtypes = [_P, _I, ctypes.c_double, _P, _P, _I, _P, _I, _P, _P, _I]
         self._lib = lib  # kept alive with its function
-        self._calls: dict = {}  # (rows, signs, n) -> (the call's fixed arguments, its output buffers)
+        self._local = threading.local()  # .calls: (rows, signs, n) -> (the call's fixed arguments, its buffers)
 
     def refine(self, q: np.ndarray, h: float, rows: np.ndarray, sgn: np.ndarray, p: np.ndarray):
         """Every sampled extreme in q (Q, n, C order) of the requests (rows (R,) int64, signs (R,): +1 a maximum,
@@ -91,12 +93,15 @@ class Driver:
         None if the call fails. The hits are a view of a buffer the next call with these requests overwrites."""
         n = q.shape[1]
         key = (id(rows), id(sgn), n)
-        call = self._calls.get(key)
+        calls = getattr(self._local, "calls", None)
+        if calls is None:
+            calls = self._local.calls = {}
+        call = calls.get(key)
         if call is None:
             cap = rows.size * (n // 2 + 1)
             out, starts = np.empty((5, cap)), np.empty(rows.size + 2, np.int64)
             fixed = (_pointer(rows), _pointer(sgn), rows.size)
-            call = self._calls[key] = (fixed, (_pointer(out), _pointer(starts), cap), out, starts, (rows, sgn))
+            call = calls[key] = (fixed, (_pointer(out), _pointer(starts), cap), out, starts, (rows, sgn))
         fixed, buffers, out, starts, _ = call
         k = self._refine(_pointer(q), n, h, *fixed, _pointer(p), p.size, *buffers)
         if k < 0:
