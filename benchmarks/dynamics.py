@@ -33,12 +33,12 @@ def median_ms(f, repeat=7):
 
 
 def main() -> int:
-    """Two regimes per mechanism: uncompiled (the motion on the jets, the dynamics on CasADi's VM, as in a shape's
-    first Batched.HOT calls; the compiled calls held back for the measurement) and compiled (machine code, from
+    """Two regimes per mechanism: uncompiled (the motion and the dynamics on CasADi's VM, as in a shape's first
+    Batched.HOT calls; the compiled calls held back for the measurement) and compiled (machine code, from
     Batched.HOT uses on)."""
     th = 2 * np.pi * np.arange(SAMPLES) / SAMPLES
     rows = {}
-    print(f"{SAMPLES} crank angles, ms: uncompiled (motion on jets, dynamics on the VM) | compiled")
+    print(f"{SAMPLES} crank angles, ms: uncompiled (CasADi's VM) | compiled")
     print(f"{'type':20s} {'motion':>8s} {'dynamics':>9s} {'ratio':>6s} | {'motion':>8s} {'dynamics':>9s} {'ratio':>6s}")
     for cls in TYPES:
         out = {"first": ([], [], []), "compiled": ([], [], [])}

@@ -129,6 +129,8 @@ class Batched:
     def __call__(self, z: np.ndarray) -> np.ndarray:
         """z: (K, m) -> (K, r)."""
         k = z.shape[0]
+        if k == 0:  # no rows (an empty array of crank angles): CasADi maps over one or more
+            return np.empty((0, self.r))
         if k > self.MAX_ROWS:
             return np.concatenate([self(z[i : i + self.MAX_ROWS]) for i in range(0, k, self.MAX_ROWS)])
         zin, out, ev = self.buffers(k)
@@ -258,8 +260,9 @@ class Kernel:
     def rates(self, params, theta, omega2: float, alpha2: float, which: str):
         """Compiled time rates at crank angles theta (rad), crank rate omega2 (rad/s) and acceleration alpha2
         (rad/s^2): which = 'x' gives (x, v, a), 'all' gives them and then each link angle, omega, alpha in
-        ``angle_names`` order, as rows of an array (3 q, n); None while these calls are not yet machine code
-        (the jets are faster than CasADi's VM: the caller evaluates them instead)."""
+        ``angle_names`` order, as rows of an array (3 q, n). On CasADi's VM until a shape of call is hot, then
+        machine code: the same numbers to the last bit at every call (the jets, a little faster for a first call,
+        differ from both in the last bits)."""
         key = "rates " + which
         f = self._groups.get(key)
         if f is None:
@@ -274,8 +277,6 @@ class Kernel:
             z = casadi.SX.sym("z", 3 + P.numel())
             fn = casadi.Function("r", [t, w, al, P], [casadi.vertcat(*out)])
             f = self._groups[key] = Batched(casadi.Function(f"rates_{which}", [z], [fn(z[0], z[1], z[2], z[3:])], CSE))
-        if not f.hot(np.size(theta)):
-            return None
         return f(self._rows(theta, params, omega2, alpha2)).T
 
     def _rows(self, theta, params, *scalars) -> np.ndarray:

@@ -551,9 +551,6 @@ class Mechanism:
     def _motion(self, t, omega2, alpha2, which) -> Motion:
         k = self._kernel
         r = k.rates(self.params, t, omega2, alpha2, which)
-        if r is None:  # not (yet) machine code: Taylor jets through the loop
-            (x, v, a), rates = self._jet_motion(t, omega2, alpha2)
-            return Motion(t, x, v, a, lambda: rates)
         if which == "x":
             links = lambda: self._motion(t, omega2, alpha2, "all")._rates  # noqa: E731
             return Motion(t, r[0].copy(), r[1].copy(), r[2].copy(), links)
@@ -562,7 +559,7 @@ class Mechanism:
         return Motion(t, r[0].copy(), r[1].copy(), r[2].copy(), lambda: rates)
 
     def _jet_motion(self, t, omega2, alpha2):
-        """((x, v, a), (angles, omega, alpha)) by Taylor jets through the loop."""
+        """((x, v, a), (angles, omega, alpha)) by Taylor jets through the loop (an independent route, for checks)."""
         lp = self.evaluate(JET, Jet.seed(t, omega2, alpha2))
 
         def parts(j):
