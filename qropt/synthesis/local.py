@@ -21,6 +21,7 @@ from qropt.synthesis.formulation import TWO_PI, Formulation
 
 STUCK = 3  # exchange rounds that end alike, in a row, after which the loop stops (``_stuck``)
 RESTARTS = 2  # runs continued from their last iterate when they hit the iteration limit near a design
+RELIFTS = 2  # runs of a dynamic objective continued, their extremes lifted anew, after the iteration limit
 RESTART_VIOLATION = 1e-6  # ... that is, with no constraint violated by more than this
 MEMO = 64  # problems a solver keeps derived problems of (a chart's tiles bring thousands)
 
@@ -184,6 +185,7 @@ class LocalSolve:
         c = Candidate(False, dict(values0), branch, orientation)
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
         g, info, m, restarts, polished, polish = None, {}, None, 0, False, None
+        relifts = 0
         first = continued[2] if continued is not None else None
         rounds = []  # what each round's certificate asked (``_stuck``)
         while c.rounds < max_rounds:
@@ -216,6 +218,27 @@ class LocalSolve:
             if run.status in (Status.ITERATION_LIMIT, Status.STALLED) and restarts < RESTARTS and close:
                 restarts += 1  # the iteration budget ran out, or the steps stalled, near a design: go on from there
                 continue
+            # a dynamic objective's run that ran out of iterations far from a design: the torque's extremes move,
+            # merge and appear as the design changes, and a lifted angle whose extreme merged cannot meet its
+            # stationarity row (violated by 30-320 N m/rad where the crank-rocker slider's runs at TR 1.423 stopped,
+            # from starts that met every row). Go on from there with each lifted angle at an extreme of the design
+            # it reached (``lifted_start``)
+            if (
+                run.status is Status.ITERATION_LIMIT
+                and relifts < RELIFTS
+                and form.n_lift
+                and objective is not None
+                and not objective.kinematic
+                and not range_target
+            ):
+                pt = form.unpack(w)
+                phi, _, _ = form.lifted_start(form.concrete(problem, pt.z), pt.values, designs, None)
+                if phi is not None:
+                    relifts += 1
+                    b = form.w_blocks.split(w)
+                    b["phi"] = np.asarray(phi[: form.n_lift], float)
+                    w = form.epigraph_start(form.w_blocks.join(**b), p)
+                    continue
             if not run.converged and not range_target:
                 break
             caps = form.caps(w, p)
