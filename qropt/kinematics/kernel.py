@@ -59,7 +59,9 @@ class Batched:
     A K that is used HOT times is compiled to machine code (``native``): the row function mapped over K, or,
     from WIDE rows up, the mapped function itself as one C loop. ``f`` stays the symbolic Function, for
     composing larger ones (and a Function made for one problem is never compiled: ``compiled=False``). Buffers
-    are kept for at most KEPT shapes of up to MAX_ROWS rows."""
+    are kept for at most KEPT shapes of up to MAX_ROWS rows, per thread: CasADi evaluates a buffer without Python's
+    lock, and two threads sharing one would overwrite each other's rows, or one free a buffer the other evaluates.
+    Every call, on the VM or compiled, gives the same numbers to the last bit."""
 
     HOT = 16  # calls with one K after which that K runs compiled (rarely used shapes stay on CasADi's VM)
     WIDE = 64  # rows from which the whole map is compiled as one loop
@@ -114,17 +116,6 @@ class Batched:
         if uses < self.HOT and self.may_compile:
             uses = self._uses[k] = uses + 1
         return uses
-
-    def credit(self, k: int, uses: int) -> None:
-        """Counts uses with K rows made before this Batched existed (by a caller that builds its Function only
-        once it would be compiled)."""
-        if self.may_compile:
-            self._uses[k] = max(self._uses.get(k, 0), min(uses, self.HOT))
-
-    def hot(self, k: int) -> bool:
-        """Counts a use with K rows; whether calls with K rows now run as machine code (a caller with a faster
-        route than CasADi's virtual machine takes its own until then)."""
-        return k <= self.MAX_ROWS and self._count(k) >= self.HOT and self._entry(k)[5]
 
     def __call__(self, z: np.ndarray) -> np.ndarray:
         """z: (K, m) -> (K, r)."""
