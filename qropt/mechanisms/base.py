@@ -23,7 +23,7 @@ from qropt.errors import AssemblyError, DegenerateMechanism, InvalidParameter, N
 from qropt.kinematics import cycle
 from qropt.kinematics.closures import transmission_angle
 from qropt.kinematics.kernel import kernel, resolved_spectrum, spectral_derivative, spectrum
-from qropt.kinematics.ops import JET, NUMPY, Jet
+from qropt.kinematics.ops import NUMPY
 
 REQUIRED = object()  # a PARAMS default: the parameter has none and must be given
 REGISTRY: dict[str, type[Mechanism]] = {}  # KIND -> the type (shipped types and every user type with a KIND)
@@ -557,20 +557,6 @@ class Mechanism:
         names = k.angle_names
         rates = tuple({n: r[3 + 3 * i + j].copy() for i, n in enumerate(names)} for j in range(3))
         return Motion(t, r[0].copy(), r[1].copy(), r[2].copy(), lambda: rates)
-
-    def _jet_motion(self, t, omega2, alpha2):
-        """((x, v, a), (angles, omega, alpha)) by Taylor jets through the loop (an independent route, for checks)."""
-        lp = self.evaluate(JET, Jet.seed(t, omega2, alpha2))
-
-        def parts(j):
-            if isinstance(j, Jet) and j.c.shape == (3,) + t.shape:
-                return list(j.c.copy())
-            if isinstance(j, Jet):
-                return [np.broadcast_to(c, t.shape).astype(float) for c in (j.v, j.d1, j.d2)]
-            return [np.broadcast_to(float(j), t.shape).astype(float), np.zeros_like(t), np.zeros_like(t)]
-
-        rates = {k: parts(j) for k, j in lp.angles.items()}
-        return parts(lp.x), tuple({k: r[i] for k, r in rates.items()} for i in range(3))
 
     def transmission_angles(self, theta2) -> dict[str, np.ndarray]:
         """Transmission angle (rad, in [0, pi/2]) of every transmitting joint at theta2."""

@@ -249,7 +249,8 @@ class Solver:
         """For a dynamic objective, the best design solved again from itself with a fresh NLP (its samples and
         lifted extremes placed anew), up to REFRESHES times while that improves it by more than TIE_TOL: the
         exchange loop's samples can hold a design that a fresh start at it leaves for a better one nearby (the
-        Whitworth's least peak torque at TR 1.796, 1.5711 m: 3578.882 N m, then 3578.109 from itself)."""
+        Whitworth's least peak torque at TR 1.796, 1.5711 m once ended at 3578.882 N m and went to 3578.109 from
+        itself; it now ends at 3578.882 and stays, docs/benchmarks.md)."""
         c = criteria.of_problem(problem)
         if c is None or c.kinematic or r.status != "optimal":
             return r
