@@ -49,7 +49,7 @@ def run_objective(objective: str, task_list, dynamic: bool) -> dict:
         cmp = design(tr, s, objective=objective, solver=solver, **kw)
         per_task.append(time.perf_counter() - t)
         for r in cmp.rows:
-            rows[r.type].append((r.result.status, r.result.stats.get("t_total", 0.0), tr, s))
+            rows[r.type].append((r.result.status, r.result.stats.get("t_total", 0.0), tr, s, r.result.objective))
         print(f"  {objective:16s} TR {tr:5.3f} stroke {s:7.4f} m: {per_task[-1]:6.2f} s", flush=True)
     types = {}
     for k, v in rows.items():
@@ -61,6 +61,7 @@ def run_objective(objective: str, task_list, dynamic: bool) -> dict:
             "worst_s": worst[1],
             "worst_task": [worst[2], worst[3]],
             "statuses": statuses,
+            "objective": [x[4] for x in v],  # per task, in the task list's order (None: no design)
         }
     return {
         "cold_first_call_s": cold,

@@ -11,26 +11,24 @@ In order, each step only where the ones before said nothing:
    refinement of the objective, and otherwise makes the answer 'failed' (the optimum was not reached), never
    'infeasible';
 4. where the closed forms gave the starts, one space-filling search of ``starts_n`` starts (they may have missed);
-   where there are none, one multi-start of WIDER times the starts (the spread starts may have been too few).
+   where there are none or only starting points, one multi-start of WIDER times the starts (the spread starts may
+   have been too few); it runs too where the multi-start's second pass finds fewer than THIN certified designs.
 Every other solve here runs without diagnosis and with at most DIAGNOSIS_STARTS space-filling starts, so a
 diagnosis costs at most (bounds + 4) solves and 2 * RANGE_SOLVES local solves per target.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 
 from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
-from qropt.synthesis.atlas import Starts
 from qropt.synthesis.certificate import Designs
+from qropt.synthesis.multistart import THIN
 from qropt.synthesis.result import Result
 
 DIAGNOSIS_STARTS = 4  # space-filling starts of each solve a diagnosis runs
-WIDER = 4  # without closed forms, one more multi-start of this many times the starts (measured: the drag-link
-# slider's least peak acceleration at TR 2.479, stroke 0.2952 m and TR 2.004, 1.37 m needs 96 starts, not 24)
 RANGE_SOLVES = 4  # local solves for a target outside its sampled range, that push both ends out (two an end)
 
 
@@ -78,16 +76,16 @@ class Diagnosis:
             return done("infeasible", "; ".join([why, *msgs]), reachable=reach)
         if retry is not None:  # the multi-start's second pass: every space-filling start both ways
             cands = cands + retry()
-            if any(c.ok for c in cands):
+            if sum(c.ok for c in cands) >= THIN:
                 return self.solver.best(problem, cands, claim, plan, t0)
         if plan.kind in ("none", "partial") and starts_n > 0:  # the spread starts may have been too few here
-            wide = dataclasses.replace(plan, atlas=Starts()) if plan.kind == "none" else starts_.plan(problem, False)
-            n_wide = starts_.grown(WIDER * starts_n, problem, wide) if plan.kind == "partial" else WIDER * starts_n
-            more, how, _ = self.solver.multistart.candidates(
-                problem, wide, [], targets, n_wide, seed + 1, self.solver.max_rounds, Designs(), retry=False
+            more, how, wide = self.solver.multistart.wider(
+                problem, plan, targets, starts_n, seed, self.solver.max_rounds
             )
-            if any(c.ok for c in more):
-                return self.solver.best(problem, more, how, wide, t0)
+            if any(c.ok for c in more):  # with the second pass's designs, where it found one or two
+                return self.solver.best(problem, [c for c in cands if c.ok] + more, how, wide, t0)
+        if any(c.ok for c in cands):
+            return self.solver.best(problem, cands, claim, plan, t0)
         if problem.objective and not found:  # is there any design at all? (then the objective's solves failed)
             r = solve(problem.replace(objective=None), targets=targets, starts_n=n, seed=seed, diagnose=False)
             found = [{k: r.params[k] for k in problem.free}] if r.success else []

@@ -9,11 +9,15 @@ other orientation until each has at least MIN_WAY of them.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from qropt.errors import QroptError
+from qropt.synthesis import atlas as atlas_
 from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
+from qropt.synthesis.certificate import Designs
 from qropt.synthesis.local import Candidate, LocalSolve, nlp_value
 
 NEAR = ("atlas", "given")  # starts at optima of nearby problems: run from a small barrier (``Ipopt.near``)
@@ -21,6 +25,10 @@ MIN_WAY = 3  # space-filling starts tried in each way of meeting the TR equality
 WALK_XTOL = 1e-12  # a family walk's search tolerance relative to its parameter (SciPy's bounded Brent stops
 # within sqrt(machine epsilon) of it, relative, at the least: about 1e-16 of a smooth objective's optimum)
 MANY_STARTS = 6  # more closed-form points than this are scored exactly and only the best few refined
+WIDER = 4  # a wider multi-start runs this many times the starts (measured: the drag-link slider's least peak
+# acceleration at TR 2.479, stroke 0.2952 m and TR 2.004, 1.37 m needs 96 starts, not 24)
+THIN = 3  # a multi-start whose second pass (both TR orientations) certifies fewer designs than this is thin
+# evidence: the diagnosis's wider multi-start runs too (``Diagnosis.run``)
 ATLAS_SHORT = 0.02  # where the atlas's starts end this much (relative) worse than their nodes' designs interpolated
 # to the TR, those without a design run again with a larger iteration limit (a jump of 0.05 in TR from an optimum
 # took up to 180 IPOPT iterations), and where they end this much worse than both nodes' designs, the multi-start runs
@@ -94,6 +102,15 @@ class MultiStart:
         if retry:
             return cands + again(), claim, None
         return cands, claim, again
+
+    def wider(self, problem, plan, targets, starts_n, seed, max_rounds):
+        """(candidates, claim, plan) of one more multi-start of WIDER times ``starts_n`` space-filling starts
+        (already grown with the free parameters), from seed + 1, without the closed-form points and the atlas."""
+        wide = dataclasses.replace(plan, atlas=atlas_.Starts()) if plan.kind == "none" else starts_.plan(problem, False)
+        more, how, _ = self.candidates(
+            problem, wide, [], targets, WIDER * starts_n, seed + 1, max_rounds, Designs(), retry=False
+        )
+        return more, how, wide
 
     def run(self, problem, runs, targets, max_rounds, designs, both_ways, patient=False, hint=None):
         """A local solve from every start; the incumbent's NLP value prunes starts that cannot beat it; patient:
@@ -249,4 +266,4 @@ def distinct(cands):
     return out
 
 
-__all__ = ["MultiStart", "score", "distinct", "MIN_WAY", "MANY_STARTS"]
+__all__ = ["MultiStart", "score", "distinct", "MIN_WAY", "MANY_STARTS", "WIDER", "THIN"]

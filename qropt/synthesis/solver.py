@@ -44,8 +44,8 @@ class Solver:
     ends the exchange loop}; ipopt_options: merged into IPOPT's (names as CasADi takes them, 'ipopt.tol'; runs
     that start at or near an optimum use a monotone barrier from mu_init 1e-6, unless these name their own);
     samples: uniform epigraph sample angles per formulation (the exchange loop adds up to ``extra`` more);
-    starts_n, seed: the Sobol multi-start used where no closed form enumerates the solutions (without closed
-    forms, starts_n per two free parameters unless a solve names its own); backend: an NLP
+    starts_n, seed: the Sobol multi-start used where no closed form enumerates the solutions (where none
+    enumerates or walks them, starts_n per two free parameters unless a solve names its own); backend: an NLP
     backend (``qropt.synthesis.backends``; default IPOPT); atlas: start a problem whose shape is in the atlas
     (``qropt.synthesis.atlas``) from its designs first, and run the multi-start only where none certifies.
     Results do not depend on what the Solver solved before: formulations take every value as a parameter.
@@ -250,7 +250,7 @@ class Solver:
         lifted extremes placed anew), up to REFRESHES times while that improves it by more than TIE_TOL: the
         exchange loop's samples can hold a design that a fresh start at it leaves for a better one nearby (the
         Whitworth's least peak torque at TR 1.796, 1.5711 m once ended at 3578.882 N m and went to 3578.109 from
-        itself; it now ends at 3578.882 and stays, docs/benchmarks.md)."""
+        itself; its screened starts now reach 3578.109 directly, docs/benchmarks.md)."""
         c = criteria.of_problem(problem)
         if c is None or c.kinematic or r.status != "optimal":
             return r

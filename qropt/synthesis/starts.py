@@ -112,14 +112,15 @@ def corners(problem) -> list[dict]:
 
 def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
     """Up to n of the ``rule_points`` whose mechanism turns fully on the first branch; if none does, the first n
-    points as they are. With a time-ratio target and no closed forms, ``screen`` chooses them (POOL * n points
-    and at least SCREEN, evaluated at once). Where every length and offset is free, each point is scaled to meet
-    the stroke target (TR and angles do not change with scale) when the scaled point stays inside the bounds."""
+    points as they are. With a time-ratio target and no closed form that enumerates or walks every design (only
+    starting points, or none), ``screen`` chooses them (POOL * n points and at least SCREEN, evaluated at once).
+    Where every length and offset is free, each point is scaled to meet the stroke target (TR and angles do not
+    change with scale) when the scaled point stays inside the bounds."""
     if n <= 0:
         return []
     branch = branches(problem)[0]
     build = build or _build
-    if "time_ratio" in problem.targets and plan(problem).kind == "none":  # no closed form helps: screen
+    if "time_ratio" in problem.targets and plan(problem).kind in ("none", "partial"):  # screen
         chosen = screen(problem, n, seed, build)
         if chosen:
             return chosen
@@ -134,8 +135,9 @@ def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
 
 
 def grown(n: int, problem, plan: Plan) -> int:
-    """The default number of space-filling starts: n, and without closed forms n per two free parameters."""
-    return n * max(1, len(problem.free) // 2) if plan.kind == "none" else n
+    """The default number of space-filling starts: n, and where no closed form enumerates or walks every design
+    (only starting points, or none) n per two free parameters."""
+    return n * max(1, len(problem.free) // 2) if plan.kind in ("none", "partial") else n
 
 
 SCREEN = 4096  # rule points a screen draws at least
