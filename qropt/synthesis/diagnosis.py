@@ -82,8 +82,8 @@ class Diagnosis:
             more, how, wide = self.solver.multistart.wider(
                 problem, plan, targets, starts_n, seed, self.solver.max_rounds
             )
-            if any(c.ok for c in more):  # with the second pass's designs, where it found one or two
-                return self.solver.best(problem, [c for c in cands if c.ok] + more, how, wide, t0)
+            if any(c.ok for c in more):  # with the passes' designs (one or two), every start counted
+                return self.solver.best(problem, cands + more, how, wide, t0)
         if any(c.ok for c in cands):
             return self.solver.best(problem, cands, claim, plan, t0)
         if problem.objective and not found:  # is there any design at all? (then the objective's solves failed)
