@@ -6,8 +6,9 @@ after it is timed warm (the same structures, new numbers). Reported per type and
 worst row time, the statuses, and the median and worst ``design()`` time over the tasks. Writes
 ``results/tasks.json`` and ``results/tasks.md``.
 
-Run: ``python -m benchmarks.tasks [--tasks 12] [--objectives max_gamma_min min_peak_accel] [--dynamic]``
-(repository root). ``--dynamic`` adds ``min_peak_torque`` with the default mass model below.
+Run: ``python -m benchmarks.tasks [--tasks 12] [--objectives max_gamma_min min_peak_accel] [--dynamic]
+[--workers K]`` (repository root). ``--dynamic`` adds ``min_peak_torque`` with the default mass model below;
+``--workers`` solves each task's rows in K worker processes (``design(..., workers=K)``; results/tasks_workers.json).
 """
 
 from __future__ import annotations
@@ -36,9 +37,10 @@ def tasks(n: int, seed: int = SEED) -> list[tuple[float, float]]:
     return [(round(float(1.1 + 1.9 * a), 3), round(float(0.05 * 100**b), 4)) for a, b in u]
 
 
-def run_objective(objective: str, task_list, dynamic: bool) -> dict:
+def run_objective(objective: str, task_list, dynamic: bool, workers: int | None = None) -> dict:
     solver = Solver()
     kw = {"masses": MASSES, "loads": LOADS, "omega2": OMEGA2} if dynamic else {}
+    kw["workers"] = workers
     tr, s = task_list[0]
     t = time.perf_counter()
     design(tr, s, objective=objective, solver=solver, **kw)
@@ -101,18 +103,20 @@ def main(argv=None) -> int:
     ap.add_argument("--tasks", type=int, default=12)
     ap.add_argument("--objectives", nargs="+", default=["max_gamma_min", "min_peak_accel"])
     ap.add_argument("--dynamic", action="store_true", help="also min_peak_torque (steel links, 20 kg ram, 1000 N)")
+    ap.add_argument("--workers", type=int, help="solve each task's rows in this many worker processes")
     args = ap.parse_args(argv)
     task_list = tasks(args.tasks)
     print(f"{len(task_list)} tasks: " + ", ".join(f"({a:g}, {b:g})" for a, b in task_list))
     results = {}
     for obj in args.objectives:
-        results[obj] = run_objective(obj, task_list, dynamic=False)
+        results[obj] = run_objective(obj, task_list, dynamic=False, workers=args.workers)
     if args.dynamic:
-        results["min_peak_torque"] = run_objective("min_peak_torque", task_list, dynamic=True)
+        results["min_peak_torque"] = run_objective("min_peak_torque", task_list, dynamic=True, workers=args.workers)
     table = markdown(results, len(task_list))
     print(table)
-    save("tasks.json", {"tasks": task_list, "seed": SEED, "results": results})
-    (RESULTS / "tasks.md").write_text(table)
+    name = "tasks" if args.workers is None else "tasks_workers"
+    save(f"{name}.json", {"tasks": task_list, "seed": SEED, "workers": args.workers, "results": results})
+    (RESULTS / f"{name}.md").write_text(table)
     return 0
 
 

@@ -116,6 +116,7 @@ def test_angle_parsing():
         (["reachable", "--tr", "nan"], 2, "finite number"),
         (["synth", "--starts", "-3"], 2, "--starts"),
         (["synth", "--size", "footprint"], 2, "min_size"),
+        (["design", "--tr", "1.5", "--stroke", "0.3", "--workers", "0"], 1, "worker processes in [1,"),
         (["analyze", "whitworth", "--r1", "0.1", "--r2", "0.2", "--r5", "0.12", "--r6", "0.05"], 1, "fails for theta2"),
     ],
 )

@@ -52,6 +52,10 @@ def test_design_pareto_and_family_best_take_it():
     cranks = [row.criteria["crank"] for row in c.rows if row.success]
     assert len(cranks) == 2 and cranks == sorted(cranks)
     assert all(row.result.objective == row.criteria["crank"] for row in c.rows if row.success)
+    kw = {"objective": "min_crank", "types": ["slider-crank", "crank-shaper"], "bounds": {"r2": (0.1, 1.5)}}
+    assert [r.result.objective for r in qropt.design(1.5, 0.3, workers=2, **kw).rows] == [
+        r.result.objective for r in c.rows
+    ]  # worker processes know it too (a pool started before it was registered is started anew)
     front = qropt.pareto(problem_bases.slider_crank(), ("max_gamma_min", "min_crank"), n=3)
     assert front.criteria == ("gamma_min", "crank") and len(front.points) >= 2
     fam = qropt.family(problem_bases.slider_crank())

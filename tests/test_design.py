@@ -370,6 +370,8 @@ def test_a_type_that_cannot_do_the_task_says_why():
 
 
 def test_design_rejects_bad_input():
+    from qropt.synthesis.backends import Scipy
+
     for kw in (
         {"types": ["bogus"]},
         {"types": "slider-crank"},
@@ -377,12 +379,46 @@ def test_design_rejects_bad_input():
         {"objective": "max_speed"},
         {"bounds": {"q7": (0, 1)}},
         {"conditions": {"max_sum": -1}},
+        {"workers": 0},
+        {"workers": 2.0},
+        {"workers": True},
+        {"workers": 10**6},
+        {"workers": 2, "solver": qropt.Solver(backend=Scipy())},  # a worker's Solver is rebuilt from its options
     ):
         with pytest.raises(QroptError):
             design(TR, STROKE, **kw)
     for tr, stroke in ((0.5, 0.3), (1.5, -1.0), (float("nan"), 0.3), ("1.5", 0.3)):
         with pytest.raises(QroptError):
             design(tr, stroke)
+
+
+def test_rows_solved_in_worker_processes_are_those_of_one_process(comparison):
+    """design(..., workers=2): every row the same, to the last bit, as solved in this process (a solve does not
+    depend on what its Solver solved before); progress once per type; a type a process cannot import by name (one
+    defined in a function) is solved here."""
+    from qropt.studies import _workers
+
+    def rows(c):
+        return [(r.type, r.result.status, r.result.objective, dict(r.result.mechanism.params)) for r in c.rows]
+
+    seen = []
+    assert rows(design(TR, STROKE, workers=2, progress=seen.append)) == rows(comparison)
+    assert len(seen) == len(TYPES)
+
+    class LocalCrank(qropt.mechanisms.SliderCrank):
+        KIND = "local-crank"
+
+    p = type_problem("slider-crank", TR, STROKE)
+    here = p.replace(mechanism=LocalCrank)
+    assert _workers.portable(p) and not _workers.portable(here)
+    out = _workers.solve_all({"here": here, "away": p}, qropt.Solver(), 2)
+    assert type(out["here"].mechanism) is LocalCrank and out["here"].success and out["away"].success
+    procs = list(_workers._POOL["executor"]._processes.values())
+    _workers.stop()  # as on Ctrl-C: the processes end at once, and a later call starts new ones
+    for proc in procs:
+        proc.join(10)
+        assert not proc.is_alive()
+    assert _workers.solve_all({"away": p}, qropt.Solver(), 2)["away"].objective == out["away"].objective
 
 
 # ---- trade-off fronts ----------------------------------------------------------------------------------------

@@ -52,6 +52,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--pareto", nargs=2, metavar=("A", "B"), help="also each type's front between two objectives")
     parser.add_argument("--n", type=int, default=12, help="front points per type with --pareto (default 12)")
+    parser.add_argument("--workers", type=int, help="solve the types in this many worker processes")
     parser.add_argument("--csv", metavar="FILE", help="write the comparison table as CSV")
     parser.add_argument("--json", action="store_true", help="print the comparison as JSON")
     parser.add_argument("--plot", metavar="FILE", help="draw the designs side by side (.png, .pdf, .svg)")
@@ -114,6 +115,7 @@ def run(args) -> int:
             units=args.units,
             masses=masses,
             loads=loads,
+            workers=args.workers,
         )
     if args.csv:
         cmp.to_csv(args.csv)

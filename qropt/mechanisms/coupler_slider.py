@@ -44,7 +44,8 @@ class CouplerSlider(_FourBarBase):
         return grashof_rules(xp, p, grashof) if grashof else []
 
     def validate(self):
-        if all(self.broken_rules(kind) for kind in SHORTEST):
+        # the class whose shortest link is the shorter first: the other is then rarely evaluated
+        if all(self.broken_rules(k) for k in sorted(SHORTEST, key=lambda k: self.params[SHORTEST[k]])):
             g = self.grashof()
             raise GrashofError(
                 f"CouplerSlider needs a Grashof crank-rocker (r2 shortest) or drag-link (r1 shortest), "

@@ -11,26 +11,19 @@ is not thread-safe: one thread per worker process). Dask is imported only when a
 from __future__ import annotations
 
 import contextlib
-import json
 import logging
 import os
 
 from qropt.errors import ChartError, QroptError
 from qropt.studies._chart import Cell
 from qropt.studies._continuation import solve_tile
+from qropt.studies._workers import MAX_WORKERS_PER_CPU, max_workers
 
 CONNECT_TIMEOUT = 5  # s
-MAX_WORKERS_PER_CPU = 4  # a local cluster's worker processes (one IPOPT each); more only share the same cores
 # Dask's workers return freed memory to the system at once (MALLOC_TRIM_THRESHOLD_=65536); a solve allocates
 # and frees many small arrays, and that setting makes a tile about 25% slower: the local cluster leaves glibc's
 # own threshold (give a running cluster's workers MALLOC_TRIM_THRESHOLD_=1073741824 for the same)
 LOCAL_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
-_SOLVERS: dict = {}  # per worker process: the Solver of each option set, built once
-
-
-def max_workers() -> int:
-    """The most worker processes a local cluster may start on this machine."""
-    return MAX_WORKERS_PER_CPU * (os.cpu_count() or 1)
 
 
 def check_workers(workers: int) -> int:
@@ -57,12 +50,9 @@ def solver_options(solver) -> dict:
 
 def worker_tile(spec: dict, options: dict) -> list[dict]:
     """Run on a worker: one tile with this process's Solver for ``options``; the cells as dictionaries."""
-    from qropt.synthesis.solver import Solver
+    from qropt.synthesis.solver import shared
 
-    key = json.dumps(options, sort_keys=True, default=str)
-    if key not in _SOLVERS:
-        _SOLVERS[key] = Solver(**options)
-    return [c.to_dict() for c in solve_tile(spec, _SOLVERS[key])]
+    return [c.to_dict() for c in solve_tile(spec, shared(options))]
 
 
 @contextlib.contextmanager

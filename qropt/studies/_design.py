@@ -23,6 +23,7 @@ from qropt import units as units_
 from qropt.errors import ProblemError, QroptError
 from qropt.mechanisms import mechanism_type
 from qropt.mechanisms.base import MAGNITUDE, REQUIRED
+from qropt.studies import _workers
 from qropt.synthesis import criteria
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import SOLUTION_PRESENT, Result, json_safe
@@ -255,6 +256,7 @@ def design(
     units: str = units_.DEFAULT,
     masses=None,
     loads=None,
+    workers: int | None = None,
 ) -> Comparison:
     """Solve the task (TR, stroke) for every type (or ``types``) and compare; see the module docstring.
 
@@ -263,8 +265,9 @@ def design(
     the reason in ``Comparison.fronts``); progress: a callable called once per finished type; units: the length
     unit of the stroke, the bounds and every length of the answer (one of ``qropt.units.LENGTH_UNITS``); masses,
     loads: every type's mass model and loads (``qropt.Masses``, ``qropt.Loads``; the bars follow each design's
-    links), for the dynamic objectives and bounds. Every argument is checked (every type's problem built, the
-    front's objectives and ``n``) before any solve.
+    links), for the dynamic objectives and bounds; workers: solve the rows in that many worker processes, kept
+    for later calls (``qropt.studies._workers``; the same rows as in this process, the largest given out first).
+    Every argument is checked (every type's problem built, the front's objectives and ``n``) before any solve.
     """
     from qropt.synthesis.solver import DEFAULT, Solver
 
@@ -272,6 +275,8 @@ def design(
         raise ProblemError(f"solver is a qropt.Solver or None, got {type(solver).__name__}")
     if progress is not None and not callable(progress):
         raise ProblemError(f"progress is a callable (called once per finished type) or None, got {progress!r}")
+    if workers is not None:
+        _workers.check_workers(workers)
     solver = solver or DEFAULT
     try:
         units = units_.length_unit(units)
@@ -319,8 +324,13 @@ def design(
         for p in problems.values():
             _check(p, pareto, n)
     rows, fronts = [], {}
+    if workers is not None and workers > 1:
+        each = (lambda _: progress(1)) if progress and pareto is None else None  # with fronts: once each is done
+        solved = _workers.solve_all(problems, solver, workers, done=each)
+    else:
+        solved = None
     for kind, p in problems.items():
-        r = solver.solve(p)
+        r = solved[kind] if solved is not None else solver.solve(p)
         if r.mechanism is None and r.units != units:  # a Result without a design names the problem's unit too
             r = dataclasses.replace(r, units=units)
         rows.append(_row(kind, p, r))
@@ -331,7 +341,7 @@ def design(
                 fronts[kind] = front(p, pareto, n=n, solver=solver)
             except ProblemError as e:  # this type has no front (an end has no design): say why, keep the others
                 fronts[kind] = str(e)
-        if progress:
+        if progress and (solved is None or pareto is not None):
             progress(1)
     maximise = criteria.maximises(objective)
     ok = [r for r in rows if r.success]

@@ -567,6 +567,12 @@ class Formulation:
         b["psi"] = self.box_angles(box)
         return self.w_blocks.join(**b)
 
+    def with_lifts(self, w, phi) -> np.ndarray:
+        """w with its lifted angles moved to phi (rad; ``lifted_start``'s first value)."""
+        b = self.w_blocks.split(w)
+        b["phi"] = np.asarray(phi[: self.n_lift], float)
+        return self.w_blocks.join(**b)
+
     def lifted_start(self, problem, values: dict, build=None, theta=None) -> tuple:
         """(phi, box, turn): the lifted angles' start at the design with free parameters ``values`` on this branch
         (built by ``build(problem, values, branch)``, default ``Problem.build``; (None, None, None) where it does

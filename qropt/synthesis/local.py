@@ -235,9 +235,7 @@ class LocalSolve:
                 phi, _, _ = form.lifted_start(form.concrete(problem, pt.z), pt.values, designs, None)
                 if phi is not None:
                     relifts += 1
-                    b = form.w_blocks.split(w)
-                    b["phi"] = np.asarray(phi[: form.n_lift], float)
-                    w = form.epigraph_start(form.w_blocks.join(**b), p)
+                    w = form.epigraph_start(form.with_lifts(w, phi), p)
                     continue
             if not run.converged and not range_target:
                 break

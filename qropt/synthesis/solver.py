@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import json
 import math
 import time
 
@@ -545,6 +546,17 @@ def _real(name, v) -> float:
 
 
 DEFAULT = Solver()
+_SHARED: dict = {}  # per process: the Solver of each option set
+
+
+def shared(options: dict, solver: Solver | None = None) -> Solver:
+    """This process's Solver for ``options`` (``Solver.options()``): the first given, else one built once (a
+    worker process's, whose formulations stay built from one task to the next; a process forked after a Solver
+    was given here starts with its formulations)."""
+    key = json.dumps(options, sort_keys=True, default=str)
+    if key not in _SHARED:
+        _SHARED[key] = solver or Solver(**options)
+    return _SHARED[key]
 
 
 def solve(problem: Problem, **options) -> Result:
