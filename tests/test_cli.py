@@ -128,6 +128,18 @@ def test_bad_command_lines_print_one_line(argv, code, words, capsys, tmp_path, m
     assert not (tmp_path / "x.csv").exists()
 
 
+def test_ctrl_c_is_one_line(capsys, monkeypatch):
+    from qropt.studies import _design
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(_design, "design", interrupted)
+    assert cli.main(["design", "--tr", "1.5", "--stroke", "0.3"]) == 130
+    err = capsys.readouterr().err
+    assert err.strip() == "qropt: interrupted"
+
+
 @pytest.mark.parametrize(
     ("text", "words"),
     [

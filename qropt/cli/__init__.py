@@ -782,6 +782,9 @@ def main(argv=None) -> int:
     except OSError as e:
         print(f"qropt: error: {e}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:  # Ctrl-C: one line (a design's worker processes are stopped already)
+        print("qropt: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -7,6 +7,7 @@ and each builds its Solver from ``Solver.options()``, once per option set: a sol
 what a solver solved before, so the rows are those of a solve in this process. A problem travels pickled: one
 whose mechanism type a process cannot import by name (defined in ``__main__`` or a notebook, or built at run
 time) is solved in this process instead. The largest problems (by free parameters) are given out first.
+Ctrl-C is the caller's: the workers ignore it, and the caller's KeyboardInterrupt stops them at once (``stop``).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import concurrent.futures as cf
 import importlib
 import multiprocessing
 import os
+import signal
 
 from qropt.errors import ProblemError, QroptError
 
@@ -62,8 +64,14 @@ def _executor(workers: int) -> cf.ProcessPoolExecutor:
     if _POOL.get("key") != key:
         shutdown()
         ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-        _POOL["executor"], _POOL["key"] = cf.ProcessPoolExecutor(workers, mp_context=ctx), key
+        pool = cf.ProcessPoolExecutor(workers, mp_context=ctx, initializer=_quiet)
+        _POOL["executor"], _POOL["key"] = pool, key
     return _POOL["executor"]
+
+
+def _quiet() -> None:
+    """In a worker: Ctrl-C is the caller's to handle (it stops the workers), not each worker's."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 @atexit.register
