@@ -3,8 +3,9 @@
 The pool is kept between calls (its processes keep the NLPs they built, so a second call is warm) and replaced
 when a call asks for another number of workers; it is shut down when the interpreter exits. Its processes are
 forked where the system can (a script needs no ``if __name__ == "__main__"`` guard; elsewhere they are spawned),
-and each builds its Solver from ``Solver.options()``, once per option set: a solve's result does not depend on
-what a solver solved before, so the rows are those of a solve in this process. A problem travels pickled: one
+and each solves with the caller's Solver as it was when forked, or with one built from ``Solver.options()``
+(once per option set): a solve's result does not depend on what a solver solved before, so the rows are those
+of a solve in this process. A problem travels pickled: one
 whose mechanism type a process cannot import by name (defined in ``__main__`` or a notebook, or built at run
 time) is solved in this process instead. The largest problems (by free parameters) are given out first.
 Ctrl-C is the caller's: the workers ignore it, and the caller's KeyboardInterrupt stops them at once (``stop``).
