@@ -97,10 +97,11 @@ def solve_all(problems: dict, solver, workers: int, done=None) -> dict:
     is called with each key as its result arrives. A lost worker is a ProblemError naming it."""
     from qropt.synthesis.backends import Ipopt
 
-    if type(solver.backend) is not Ipopt:
+    if type(solver.backend) is not Ipopt or solver.backend.given != solver.ipopt_options:
         raise ProblemError(
-            f"workers solve with Solvers rebuilt from Solver.options(), which do not carry a backend of one's own "
-            f"({solver.backend.name!r}): solve in this process (workers=None)"
+            f"workers solve with Solvers rebuilt from Solver.options(), which do not carry a backend given to the "
+            f"Solver ({solver.backend.name!r}; IPOPT options go in Solver(ipopt_options=...)): solve in this "
+            "process (workers=None)"
         )
     from qropt.synthesis.solver import shared
 
@@ -134,12 +135,13 @@ def solve_all(problems: dict, solver, workers: int, done=None) -> dict:
 
 
 def stop() -> None:
-    """Stop the pool's processes at once, their rows unfinished (a later call starts new ones)."""
+    """Stop the pool's processes at once, their rows unfinished (a later call starts new ones): killed, as a
+    worker has nothing to save."""
     ex = _POOL.pop("executor", None)
     _POOL.pop("key", None)
     if ex is not None:
         for proc in list(getattr(ex, "_processes", {}).values()):
-            proc.terminate()
+            proc.kill()
         ex.shutdown(wait=False, cancel_futures=True)
 
 
