@@ -325,3 +325,49 @@ def test_the_whitworths_least_peak_torque_at_a_drawn_task_is_the_best_known():
     assert peak == pytest.approx(again.objective, rel=1e-6)
     assert r.objective == pytest.approx(again.objective, rel=1e-8)  # the row: the best known
     assert r.objective < 3578.88227 * (1 - 2e-4)  # not the design it ended at before
+
+
+def test_a_design_certified_under_the_transmission_guard_is_continued_to_the_problem():
+    """The crank-rocker slider at TR 1.66, 0.2997 m (a task of ``benchmarks.tasks``): a design certified under
+    gamma_min >= 10 deg (the peak torque's guard, binding there) is no start for the problem itself (IPOPT from it
+    ends without a design), and continued through smaller guards it ends at a certified design of the problem with
+    less torque, its transmission below the guard; its peak is the torque's on a dense grid. ``qropt.solve``
+    returns that design where the multi-start without the guard gave 136.08 N m (docs/benchmarks.md)."""
+    import math
+
+    from qropt.synthesis import starts
+    from qropt.synthesis.certificate import Designs
+    from qropt.synthesis.dynamic import PeakTorque
+
+    masses, loads = qropt.Masses.steel(4e-4, ram=20.0), qropt.Loads(1000.0)
+    p = type_problem(
+        "crank-rocker-slider", 1.66, 0.2997, objective="min_peak_torque", masses=masses, loads=loads, omega2=10.0
+    )
+    guard = PeakTorque.guard
+    guarded = p.replace(conditions={**p.conditions, "gamma_min": guard})
+    start = {  # the best design of the guarded problem's multi-start
+        "r1": 0.47179134116247623,
+        "r2": 0.21747404262623238,
+        "r3": 0.558816973875691,
+        "r4": 0.6157940686080335,
+        "r5": 0.346934944620966,
+        "r6": 0.08041323975886217,
+        "h": 0.27000598459870906,
+    }
+    solver, designs, branch = qropt.Solver(), Designs(), starts.branches(p)[0]
+    g = solver.local_solve.run(guarded, start, branch, dict(p.targets), near=True, designs=designs)
+    assert g.ok and g.mechanism.gamma_min().value == pytest.approx(guard, abs=1e-8)  # the guard binds
+    at_guard = criteria.objective_of(p, g.mechanism)
+    plain = solver.local_solve.run(
+        p, g.values, branch, dict(p.targets), orientation=g.orientation, near=True, designs=designs
+    )
+    c = solver.multistart.continued(p, g, guard, dict(p.targets), None, designs)
+    assert c is not None and c.ok and c.problem.conditions.get("gamma_min") is None
+    m = c.mechanism
+    assert m.time_ratio() == pytest.approx(1.66, rel=1e-9) and m.stroke() == pytest.approx(0.2997, rel=1e-9)
+    value = criteria.objective_of(p, m)
+    assert value < 0.98 * at_guard and m.gamma_min().value < guard - math.radians(1.0)
+    assert not plain.ok or criteria.objective_of(p, plain.mechanism) > value  # the plain run does not get there
+    th = np.linspace(0.0, 2 * np.pi, 20001)
+    peak = np.abs(m.dynamics(th, 10.0, masses=masses, loads=loads).torque).max()
+    assert value * (1 - 1e-5) <= peak <= value * (1 + 1e-12)

@@ -67,6 +67,9 @@ class Criterion:
     size: ClassVar[str | None] = None  # a size measure: the objective is min_size with problem.size = this
     kinematic: ClassVar[bool] = True  # depends on the motion alone (not on the size or on masses)
     needs_masses: ClassVar[bool] = False  # a dynamic criterion: the problem's masses and loads, at its omega2
+    guard: ClassVar[float | None] = None  # rad: a transmission angle below which the NLP does not see the criterion
+    # well; a multi-start without closed forms is run again with gamma_min >= guard and its designs continued to
+    # the problem (``MultiStart.guarded``)
 
     # ---- names -------------------------------------------------------------------------------------
     @property

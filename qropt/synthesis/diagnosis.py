@@ -74,18 +74,9 @@ class Diagnosis:
             where = " inside the bounds" if plan.outside else ""
             why = f"no design: the closed form that gives every design ({plan.how}) gives none{where} for these targets"
             return done("infeasible", "; ".join([why, *msgs]), reachable=reach)
-        if retry is not None:  # the multi-start's second pass: every space-filling start both ways
-            cands = cands + retry()
-            if sum(c.ok for c in cands) >= THIN:
-                return self.solver.best(problem, cands, claim, plan, t0)
-        if plan.kind in ("none", "partial") and starts_n > 0:  # the spread starts may have been too few here
-            more, how, wide = self.solver.multistart.wider(
-                problem, plan, targets, starts_n, seed, self.solver.max_rounds
-            )
-            if any(c.ok for c in more):  # with the passes' designs (one or two), every start counted
-                return self.solver.best(problem, cands + more, how, wide, t0)
+        cands, claim, searched = self.searched(problem, plan, cands, claim, retry, targets, starts_n, seed)
         if any(c.ok for c in cands):
-            return self.solver.best(problem, cands, claim, plan, t0)
+            return self.solver.best(problem, cands, claim, searched, t0)
         if problem.objective and not found:  # is there any design at all? (then the objective's solves failed)
             r = solve(problem.replace(objective=None), targets=targets, starts_n=n, seed=seed, diagnose=False)
             found = [{k: r.params[k] for k in problem.free}] if r.success else []
@@ -138,6 +129,24 @@ class Diagnosis:
             shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
             msg += f"; a design meeting every target and condition: {shown}" + _dead_point_hint(problem)
         return done("failed", msg, reachable=reach)
+
+    def searched(self, problem, plan, cands, claim, retry, targets, starts_n, seed):
+        """The searches a first pass without a certified design calls for: its second pass (``retry``, every
+        space-filling start both ways), and where that certifies fewer than THIN designs and the closed forms give
+        starting points or none, one multi-start of WIDER times the starts (the spread starts may have been too
+        few). (candidates, claim, plan) to take the best of: the passes' and, where it certifies any, the wider
+        one's, every start counted."""
+        if retry is not None:
+            cands = cands + retry()
+            if sum(c.ok for c in cands) >= THIN:
+                return cands, claim, plan
+        if plan.kind in ("none", "partial") and starts_n > 0:
+            more, how, wide = self.solver.multistart.wider(
+                problem, plan, targets, starts_n, seed, self.solver.max_rounds
+            )
+            if any(c.ok for c in more):
+                return cands + more, how, wide
+        return cands, claim, plan
 
     def bound_out_of_reach(self, problem, targets, starts_n, seed):
         """((message, {quantity: (low, high)}) if a bound condition is beyond what any design meeting the targets

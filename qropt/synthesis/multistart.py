@@ -4,12 +4,14 @@ Closed forms first: a complete enumeration is polished point by point (no multi-
 scanned by exact evaluation and only its best points refined; otherwise the atlas's designs of the problem's
 shape (``atlas``), and only where none of them certifies, the closed-form points and a scrambled Sobol design.
 Each start is solved in its own TR orientation (both where it has none); the space-filling starts also try the
-other orientation until each has at least MIN_WAY of them.
+other orientation until each has at least MIN_WAY of them. A criterion with a transmission guard (the peak
+torque's) has its starts run again under it, each design they certify continued back to the problem (``guarded``).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -29,6 +31,10 @@ WIDER = 4  # a wider multi-start runs this many times the starts (measured: the 
 # acceleration at TR 2.479, stroke 0.2952 m and TR 2.004, 1.37 m needs 96 starts, not 24)
 THIN = 3  # a multi-start whose second pass (both TR orientations) certifies fewer designs than this is thin
 # evidence: the diagnosis's wider multi-start runs too (``Diagnosis.run``)
+GUARD_STEP = 0.7  # a guarded design is continued through transmission guards this much smaller each step: from
+# 10 deg straight to none the crank-rocker slider's best design at TR 1.66, 0.2997 m (84.56 N m, the guard binding)
+# ended at no design; through 7, 4.9, ... deg it ends at 82.52 N m, gamma_min 3.06 deg
+GUARD_LEAST = math.radians(1.0)  # the smallest guard before none
 ATLAS_SHORT = 0.02  # where the atlas's starts end this much (relative) worse than their nodes' designs interpolated
 # to the TR, those without a design run again with a larger iteration limit (a jump of 0.05 in TR from an optimum
 # took up to 180 IPOPT iterations), and where they end this much worse than both nodes' designs, the multi-start runs
@@ -102,6 +108,60 @@ class MultiStart:
         if retry:
             return cands + again(), claim, None
         return cands, claim, again
+
+    def guarded(self, problem, plan, targets, starts_n, seed, max_rounds, designs) -> tuple[list, str, list]:
+        """Where the objective's criterion names a transmission guard (``Criterion.guard``) above the problem's own
+        gamma_min bound and no closed form enumerates or walks the designs: the same starts on the problem with
+        gamma_min >= guard, and each distinct design they certify continued to this problem (``continued``).
+        (candidates of this problem, the claim's words for them, the guarded problem's candidates; [], '' and []
+        where no guard applies)."""
+        c = criteria.of_problem(problem)
+        own = problem.conditions.get("gamma_min", 0.0)
+        if c is None or c.guard is None or own >= c.guard or plan.kind not in ("none", "partial"):
+            return [], "", []
+        guarded = problem.replace(conditions={**problem.conditions, "gamma_min": c.guard})
+        found, _, _ = self.candidates(guarded, plan, [], targets, starts_n, seed, max_rounds, designs)
+        good = distinct([x for x in found if x.ok])
+        out = [x for x in (self.continued(problem, x, c.guard, targets, max_rounds, designs) for x in good) if x]
+        for x in out:
+            x.origin = "guard"
+        to = "the problem's bound" if own > 0 else "none"
+        kept = f"{len(good)} distinct design{'s' * (len(good) != 1)}"
+        how = (
+            f"{kept} of {len(found)} starts under a transmission guard (gamma_min >= {math.degrees(c.guard):g} "
+            f"deg) continued to {to}, {len(out)} certified"
+        )
+        return out, how, found
+
+    def continued(self, problem, start: Candidate, guard: float, targets, max_rounds, designs) -> Candidate | None:
+        """A design certified under a transmission guard, solved again under guards GUARD_STEP times smaller in turn
+        (down to GUARD_LEAST, or the problem's own bound) and then on the problem itself, each from the last design
+        certified, from the backend's small barrier; once the guard does not bind, the problem itself next. The
+        problem's candidate, or None where its last solve certifies nothing."""
+        own = problem.conditions.get("gamma_min", 0.0)
+        steps, g = [], guard * GUARD_STEP
+        while g > max(GUARD_LEAST, own):
+            steps.append(g)
+            g *= GUARD_STEP
+        values, way, gamma = start.values, start.orientation, start.mechanism.gamma_min().value
+        t_ipopt, iterations = 0.0, 0
+        for g in [*steps, None]:
+            if g is not None and g >= gamma:
+                continue
+            sub = problem if g is None else problem.replace(conditions={**problem.conditions, "gamma_min": g})
+            kw = {"orientation": way, "max_rounds": max_rounds, "designs": designs, "near": True}
+            x = self.local.run(sub, values, start.branch, targets, **kw)
+            t_ipopt, iterations = t_ipopt + x.t_ipopt, iterations + x.iterations
+            if x.ok and g is not None:
+                values, way, gamma = x.values, x.orientation, x.mechanism.gamma_min().value
+                if gamma > g * (1 + 1e-6):  # the guard does not bind: the problem itself from here
+                    x = self.local.run(problem, values, start.branch, targets, **{**kw, "orientation": way})
+                    t_ipopt, iterations = t_ipopt + x.t_ipopt, iterations + x.iterations
+                    g = None
+            if x.ok and g is None:
+                x.t_ipopt, x.iterations = t_ipopt, iterations
+                return x
+        return None
 
     def wider(self, problem, plan, targets, starts_n, seed, max_rounds):
         """(candidates, claim, plan) of one more multi-start of WIDER times ``starts_n`` space-filling starts
@@ -266,4 +326,4 @@ def distinct(cands):
     return out
 
 
-__all__ = ["MultiStart", "score", "distinct", "MIN_WAY", "MANY_STARTS", "WIDER", "THIN"]
+__all__ = ["MultiStart", "score", "distinct", "MIN_WAY", "MANY_STARTS", "WIDER", "THIN", "GUARD_STEP", "GUARD_LEAST"]

@@ -180,6 +180,22 @@ class Solver:
         cands, claim, retry = self.multistart.candidates(
             problem, plan, extra, targets, starts_n, seed, max_rounds, designs, retry=not diagnose, hint=hint
         )
+        guard, spent = "", {}
+        if not extra:  # a criterion the NLP sees badly near a toggle: the same starts under its transmission guard too
+            more, guard, found = self.multistart.guarded(problem, plan, targets, starts_n, seed, max_rounds, designs)
+            if retry is not None and any(c.ok for c in more) and not any(c.ok for c in cands):
+                # the guarded designs do not stand in for the searches the diagnosis runs after a first pass without
+                # one: they run here, and the best of all is taken
+                cands, claim, plan = self.diagnosis.searched(
+                    problem, plan, cands, claim, retry, targets, starts_n, seed
+                )
+            cands += more
+            if found:
+                spent = {
+                    "guarded_starts": len(found),
+                    "guarded_ipopt_runs": sum(len(c.statuses) for c in found),
+                    "t_ipopt_guarded": sum(c.t_ipopt for c in found),
+                }
         good = [c for c in cands if c.ok]
         if plan.kind == "enumeration" and not extra and not good and not diagnose:  # every design, none valid
             why = sorted({c.info.get("reason", "") or "it breaks a condition" for c in cands})
@@ -194,12 +210,12 @@ class Solver:
             kw = {"starts_n": starts_n, "seed": seed, "targets": targets, "max_rounds": max_rounds}
             return self.solve(problem, use_analytic=False, diagnose=False, **kw)
         if good:
-            r = self.best(problem, cands, claim, plan, t0)
+            r = self.best(problem, cands, claim, plan, t0, guard)
             r = self.refreshed(problem, r, targets, seed, max_rounds) if not extra else r
             r = self.least_size(problem, r, targets, seed, max_rounds)
-            return dataclasses.replace(r, stats={**r.stats, "t_total": time.perf_counter() - t0})
+            return dataclasses.replace(r, stats={**r.stats, **spent, "t_total": time.perf_counter() - t0})
         if not diagnose:
-            stats = self._stats(problem, cands, plan)
+            stats = {**self._stats(problem, cands, plan), **spent}
             stats["t_total"] = time.perf_counter() - t0
             why = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
             return Result(
@@ -222,8 +238,9 @@ class Solver:
             "t_ipopt": sum(c.t_ipopt for c in cands),
         }
 
-    def best(self, problem, cands, claim, plan, t0) -> Result:
-        """The Result of the certified candidates among ``cands``, best first (with every distinct local optimum)."""
+    def best(self, problem, cands, claim, plan, t0, guard: str = "") -> Result:
+        """The Result of the certified candidates among ``cands``, best first (with every distinct local optimum);
+        guard: the claim's words for the candidates continued from a guarded multi-start (``MultiStart.guarded``)."""
         stats = self._stats(problem, cands, plan)
         good = [c for c in cands if c.ok]
         if good:
@@ -238,7 +255,10 @@ class Solver:
             if not claim:
                 shaped = sum(c.origin == "shape" for c in cands)
                 how = f" ({shaped} chosen by the objective among {starts_.SHAPES} grid shapes)" if shaped else ""
-                claim = f"best of {k} distinct local optima from {len(cands)} starts{how}"
+                started = sum(c.origin != "guard" for c in cands)
+                claim = f"best of {k} distinct local optima from {started} starts{how}"
+            if guard:
+                claim += f"; with {guard}"
             stats.update(t_total=time.perf_counter() - t0, local_optima=k)
             local = [
                 self._result(problem, c, "local_optimum" if i else None, claim, stats) for i, c in enumerate(best_first)
