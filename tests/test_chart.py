@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from problems import _oracles as oracles
-from qropt import Problem, solve
+from qropt import Problem, Solver, solve
 from qropt.cli import main
 from qropt.errors import ChartError
 from qropt.studies._chart import Cell, Chart
@@ -91,6 +91,16 @@ def test_grid_result_and_mask(rocker):
     ):
         with pytest.raises(ChartError, match=words):
             bad()
+
+
+def test_a_chart_on_dask_workers_refuses_a_backend_they_would_not_have(rocker):
+    """Workers build their Solvers from ``Solver.options()``: a backend given to the Solver would be dropped, so the
+    chart says so before it starts a cluster."""
+    from qropt.synthesis.backends import Ipopt, Scipy
+
+    for solver in (Solver(backend=Scipy()), Solver(backend=Ipopt({"ipopt.max_iter": 100}))):
+        with pytest.raises(ChartError, match="chart in this process"):
+            chart(rocker.problem, ("time_ratio", TR), ("swing", SWING), progress=False, workers=2, solver=solver)
 
 
 def test_local_cluster_gives_the_in_process_answers(rocker, cluster):

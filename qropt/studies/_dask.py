@@ -102,6 +102,11 @@ def run_dask(specs: list, solver, mode: str, workers: int | None, progress) -> t
     specs, the cluster)."""
     from distributed import as_completed
 
+    from qropt.synthesis.solver import not_rebuilt
+
+    why = not_rebuilt(solver)
+    if why:  # the tiles would be solved with another backend than the one given
+        raise ChartError(f"a chart's Dask workers solve with Solvers of their own: {why}; chart in this process")
     options = solver_options(solver)
     order = sorted(range(len(specs)), key=lambda k: -_size(specs[k]))
     with _client(mode, workers) as (client, where):

@@ -95,15 +95,11 @@ def solve_all(problems: dict, solver, workers: int, done=None) -> dict:
     """{key: Result} of every problem, solved by ``workers`` processes with Solvers equal to ``solver`` (the
     largest problems, by free parameters, given out first; a problem that cannot travel solved here); ``done``
     is called with each key as its result arrives. A lost worker is a ProblemError naming it."""
-    from qropt.synthesis.backends import Ipopt
+    from qropt.synthesis.solver import not_rebuilt, shared
 
-    if type(solver.backend) is not Ipopt or solver.backend.given != solver.ipopt_options:
-        raise ProblemError(
-            f"workers solve with Solvers rebuilt from Solver.options(), which do not carry a backend given to the "
-            f"Solver ({solver.backend.name!r}; IPOPT options go in Solver(ipopt_options=...)): solve in this "
-            "process (workers=None)"
-        )
-    from qropt.synthesis.solver import shared
+    why = not_rebuilt(solver)
+    if why:
+        raise ProblemError(f"workers solve with Solvers of their own: {why}; solve in this process (workers=None)")
 
     options = solver.options()
     shared(options, solver)  # a pool forked from here starts with its formulations

@@ -569,6 +569,17 @@ DEFAULT = Solver()
 _SHARED: dict = {}  # per process: the Solver of each option set
 
 
+def not_rebuilt(solver: Solver) -> str | None:
+    """Why a Solver built elsewhere (a worker process) from ``solver.options()`` would not solve as ``solver`` does:
+    a backend given to it, which the options do not carry; None where it would."""
+    if type(solver.backend) is Ipopt and solver.backend.given == solver.ipopt_options:
+        return None
+    return (
+        f"a Solver rebuilt from Solver.options() does not carry the backend given to this one "
+        f"({solver.backend.name!r}; IPOPT options go in Solver(ipopt_options=...))"
+    )
+
+
 def shared(options: dict, solver: Solver | None = None) -> Solver:
     """This process's Solver for ``options`` (``Solver.options()``): the first given, else one built once (a
     worker process's, whose formulations stay built from one task to the next; a process forked after a Solver
