@@ -75,11 +75,16 @@ def _quiet() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+def _taken() -> cf.ProcessPoolExecutor | None:
+    """The pool, forgotten here (a later call starts a new one); None where there is none."""
+    _POOL.pop("key", None)
+    return _POOL.pop("executor", None)
+
+
 @atexit.register
 def shutdown() -> None:
     """Stop the pool's processes (a later call starts new ones)."""
-    ex = _POOL.pop("executor", None)
-    _POOL.pop("key", None)
+    ex = _taken()
     if ex is not None:
         ex.shutdown(wait=True, cancel_futures=True)
 
@@ -100,7 +105,6 @@ def solve_all(problems: dict, solver, workers: int, done=None) -> dict:
     why = not_rebuilt(solver)
     if why:
         raise ProblemError(f"workers solve with Solvers of their own: {why}; solve in this process (workers=None)")
-
     options = solver.options()
     shared(options, solver)  # a pool forked from here starts with its formulations
     here = {k: p for k, p in problems.items() if not portable(p)}
@@ -133,8 +137,7 @@ def solve_all(problems: dict, solver, workers: int, done=None) -> dict:
 def stop() -> None:
     """Stop the pool's processes at once, their rows unfinished (a later call starts new ones): killed, as a
     worker has nothing to save."""
-    ex = _POOL.pop("executor", None)
-    _POOL.pop("key", None)
+    ex = _taken()
     if ex is not None:
         for proc in list(getattr(ex, "_processes", {}).values()):
             proc.kill()

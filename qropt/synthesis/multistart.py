@@ -119,8 +119,7 @@ class MultiStart:
         own = problem.conditions.get("gamma_min", 0.0)
         if c is None or c.guard is None or own >= c.guard or plan.kind not in ("none", "partial"):
             return [], "", []
-        guarded = problem.replace(conditions={**problem.conditions, "gamma_min": c.guard})
-        found, _, _ = self.candidates(guarded, plan, [], targets, starts_n, seed, max_rounds, designs)
+        found, _, _ = self.candidates(_under(problem, c.guard), plan, [], targets, starts_n, seed, max_rounds, designs)
         good = distinct([x for x in found if x.ok])
         out = [x for x in (self.continued(problem, x, c.guard, targets, max_rounds, designs) for x in good) if x]
         for x in out:
@@ -145,19 +144,23 @@ class MultiStart:
             g *= GUARD_STEP
         values, way, gamma = start.values, start.orientation, start.mechanism.gamma_min().value
         t_ipopt, iterations = 0.0, 0
+
+        def run(sub):  # a local solve of sub from the last design, its time and iterations counted
+            nonlocal t_ipopt, iterations
+            x = self.local.run(
+                sub, values, start.branch, targets, orientation=way, max_rounds=max_rounds, designs=designs, near=True
+            )
+            t_ipopt, iterations = t_ipopt + x.t_ipopt, iterations + x.iterations
+            return x
+
         for g in [*steps, None]:
             if g is not None and g >= gamma:
                 continue
-            sub = problem if g is None else problem.replace(conditions={**problem.conditions, "gamma_min": g})
-            kw = {"orientation": way, "max_rounds": max_rounds, "designs": designs, "near": True}
-            x = self.local.run(sub, values, start.branch, targets, **kw)
-            t_ipopt, iterations = t_ipopt + x.t_ipopt, iterations + x.iterations
+            x = run(problem if g is None else _under(problem, g))
             if x.ok and g is not None:
                 values, way, gamma = x.values, x.orientation, x.mechanism.gamma_min().value
                 if gamma > g * (1 + 1e-6):  # the guard does not bind: the problem itself from here
-                    x = self.local.run(problem, values, start.branch, targets, **{**kw, "orientation": way})
-                    t_ipopt, iterations = t_ipopt + x.t_ipopt, iterations + x.iterations
-                    g = None
+                    x, g = run(problem), None
             if x.ok and g is None:
                 x.t_ipopt, x.iterations = t_ipopt, iterations
                 return x
@@ -265,6 +268,11 @@ class MultiStart:
         c.origin, c.start = "walk", failed.start
         c.statuses = [f"bounded 1-D search along the family ({found.nfev} evaluations)"]
         return c
+
+
+def _under(problem, guard: float):
+    """The problem with every transmission angle at least ``guard`` (rad) instead of its own gamma_min bound."""
+    return problem.replace(conditions={**problem.conditions, "gamma_min": guard})
 
 
 def expected(problem, found, designs) -> tuple[float | None, float | None]:
