@@ -43,11 +43,6 @@ def run_here(specs: list, solver, progress) -> list:
     return [solve_tile(s, solver, progress) for s in specs]
 
 
-def solver_options(solver) -> dict:
-    """A Solver's options as plain values (what a worker needs to build the same Solver)."""
-    return solver.options()
-
-
 def worker_tile(spec: dict, options: dict) -> list[dict]:
     """Run on a worker: one tile with this process's Solver for ``options``; the cells as dictionaries."""
     from qropt.synthesis.solver import shared
@@ -107,7 +102,7 @@ def run_dask(specs: list, solver, mode: str, workers: int | None, progress) -> t
     why = not_rebuilt(solver)
     if why:  # the tiles would be solved with another backend than the one given
         raise ChartError(f"a chart's Dask workers solve with Solvers of their own: {why}; chart in this process")
-    options = solver_options(solver)
+    options = solver.options()  # plain values: what a worker needs to build the same Solver
     order = sorted(range(len(specs)), key=lambda k: -_size(specs[k]))
     with _client(mode, workers) as (client, where):
         slots = max(1, sum(client.nthreads().values()))
@@ -142,4 +137,4 @@ def _size(spec) -> int:
     return (i1 - i0) * (j1 - j0)
 
 
-__all__ = ["run_here", "run_dask", "worker_tile", "solver_options", "max_workers"]
+__all__ = ["run_here", "run_dask", "worker_tile", "max_workers"]

@@ -72,6 +72,12 @@ WARM = {"ipopt.bound_push": 1e-8, "ipopt.bound_frac": 1e-8}
 PUSH = 0.01  # IPOPT's default bound_push: a start this near a bound (relative to it, at least 1) would move
 NEAR_MU = 1e-6  # the barrier's first value for a start at an optimum of a nearby problem (``Ipopt.near``)
 NEAR = {"ipopt.mu_strategy": "monotone", "ipopt.mu_init": NEAR_MU}
+DERIVATIVES = {"grad_f": "grad_f", "jac_g": "jac_g", "hess_lag": "hess_l"}  # nlpsol's option -> nlp_<its function>
+# A formulation's derivatives are built by its first solver and given to the others (warm, near, patient, each
+# objective scale, every backend's): a solver that builds its own is 70-80 MB and 1 s for the coupler slider by
+# peak torque, one given them 5 MB and 0.05 s; the same functions, the same numbers (a process solving by peak
+# torque at 12 tasks held over 10 GB of solvers that built their own)
+_DERIVATIVES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 STALLED_KKT = 1e-9  # an IPOPT run stopped short of its tolerance is acceptable at a KKT point to this, relative
 
 
@@ -95,7 +101,8 @@ class Ipopt:
     """IPOPT through CasADi, one compiled solver per formulation (two: re-solves, and starts on or near a bound,
     move off a bound by 1e-8 only, since IPOPT's default push of 0.01 is absolute and can move a small link across a
     Grashof or assembly limit, where the loop has no real solution, or a start that meets its targets far from
-    them; and a re-solve of a dynamic objective one per objective scale, ``objective_scale``)."""
+    them; and a re-solve of a dynamic objective one per objective scale, ``objective_scale``), all given the
+    formulation's derivatives built once (``DERIVATIVES``)."""
 
     name = "ipopt"
     PATIENCE = 4  # a patient run's iteration limit, in multiples of the default's
@@ -126,13 +133,17 @@ class Ipopt:
         return self._near
 
     def solver(self, form, warm: bool = False, scale: float = 1.0):
+        """The compiled solver of ``form`` (its objective scaled by ``scale``, ``objective_scale``)."""
         kept = self._solvers.setdefault(form, {})
         key = (warm, scale)
         if key not in kept:
             opts = {**WARM, **self.options} if warm else dict(self.options)
             if scale != 1.0:
                 opts["ipopt.obj_scaling_factor"] = scale
-            kept[key] = casadi.nlpsol("qropt_warm" if warm else "qropt", "ipopt", form.nlp, opts)
+            shared = _DERIVATIVES.get(form)
+            kept[key] = casadi.nlpsol("qropt_warm" if warm else "qropt", "ipopt", form.nlp, {**opts, **(shared or {})})
+            if shared is None:
+                _DERIVATIVES[form] = {k: kept[key].get_function(f"nlp_{n}") for k, n in DERIVATIVES.items()}
         return kept[key]
 
     def run(self, form, w0, p, lbx, ubx, warm: bool = False) -> Run:
