@@ -79,7 +79,7 @@ def test_a_run_whose_linear_solves_once_overflowed_ends():
     starts: the KKT system of iteration 32 is solved to a step of norm 1e111, and with IPOPT's default of up to 10
     steps of iterative refinement (5 as well) the refinement overflows, the multipliers and the barrier parameter
     become NaN and IPOPT loops on its inertia correction for ever (in a child process here, so that a hang is a
-    failure). IPOPT's options (``formulation.IPOPT``) stop the refinement after two steps: the system is found
+    failure). IPOPT's options (``formulation.IPOPT``) stop the refinement after three steps: the system is found
     singular and perturbed."""
     code = (
         "import math\n"
