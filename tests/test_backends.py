@@ -4,8 +4,6 @@ that once never ended."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from types import SimpleNamespace
 
 import casadi
@@ -14,6 +12,7 @@ import pytest
 
 from qropt.synthesis import backends
 from qropt.synthesis.backends import Ipopt
+from tests.child import run_child
 
 BOX = ([0.0, -10.0], [1.0, 10.0])
 
@@ -95,7 +94,5 @@ def test_a_run_whose_linear_solves_once_overflowed_ends():
         "    bound=4982.675999639441)\n"
         "print(c.ok, c.iterations)\n"
     )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, f"exit {done.returncode}: {done.stderr[-2000:]}"
-    ok, iterations = done.stdout.split()
+    ok, iterations = run_child(code, 120).split()
     assert int(iterations) > 0

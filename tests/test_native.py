@@ -4,8 +4,6 @@ a cache on disk, and a working fallback without a compiler."""
 import ast
 import os
 import pickle
-import subprocess
-import sys
 from pathlib import Path
 
 import casadi
@@ -17,6 +15,7 @@ from qropt.kinematics import cycle, driver, native
 from qropt.kinematics.kernel import Batched
 from qropt.kinematics.ops import JET, Jet
 from qropt.mechanisms import TYPES
+from tests.child import run_child
 from tests.randmech import random_mechanisms
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -187,9 +186,7 @@ def test_threads_analysing_mechanisms_get_the_numbers_of_one_thread():
         "[x.start() for x in ts]; [x.join() for x in ts]\n"
         "print(len(wrong), sum(wrong))\n"
     )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, cwd=ROOT)
-    assert done.returncode == 0, f"exit {done.returncode}: {done.stderr[-2000:]}"
-    assert done.stdout.split() == ["80", "0"]
+    assert run_child(code, 300, cwd=ROOT).split() == ["80", "0"]
 
 
 @needs_compiler
@@ -250,9 +247,7 @@ def test_analysis_without_a_compiler_is_the_same():
     runs = {}
     for flag in ("0", "1"):
         env = {**os.environ, "QROPT_NATIVE": flag}
-        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=300)
-        assert done.returncode == 0, done.stderr
-        runs[flag] = ast.literal_eval(done.stdout.strip())
+        runs[flag] = ast.literal_eval(run_child(code, 300, env=env).strip())
     np.testing.assert_allclose(runs["0"], runs["1"], rtol=1e-13, atol=0)
 
 
@@ -273,6 +268,4 @@ def test_threads_calling_one_kernel_each_get_their_own_rows():
         "[t.start() for t in ts]; [t.join() for t in ts]\n"
         "print(len(wrong), sum(wrong))\n"
     )
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
-    assert done.returncode == 0, f"exit {done.returncode}: {done.stderr[-2000:]}"
-    assert done.stdout.split() == ["120", "0"]
+    assert run_child(code, 300).split() == ["120", "0"]
