@@ -349,12 +349,13 @@ def test_every_lifted_extreme_starts_at_a_stationary_point_of_the_torque():
     has three peaks, and the fourth lift starts at the largest again, not at an angle where the torque is not
     stationary: there the lift's stationarity row held the design where such a point is made (a fold, at 75.5
     deg: d2T/dtheta2 = 0 there), and the solve ended 1.9e-4 above the optimum."""
-    from qropt.synthesis.dynamic import PeakTorque
-
     p, m = _whitworth_238()
     d = m.dynamics(np.linspace(0.0, 2 * np.pi, 3600, endpoint=False), 10.0, masses=p.masses, loads=p.loads)
     scale = np.abs(d.torque).max()
-    phi = PeakTorque().lift_start(None, p, m, 4)
+    a, _ = m.stroke_angles()
+    f = Formulation(p, {"sigma_slider": 1.0}, 1 if a >= 2 * np.pi - a else -1)
+    assert f.n_lift == 4
+    phi, _, _ = f.lifted_start(p, _WHITWORTH_238)
     assert len(phi) == 4 and len({round(a, 9) for a in phi}) == 3 and phi[3] == phi[0]  # the three, the largest
     assert np.abs(m.dynamics(np.array(phi[:1]), 10.0, masses=p.masses, loads=p.loads).torque)[0] == pytest.approx(
         scale, rel=1e-6

@@ -162,7 +162,8 @@ class Criterion:
         return []
 
     def lift_start(self, f, problem, m, n: int) -> list:
-        """Start angles (rad) of its n lifted angles at mechanism m (worst first)."""
+        """Start angles (rad) of its n lifted angles at mechanism m, worst first: its extremes there, up to n (the
+        Formulation repeats the worst where there are fewer, ``repeated``)."""
         return []
 
     def exchange(self, f, problem, m, z, value_nlp, gap_tol) -> Exchange:
@@ -376,6 +377,15 @@ class PeakVelocity(Criterion):
 
 
 # ---- helpers shared by the criteria --------------------------------------------------------------------
+def repeated(angles: list, n: int) -> list:
+    """n start angles (rad) of lifts from the extremes given, worst first: the worst again where there are
+    fewer (a lift started where its quantity is not stationary holds the design where such a point is made, a
+    fold), spread over [0, pi] where there are none."""
+    if not angles:
+        return [float(a) for a in np.linspace(0.0, math.pi, n)]
+    return [angles[k % len(angles)] for k in range(n)]
+
+
 def largest(m, extremes, working: bool) -> list:
     """Crank angles of extremes (maxima, minima), largest magnitude first; only the working stroke's, measured
     from its start (inside its lifted interval), if ``working``."""

@@ -437,12 +437,8 @@ class _LiftedPeak(_Dynamic):
         f.row(f"lifted {self.what} extreme: stationary", casadi.jacobian(expr, phi), 0.0, 0.0, kind="lift")
         return terms
 
-    def lift_start(self, f, problem, m, n):
-        """The n largest extremes exactly (the stationarity rows start met); where the turn has fewer, the largest
-        again: a lift started where the quantity is not stationary holds the design where such a point is made (a
-        fold; its row a constraint on the design)."""
-        phi = [p.theta2 for p in _cycle(problem, m).peaks(self.quantity, n)]
-        return phi + [phi[k % len(phi)] for k in range(n - len(phi))] if phi else phi
+    def lift_start(self, f, problem, m, n):  # at the largest extremes exactly: the stationarity rows start met
+        return [p.theta2 for p in _cycle(problem, m).peaks(self.quantity, n)]
 
     def exchange(self, f, problem, m, z, value_nlp, gap_tol):
         peaks = _cycle(problem, m).peaks(self.quantity, EXCHANGE_PEAKS)

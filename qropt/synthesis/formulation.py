@@ -589,7 +589,7 @@ class Formulation:
             phi = []
             for c in dict.fromkeys(c for c, _ in self.lifts):
                 n = sum(1 for c2, _ in self.lifts if c2 is c)
-                phi += (c.lift_start(self, problem, m, n) + [float(a) for a in np.linspace(0.0, math.pi, n)])[:n]
+                phi += criteria.repeated(c.lift_start(self, problem, m, n), n)
             return (phi or None), box, (self.turn_start(m, theta) if guarded else None)
         except QroptError:
             return None, None, None
