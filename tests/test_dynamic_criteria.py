@@ -377,6 +377,29 @@ def test_a_solve_from_the_whitworths_best_design_stays_there():
     assert r.status == "optimal" and r.objective <= best * (1 + 1e-9)
 
 
+def test_the_slider_cranks_least_peak_torque_in_a_valley_beyond_its_first_scan_point():
+    """The slider-crank at TR 1.235, 0.0871 m (a task tests/test_global.py drew): its least peak torque lies in a
+    narrow valley (r2 0.00763 m) between the end of its closed-form family (r2 0.00726) and the family scan's first
+    point (0.00802), where the row gave 36.33475 N m. The walk along the family now searches beyond its end
+    points too; its design is the best of a dense scan of the family (2,001 cranks, the stroke triangle's designs,
+    each by the exact peak torque)."""
+    from benchmarks.tasks import LOADS as loads
+    from benchmarks.tasks import MASSES as masses
+
+    p = type_problem("slider-crank", 1.235, 0.0871, objective="min_peak_torque", masses=masses, loads=loads, omega2=10)
+    r = qropt.Solver().solve(p)
+    assert r.status == "optimal", r.message
+    lo, hi = analytic.slider_crank_window(1.235, 0.0871, *p.free["r2"])
+    scan = []
+    for r2 in np.linspace(lo, min(hi, 3 * lo), 2001):
+        for d in analytic.slider_crank_design(1.235, 0.0871, float(r2)):
+            m = p.build({"r2": d.r2, "r3": d.r3, "e": d.e}, {"sigma_slider": 1.0})
+            scan.append(criteria.objective_of(p, m))
+    assert r.objective <= min(scan) * (1 + 1e-9)
+    assert r.objective == pytest.approx(36.3294645, rel=1e-7)
+    assert r.objective < 36.33475 * (1 - 1e-4)  # not the design it gave before
+
+
 def test_a_design_certified_under_the_transmission_guard_is_continued_to_the_problem():
     """The crank-rocker slider at TR 1.66, 0.2997 m (a task of ``benchmarks.tasks``): a design certified under
     gamma_min >= 10 deg (the peak torque's guard, binding there) is no start for the problem itself (IPOPT from it

@@ -24,6 +24,7 @@ from qropt.synthesis.local import Candidate, LocalSolve, nlp_value
 
 NEAR = ("atlas", "given")  # starts at optima of nearby problems: run from a small barrier (``Ipopt.near``)
 MIN_WAY = 3  # space-filling starts tried in each way of meeting the TR equality, at least
+WALK_GRID = 33  # points of a family walk's finer grid between two scan points, before its bounded search
 WALK_XTOL = 1e-12  # a family walk's search tolerance relative to its parameter (SciPy's bounded Brent stops
 # within sqrt(machine epsilon) of it, relative, at the least: about 1e-16 of a smooth objective's optimum)
 MANY_STARTS = 6  # more closed-form points than this are scored exactly and only the best few refined
@@ -244,7 +245,9 @@ class MultiStart:
         variant = [k for k, at in enumerate(walk.positions) if at == x].index(i)  # which design at x (mirrors)
         xs = sorted(set(walk.positions))
         j = xs.index(x)
-        lo, hi = xs[max(j - 1, 0)], xs[min(j + 1, len(xs) - 1)]
+        step = (xs[1] - xs[0], xs[-1] - xs[-2]) if len(xs) > 1 else (0.0, 0.0)
+        lo = xs[j - 1] if j > 0 else x - step[0]  # the end points: as far beyond (no design there costs inf)
+        hi = xs[j + 1] if j < len(xs) - 1 else x + step[1]
         sign = criteria.sense(problem.objective)
 
         def design(t):
@@ -258,6 +261,13 @@ class MultiStart:
             f = score(problem, v, branch, designs)[0] if v is not None else None
             return np.inf if f is None else -sign * f
 
+        # the objective between the scan's points can have several minima, and a narrow valley beyond the first
+        # (the slider-crank's peak torque at TR 1.235, 0.0871 m: 36.3295 N m at r2 0.00763 m, between the end of
+        # the family, 0.00726, and its first scan point, 0.00802): the search runs between the best of a finer
+        # grid's neighbours
+        ts = np.linspace(lo, hi, WALK_GRID)
+        k = int(np.argmin([cost(t) for t in ts]))
+        lo, hi = ts[max(k - 1, 0)], ts[min(k + 1, WALK_GRID - 1)]
         found = minimize_scalar(
             cost, bounds=(lo, hi), method="bounded", options={"xatol": WALK_XTOL * max(abs(lo), abs(hi))}
         )
