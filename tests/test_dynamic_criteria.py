@@ -356,14 +356,14 @@ def test_every_lifted_extreme_starts_at_a_stationary_point_of_the_torque():
     f = Formulation(p, {"sigma_slider": 1.0}, 1 if a >= 2 * np.pi - a else -1)
     assert f.n_lift == 4
     phi, _, _ = f.lifted_start(p, _WHITWORTH_238)
-    assert len(phi) == 4 and len({round(a, 9) for a in phi}) == 3 and phi[3] == phi[0]  # the three, the largest
+    assert len(phi) == 4 and len({round(t, 9) for t in phi}) == 3 and phi[3] == phi[0]  # the three, the largest
     assert np.abs(m.dynamics(np.array(phi[:1]), 10.0, masses=p.masses, loads=p.loads).torque)[0] == pytest.approx(
         scale, rel=1e-6
     )
     h = 1e-6
-    for a in phi:
-        t = m.dynamics(np.array([a - h, a + h]), 10.0, masses=p.masses, loads=p.loads).torque
-        assert abs(t[1] - t[0]) / (2 * h) < 1e-4 * scale, np.degrees(a)  # dT/dtheta2 = 0 (N m/rad)
+    for angle in phi:
+        t = m.dynamics(np.array([angle - h, angle + h]), 10.0, masses=p.masses, loads=p.loads).torque
+        assert abs(t[1] - t[0]) / (2 * h) < 1e-4 * scale, np.degrees(angle)  # dT/dtheta2 = 0 (N m/rad)
 
 
 def test_a_solve_from_the_whitworths_best_design_stays_there():

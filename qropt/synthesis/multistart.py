@@ -245,9 +245,9 @@ class MultiStart:
         variant = [k for k, at in enumerate(walk.positions) if at == x].index(i)  # which design at x (mirrors)
         xs = sorted(set(walk.positions))
         j = xs.index(x)
-        step = (xs[1] - xs[0], xs[-1] - xs[-2]) if len(xs) > 1 else (0.0, 0.0)
-        lo = xs[j - 1] if j > 0 else x - step[0]  # the end points: as far beyond (no design there costs inf)
-        hi = xs[j + 1] if j < len(xs) - 1 else x + step[1]
+        lo, hi = xs[max(j - 1, 0)], xs[min(j + 1, len(xs) - 1)]
+        # an end point: as far beyond as its neighbour is on the other side (no design there costs inf)
+        lo, hi = (lo if j > 0 else x - (hi - x)), (hi if j < len(xs) - 1 else x + (x - lo))
         sign = criteria.sense(problem.objective)
 
         def design(t):
