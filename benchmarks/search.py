@@ -17,8 +17,14 @@ For a task (TR, stroke) and a row of ``design`` (its problem ``type_problem(kind
    solves (the row's NLP, no closed forms, no Sobol points): each ends at an exact, certified design.
 3. **Multi-start.** The row's problem solved with ``starts`` Sobol starts (default: many times the default),
    without the atlas that a default solve starts from.
+4. **Evolution** (``evolve`` generations, 0 for none; ``qropt.synthesis.evolution``, with more generations,
+   seeds and designs than a solve's): differential evolution over the box, each candidate moved onto the TR by
+   its crank length and scaled to the stroke, ranked by the exact objective. Its best distinct designs go two
+   ways: a Nelder-Mead descent on the exact objective with every point put on the targets exactly, which needs
+   no NLP at all; and local solves of the row's NLP, as in 2.
 
-The reference is the best certified design of 2 and 3; ``design``'s row misses when it is worse than the
+The reference is the best design of 2, 3 and 4 (certified by the solver, or, for the descent, evaluated
+exactly on the targets); ``design``'s row misses when it is worse than the
 reference by more than ``TOL`` (relative). Used by ``tests/test_global.py`` (small) and ``python -m
 benchmarks.search`` (10^6 shapes per row; writes results/search.json and results/search.md).
 """
@@ -37,7 +43,7 @@ from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle
 from qropt.kinematics.ops import NUMPY
 from qropt.mechanisms import REQUIRED
 from qropt.studies._design import TYPES, design, type_problem
-from qropt.synthesis import criteria
+from qropt.synthesis import criteria, evolution
 from qropt.synthesis.criteria import objective_of, sense
 from qropt.synthesis.result import SOLUTION_PRESENT
 
@@ -164,8 +170,16 @@ def _exact(problem, design: dict) -> float | None:
     return -sense(problem.objective) * v if v is not None and math.isfinite(v) else None
 
 
-def reference(problem, n: int, seed: int, polish: int = 16, starts: int = 256, solver=None) -> dict:
-    """The best certified design of the polished shapes and of a large multi-start (see the module docstring)."""
+EVOLVE_SEEDS = 2  # evolutions per row, each from its own seed
+EVOLVE_KEEP = 6  # distinct designs of each evolution descended and solved
+DESCENT_EVALS = 1500  # exact evaluations of a descent
+
+
+def reference(
+    problem, n: int, seed: int, polish: int = 16, starts: int = 256, evolve_generations: int = 0, solver=None
+) -> dict:
+    """The best design of the polished shapes, a large multi-start and, with ``evolve_generations``, the
+    evolution's descents and solves (see the module docstring)."""
     solver = solver or Solver(atlas=False)  # independent of the atlas, which a default solve starts from
     t0 = time.perf_counter()
     found, values, counted = shapes(problem, n, seed)
@@ -176,6 +190,29 @@ def reference(problem, n: int, seed: int, polish: int = 16, starts: int = 256, s
     for how, r in (("shapes", polished), ("multistart", multi)):
         if r.status in SOLUTION_PRESENT and (best is None or -sense(problem.objective) * r.objective < best[1]):
             best = (how, -sense(problem.objective) * r.objective, r)
+    evolved = {}
+    if evolve_generations:
+        t1 = time.perf_counter()
+        kept = [
+            d for s in range(EVOLVE_SEEDS) for d in evolution.evolve(problem, evolve_generations, seed + s, EVOLVE_KEEP)
+        ]
+        on = [x for d in kept if (x := evolution.on_targets(problem, d)) is not None]
+        descents = [got for x in on if (got := evolution.descend(problem, x, DESCENT_EVALS))]
+        solved = solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=kept, diagnose=False)
+        v = -sense(problem.objective) * solved.objective if solved.status in SOLUTION_PRESENT else None
+        exact = min(descents, key=lambda t: t[0], default=None)
+        evolved = {
+            "evolved": len(kept),
+            "descent": None if exact is None else -sense(problem.objective) * exact[0],
+            "descent_params": None if exact is None else exact[1],
+            "evolution_solve": None if v is None else solved.objective,
+            "seconds_evolution": time.perf_counter() - t1,
+        }
+        if v is not None and (best is None or v < best[1]):
+            best = ("evolution", v, solved)
+        if exact is not None and (best is None or exact[0] < best[1]):
+            best = ("evolution, exact", exact[0], None)
+            evolved["objective"], evolved["params"] = -sense(problem.objective) * exact[0], exact[1]
     return {
         "shapes": n,
         "valid": counted,
@@ -184,19 +221,29 @@ def reference(problem, n: int, seed: int, polish: int = 16, starts: int = 256, s
         "seconds_shapes": t_shapes,
         "seconds": time.perf_counter() - t0,
         "found_by": None if best is None else best[0],
-        "objective": None if best is None else best[2].objective,
-        "params": None if best is None else dict(best[2].params),
-    }
+        "objective": None if best is None else best[2].objective if best[2] is not None else evolved["objective"],
+        "params": None if best is None else dict(best[2].params) if best[2] is not None else evolved["params"],
+    } | {k: v for k, v in evolved.items() if k not in ("objective", "params")}
 
 
-def compare(time_ratio: float, stroke: float, objective: str, n: int, seed: int, types=None, starts: int = 256, **kw):
+def compare(
+    time_ratio: float,
+    stroke: float,
+    objective: str,
+    n: int,
+    seed: int,
+    types=None,
+    starts: int = 256,
+    evolve_generations: int = 0,
+    **kw,
+):
     """Every row of ``design(time_ratio, stroke, objective, **kw)`` against its reference: one dict per row
     (``kw``: masses, loads, omega2 of a dynamic objective)."""
     c = design(time_ratio, stroke, objective=objective, types=types, **kw)
     out = []
     for row in c.rows:
         problem = type_problem(row.type, time_ratio, stroke, objective=objective, **kw)
-        ref = reference(problem, n, seed, starts=starts)
+        ref = reference(problem, n, seed, starts=starts, evolve_generations=evolve_generations)
         mine = row.result.objective if row.result.status in SOLUTION_PRESENT else None
         worse = -sense(objective)  # larger is worse
         if ref["objective"] is None:
@@ -231,6 +278,7 @@ def main(argv=None) -> int:
     ap.add_argument("--starts", type=int, default=256)
     ap.add_argument("--objectives", nargs="+", default=["max_gamma_min", "min_peak_accel"])
     ap.add_argument("--types", nargs="+", default=None, help="rows of design() (default: every row)")
+    ap.add_argument("--evolve", type=int, default=0, help="generations of the evolution (default: none)")
     ap.add_argument("--seed", type=int, default=20261124)
     ap.add_argument("--name", default="search", help="results/<name>.json and .md")
     a = ap.parse_args(argv)
@@ -240,18 +288,19 @@ def main(argv=None) -> int:
         # a dynamic objective with benchmarks.tasks' default mass model (steel links, a 20 kg ram, 1,000 N)
         kw = {"masses": MASSES, "loads": LOADS, "omega2": OMEGA2} if criteria.of(objective).needs_masses else {}
         for tr, s in task_list:
-            got = compare(tr, s, objective, a.shapes, a.seed, types=a.types, starts=a.starts, **kw)
+            got = compare(tr, s, objective, a.shapes, a.seed, a.types, a.starts, a.evolve, **kw)
             rows += got
             for r in got:
                 ref = r["reference"]
                 flag = "MISS" if r["miss"] else "ok"
                 print(
                     f"{objective:15s} TR {tr:5.3f} stroke {s:7.4f} {r['type']:20s} {flag:4s} design {r['design']} "
-                    f"reference {ref['objective']} ({ref['found_by']}; {ref['near_task']} shapes near the task)",
+                    f"reference {ref['objective']} ({ref['found_by']}; {ref['near_task']} shapes near the task"
+                    + (f"; evolution: descent {ref['descent']}, solve {ref['evolution_solve']})" if a.evolve else ")"),
                     flush=True,
                 )
     misses = sum(r["miss"] for r in rows)
-    save(f"{a.name}.json", {"shapes": a.shapes, "starts": a.starts, "rows": rows, "misses": misses})
+    save(f"{a.name}.json", {"shapes": a.shapes, "starts": a.starts, "evolve": a.evolve, "rows": rows, "misses": misses})
     lines = ["| objective | type | rows | misses |", "|---|---|---|---|"]
     for objective in a.objectives:
         for t in TYPES:

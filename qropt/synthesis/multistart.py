@@ -17,12 +17,12 @@ import numpy as np
 
 from qropt.errors import QroptError
 from qropt.synthesis import atlas as atlas_
-from qropt.synthesis import criteria
+from qropt.synthesis import criteria, evolution
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.certificate import Designs
 from qropt.synthesis.local import Candidate, LocalSolve, nlp_value
 
-NEAR = ("atlas", "given")  # starts at optima of nearby problems: run from a small barrier (``Ipopt.near``)
+NEAR = ("atlas", "given", "evolution")  # starts at or near optima: run from a small barrier (``Ipopt.near``)
 MIN_WAY = 3  # space-filling starts tried in each way of meeting the TR equality, at least
 WALK_GRID = 33  # points of a family walk's finer grid between two scan points, before its bounded search
 WALK_XTOL = 1e-12  # a family walk's search tolerance relative to its parameter (SciPy's bounded Brent stops
@@ -30,6 +30,7 @@ WALK_XTOL = 1e-12  # a family walk's search tolerance relative to its parameter 
 MANY_STARTS = 6  # more closed-form points than this are scored exactly and only the best few refined
 WIDER = 4  # a wider multi-start runs this many times the starts (measured: the drag-link slider's least peak
 # acceleration at TR 2.479, stroke 0.2952 m and TR 2.004, 1.37 m needs 96 starts, not 24)
+EVOLUTION_GENERATIONS = 100  # an evolution's generations where a guarded multi-start finds nothing (``evolved``)
 THIN = 3  # a multi-start whose second pass (both TR orientations) certifies fewer designs than this is thin
 # evidence: the diagnosis's wider multi-start runs too (``Diagnosis.run``)
 GUARD_STEP = 0.7  # a guarded design is continued through transmission guards this much smaller each step: from
@@ -132,6 +133,24 @@ class MultiStart:
             f"deg) continued to {to}, {len(out)} certified"
         )
         return out, how, found
+
+    def evolved(self, problem, plan, cands, targets, seed, max_rounds, designs) -> tuple[list, str]:
+        """Where the guard applies (``guarded``) and both passes certify no design: local solves from the ends of
+        descents on the exact objective from an evolution's designs (``evolution.descended``: EVOLUTION_GENERATIONS
+        generations from ``seed``). (candidates, the claim's words; [] and '' where it does not apply.) Not run
+        where the passes certify a design: there it found none better (docs/benchmarks.md)."""
+        c = criteria.of_problem(problem)
+        if c is None or c.guard is None or plan.kind not in ("none", "partial") or not evolution.applies(problem):
+            return [], ""
+        if any(x.ok for x in cands):
+            return [], ""
+        ends = evolution.descended(problem, EVOLUTION_GENERATIONS, seed)
+        out = self.run(problem, [("evolution", v) for v in ends], targets, max_rounds, designs, both_ways=False)
+        how = (
+            f"{len(ends)} starts from descents on the exact objective after a differential evolution of "
+            f"{EVOLUTION_GENERATIONS} generations, {sum(x.ok for x in out)} certified"
+        )
+        return out, how
 
     def continued(self, problem, start: Candidate, guard: float, targets, max_rounds, designs) -> Candidate | None:
         """A design certified under a transmission guard, solved again under guards GUARD_STEP times smaller in turn
@@ -344,4 +363,15 @@ def distinct(cands):
     return out
 
 
-__all__ = ["MultiStart", "score", "distinct", "MIN_WAY", "MANY_STARTS", "WIDER", "THIN", "GUARD_STEP", "GUARD_LEAST"]
+__all__ = [
+    "MultiStart",
+    "score",
+    "distinct",
+    "MIN_WAY",
+    "MANY_STARTS",
+    "WIDER",
+    "THIN",
+    "GUARD_STEP",
+    "GUARD_LEAST",
+    "EVOLUTION_GENERATIONS",
+]

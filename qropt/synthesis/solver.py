@@ -183,19 +183,25 @@ class Solver:
         guard, spent = "", {}
         if not extra:  # a criterion the NLP sees badly near a toggle: the same starts under its transmission guard too
             more, guard, found = self.multistart.guarded(problem, plan, targets, starts_n, seed, max_rounds, designs)
-            if retry is not None and any(c.ok for c in more) and not any(c.ok for c in cands):
-                # the guarded designs do not stand in for the searches the diagnosis runs after a first pass without
-                # one: they run here, and the best of all is taken
-                cands, claim, plan = self.diagnosis.searched(
-                    problem, plan, cands, claim, retry, targets, starts_n, seed
-                )
-            cands += more
             if found:
                 spent = {
                     "guarded_starts": len(found),
                     "guarded_ipopt_runs": sum(len(c.statuses) for c in found),
                     "t_ipopt_guarded": sum(c.t_ipopt for c in found),
                 }
+            t_evolved = time.perf_counter()
+            evolved, how = self.multistart.evolved(problem, plan, cands + more, targets, seed, max_rounds, designs)
+            if how:  # no design yet: starts from descents on the exact objective too
+                more += evolved
+                guard = f"{guard}; {how}" if guard else how
+                spent["t_evolution"] = time.perf_counter() - t_evolved
+            if retry is not None and any(c.ok for c in more) and not any(c.ok for c in cands):
+                # the guarded and evolved designs do not stand in for the searches the diagnosis runs after a first
+                # pass without one: they run here, and the best of all is taken
+                cands, claim, plan = self.diagnosis.searched(
+                    problem, plan, cands, claim, retry, targets, starts_n, seed
+                )
+            cands += more
         good = [c for c in cands if c.ok]
         if plan.kind == "enumeration" and not extra and not good and not diagnose:  # every design, none valid
             why = sorted({c.info.get("reason", "") or "it breaks a condition" for c in cands})

@@ -203,9 +203,9 @@ def grid_cycle(problem, pts: list[dict]) -> tuple[np.ndarray, np.ndarray]:
         return tr, stroke
     theta = np.linspace(0.0, 2 * np.pi, SCREEN_GRID, endpoint=False)
     with np.errstate(all="ignore"):
-        for i, _, loop, x in _grid_loops(problem, pts, theta):
+        for i, _, loop, x in grid_loops(problem, _columns(problem, pts), theta):
             rows = x.shape[0]
-            ok = _turns(loop, x)
+            ok = turns(loop, x)
             a = (theta[np.argmin(x, axis=1)] - theta[np.argmax(x, axis=1)]) % (2 * np.pi)
             a = np.minimum(a, 2 * np.pi - a)
             ok &= a > 0
@@ -251,7 +251,7 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
     theta = np.linspace(0.0, 2 * np.pi, SHAPES_GRID, endpoint=False)
     wave = np.fft.rfftfreq(SHAPES_GRID, 1.0 / SHAPES_GRID) ** 2
     tr_target, found = problem.targets["time_ratio"], []
-    chunks = _grid_loops(problem, pts, theta)
+    chunks = grid_loops(problem, _columns(problem, pts), theta)
     with np.errstate(all="ignore"):
         while True:
             try:
@@ -262,8 +262,8 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
                 break
             _, cols, loop, x = chunk
             rows = x.shape[0]
-            ok = _turns(loop, x)
-            (t_hi, x_hi), (t_lo, x_lo) = _vertex(x, np.argmax(x, axis=1)), _vertex(x, np.argmin(x, axis=1))
+            ok = turns(loop, x)
+            (t_hi, x_hi), (t_lo, x_lo) = vertex(x, np.argmax(x, axis=1)), vertex(x, np.argmin(x, axis=1))
             a = (t_lo - t_hi) % (2 * np.pi)
             tr = np.maximum(a, 2 * np.pi - a) / np.minimum(a, 2 * np.pi - a)
             scale = target / (x_hi - x_lo)
@@ -295,7 +295,7 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
     return [v for _, v in found[:n]]
 
 
-def _vertex(x, j):
+def vertex(x, j):
     """The vertex of the parabola through each row's grid point j of x (n, m) and its neighbours on a uniform
     grid over a turn: (angle, value)."""
     r, m = np.arange(x.shape[0]), x.shape[1]
@@ -305,25 +305,30 @@ def _vertex(x, j):
     return (j + u) * (2 * np.pi / m), b - 0.25 * (a - c) * u
 
 
-def _grid_loops(problem, pts: list[dict], theta: np.ndarray):
-    """The type's loop over designs ``pts`` (free-parameter dicts, first branch) x crank angles ``theta``, in
+def _columns(problem, pts: list[dict]) -> dict:
+    """Designs (free-parameter dicts) as columns: free parameter -> array."""
+    return {k: np.array([v[k] for v in pts], float) for k in problem.free}
+
+
+def grid_loops(problem, cols: dict, theta: np.ndarray):
+    """The type's loop over designs ``cols`` (free parameter -> array, first branch) x crank angles ``theta``, in
     vectorised passes of SCREEN_CHUNK designs: (first index, the pass's free columns, its Loop, x as (designs,
     angles)). No mechanism is built; a user type's loop that takes one design at a time raises TypeError,
     ValueError or IndexError. The caller sets numpy's error state."""
     cls, branch, names = problem.mechanism, branches(problem)[0], list(problem.free)
-    cols = {k: np.array([v[k] for v in pts], float) for k in names}
+    n = next(iter(cols.values())).size if cols else 0
     given = {**problem.fixed, **branch, **{k: 1.0 for k in names}}
     base = {k: v for k, v in cls.PARAMS.items() if k not in given and isinstance(v, (int, float))}
     base.update(cls.completed(given))
-    for i in range(0, len(pts), SCREEN_CHUNK):
+    for i in range(0, n, SCREEN_CHUNK):
         part = {k: c[i : i + SCREEN_CHUNK] for k, c in cols.items()}
         loop = cls.loop(
             NUMPY, theta[None, :], {**base, **problem.fixed, **branch, **{k: c[:, None] for k, c in part.items()}}
         )
-        yield i, part, loop, np.broadcast_to(loop.x, (min(SCREEN_CHUNK, len(pts) - i), theta.size))
+        yield i, part, loop, np.broadcast_to(loop.x, (min(SCREEN_CHUNK, n - i), theta.size))
 
 
-def _turns(loop, x) -> np.ndarray:
+def turns(loop, x) -> np.ndarray:
     """Which designs of a vectorised loop close at every grid angle and whose output reverses exactly twice."""
     ok = np.all(np.isfinite(x), axis=1)
     for _, margin in loop.margins:
@@ -405,4 +410,7 @@ __all__ = [
     "orientation",
     "dead_centre_start",
     "local_best",
+    "grid_loops",
+    "turns",
+    "vertex",
 ]

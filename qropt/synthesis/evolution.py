@@ -1,0 +1,258 @@
+"""Designs on the targets without the NLP: a differential evolution over the box and descents on the exact objective.
+
+For a problem with TR and stroke targets whose lengths scale freely and whose crank length (``CRANK``) is free.
+
+- ``evolve``: SciPy's differential evolution over the unit box (lengths log-uniform, other parameters uniform).
+  Each candidate is moved onto the TR target by its crank length: its TR on a crank-angle grid (the type's loop
+  in numpy, vectorised over candidates x NODES crank lengths x GRID angles, extremes refined by the grid
+  parabola), the crossing of the target nearest the candidate's own crank gene interpolated. It is then built,
+  scaled to the stroke and, within WINDOW of the TR exactly and inside the box, valued by the exact objective
+  (minimised); off the targets its value is INFEASIBLE plus how far off, so the evolution moves toward them first.
+- ``on_targets``: a design with its crank length moved until the exact TR meets the target (Brent's root search
+  in a bracket grown from 0.2 % to 30 %), then scaled to the stroke.
+- ``descend``: Nelder-Mead on the exact objective over every free parameter but the crank, each point put on the
+  targets by ``on_targets``: no samples between which a torque spike could hide.
+
+Grid values place candidates; the values that rank them are exact. The designs are starts (``MultiStart``) and
+an independent reference (``benchmarks.search``), never results by themselves: they meet the targets exactly but
+carry no optimality conditions.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from qropt.errors import QroptError
+from qropt.kinematics.ops import NUMPY
+from qropt.synthesis import criteria
+from qropt.synthesis import starts as starts_
+
+CRANK = "r2"  # the crank length: the evolution's handle on the TR
+NODES = 48  # crank lengths (uniform in log over its bounds) at which a candidate's grid TR is read
+GRID = 64  # crank angles of that grid
+WINDOW = 0.01  # relative: a candidate whose exact TR is this near the target competes on its objective
+POPULATION = 15  # candidates per free parameter (SciPy's popsize)
+KEEP = 4  # distinct designs an evolution hands on
+DISTINCT = 0.05  # designs differ when some parameter differs by this much (in log, or of its range)
+DESCENT_EVALS = 1000  # exact evaluations of a Nelder-Mead descent
+INFEASIBLE = 1e12  # the value of a candidate off the targets (plus how far off)
+
+
+def applies(problem) -> bool:
+    """Whether the problem has TR and stroke targets, free scale, a free crank length and an objective."""
+    scalable = problem.mechanism.scalable()
+    return (
+        bool(problem.objective)
+        and {"time_ratio", "stroke"} <= set(problem.targets)
+        and CRANK in problem.free
+        and not any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable)
+        and all(problem.free[k][0] > 0 for k in problem.free if problem.mechanism.kinds()[k] == "length")
+    )
+
+
+def _value(problem, design: dict, branch: dict) -> float | None:
+    """The exact objective of a design, minimised (negated where it is maximised); None where it fails."""
+    try:
+        v = criteria.objective_of(problem, problem.build(design, branch))
+    except QroptError:
+        return None
+    if v is None or not math.isfinite(v):
+        return None
+    return -v if criteria.maximises(problem.objective) else v
+
+
+def _box(problem, u, k: str):
+    """Free parameter k at unit coordinates u: log-uniform for a length, uniform otherwise."""
+    lo, hi = problem.free[k]
+    return lo * (hi / lo) ** u if problem.mechanism.kinds()[k] == "length" else lo + (hi - lo) * u
+
+
+def outside(problem, design: dict) -> float:
+    """How far a design lies outside the box (0 inside): log ratios for lengths, fractions of the range else."""
+    out, kinds = 0.0, problem.mechanism.kinds()
+    for k, (lo, hi) in problem.free.items():
+        x, log = design[k], kinds[k] == "length"
+        if x < lo:
+            out += math.log(lo / x) if log and x > 0 else (lo - x) / (hi - lo)
+        elif x > hi:
+            out += math.log(x / hi) if log else (x - hi) / (hi - lo)
+    return out
+
+
+def _scaled(problem, design: dict, stroke: float) -> dict:
+    """The design scaled from its stroke to the target's (TR and angles do not change with scale)."""
+    s, scalable = problem.targets["stroke"] / stroke, problem.mechanism.scalable()
+    return {k: v * s if k in scalable else v for k, v in design.items()}
+
+
+def _grid_miss(problem, cols: dict) -> np.ndarray:
+    """log(TR / target) of designs given as columns (free parameter -> array) on the GRID, first branch; nan
+    where a design breaks the type's rules, does not close everywhere or does not reverse exactly twice."""
+    n = next(iter(cols.values())).size
+    theta = np.linspace(0.0, 2 * np.pi, GRID, endpoint=False)
+    miss = np.full(n, np.nan)
+    with np.errstate(all="ignore"):
+        for i, part, loop, x in starts_.grid_loops(problem, cols, theta):
+            ok = starts_.turns(loop, x)
+            p = {**problem.fixed, **part, **starts_.branches(problem)[0]}
+            for rule in problem.mechanism.rules(NUMPY, p, problem.conditions.get("grashof")):
+                ok &= np.broadcast_to(np.asarray(rule.value) >= 0, ok.shape)
+            (t_hi, _), (t_lo, _) = starts_.vertex(x, np.argmax(x, axis=1)), starts_.vertex(x, np.argmin(x, axis=1))
+            a = (t_lo - t_hi) % (2 * np.pi)
+            tr = np.maximum(a, 2 * np.pi - a) / np.minimum(a, 2 * np.pi - a)
+            miss[i : i + x.shape[0]] = np.where(ok, np.log(tr / problem.targets["time_ratio"]), np.nan)
+    return miss
+
+
+def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]:
+    """Up to ``keep`` distinct designs (free-parameter dicts) of an evolution of ``generations`` (module
+    docstring), exact objective best first; each within WINDOW of the TR, at the stroke, inside the box. None
+    for a user type whose loop takes one design at a time (it does not vectorise over designs)."""
+    from scipy.optimize import differential_evolution  # imported here: scipy.optimize takes a while to import
+
+    names = list(problem.free)
+    others = [k for k in names if k != CRANK]
+    branch = starts_.branches(problem)[0]
+    nodes = np.linspace(0.0, 1.0, NODES)
+    found: list[tuple[float, dict]] = []
+
+    def candidate(row: np.ndarray, gene: float, d: dict) -> float:
+        ends = np.flatnonzero(np.isfinite(row[:-1]) & np.isfinite(row[1:]) & (np.sign(row[:-1]) != np.sign(row[1:])))
+        if ends.size == 0:  # no crank length meets the TR: how near the nearest comes
+            near = np.abs(row[np.isfinite(row)])
+            return INFEASIBLE * (3.0 + (float(near.min()) if near.size else 10.0))
+        c = ends[np.argmin(np.abs(ends + 0.5 - gene * (NODES - 1)))]  # the crossing nearest the crank gene
+        u = nodes[c] + row[c] / (row[c] - row[c + 1]) * (nodes[c + 1] - nodes[c])
+        d = d | {CRANK: float(_box(problem, u, CRANK))}
+        try:
+            m = problem.build(d, branch)
+            miss = abs(math.log(m.time_ratio() / problem.targets["time_ratio"]))
+            d = _scaled(problem, d, m.stroke())
+        except (QroptError, ValueError, ZeroDivisionError):
+            return INFEASIBLE * 2.0
+        off = outside(problem, d)
+        if off > 0 or miss > WINDOW:
+            return INFEASIBLE * (1.0 + off + miss)
+        v = _value(problem, d, branch)
+        if v is None:
+            return INFEASIBLE * 2.0
+        found.append((v, d))
+        return v
+
+    def values(u: np.ndarray) -> np.ndarray:  # u: (parameters, candidates), SciPy's vectorised call
+        n = u.shape[1]
+        cols = {k: np.repeat(_box(problem, u[names.index(k)], k), NODES) for k in others}
+        cols[CRANK] = np.tile(_box(problem, nodes, CRANK), n)
+        miss = _grid_miss(problem, cols).reshape(n, NODES)
+        gene = u[names.index(CRANK)]
+        return np.array(
+            [candidate(miss[i], float(gene[i]), {k: float(cols[k][i * NODES]) for k in others}) for i in range(n)]
+        )
+
+    try:  # one small vectorised call first
+        _grid_miss(problem, {k: np.full(2, _box(problem, 0.5, k)) for k in names})
+    except (TypeError, ValueError, IndexError):  # a user type's loop that takes one design at a time
+        return []
+    differential_evolution(
+        values,
+        [(0.0, 1.0)] * len(names),
+        popsize=POPULATION,
+        maxiter=generations,
+        seed=seed,
+        tol=0.0,
+        init="sobol",
+        polish=False,
+        vectorized=True,
+        updating="deferred",
+    )
+    found.sort(key=lambda f: f[0])
+    chosen: list[dict] = []
+    for _, d in found:
+        if all(_apart(problem, d, c) for c in chosen):
+            chosen.append(d)
+            if len(chosen) == keep:
+                break
+    return chosen
+
+
+def _apart(problem, a: dict, b: dict) -> bool:
+    """Whether two designs differ by DISTINCT in some free parameter (in log for lengths, of its range else)."""
+    kinds = problem.mechanism.kinds()
+    for k, (lo, hi) in problem.free.items():
+        log = kinds[k] == "length"
+        if (abs(math.log(a[k] / b[k])) if log else abs(a[k] - b[k]) / (hi - lo)) > DISTINCT:
+            return True
+    return False
+
+
+def on_targets(problem, design: dict) -> dict | None:
+    """The design with its crank length moved to the nearest one whose exact TR meets the target and scaled to
+    the stroke (module docstring); None if no bracket is found."""
+    from scipy.optimize import brentq
+
+    branch = starts_.branches(problem)[0]
+    lo, hi = problem.free[CRANK]
+
+    def miss(c: float) -> float:
+        try:
+            return math.log(problem.build(design | {CRANK: c}, branch).time_ratio() / problem.targets["time_ratio"])
+        except (QroptError, ValueError, ZeroDivisionError):
+            return math.nan
+
+    c0 = design[CRANK]
+    e0 = miss(c0)
+    if not math.isfinite(e0):
+        return None
+    root = c0 if e0 == 0.0 else None
+    for step in (1.002, 1.01, 1.03, 1.1, 1.3):
+        for c1 in (c0 * step, c0 / step):
+            e1 = miss(c1) if root is None and lo <= c1 <= hi else math.nan
+            if math.isfinite(e1) and e1 * e0 <= 0.0:
+                root = brentq(miss, min(c0, c1), max(c0, c1), xtol=1e-15, rtol=1e-14)
+    if root is None:
+        return None
+    try:
+        return _scaled(problem, design | {CRANK: root}, problem.build(design | {CRANK: root}, branch).stroke())
+    except (QroptError, ValueError, ZeroDivisionError):
+        return None
+
+
+def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dict] | None:
+    """A Nelder-Mead descent from a design on the exact objective (minimised) with every point on the targets
+    (module docstring), of ``evals`` exact evaluations (DESCENT_EVALS): the best (value, design) met, or None."""
+    from scipy.optimize import minimize
+
+    names = [k for k in problem.free if k != CRANK]
+    log = {k: problem.mechanism.kinds()[k] == "length" for k in names}
+    branch = starts_.branches(problem)[0]
+    best: list = [None]
+
+    def value(z: np.ndarray) -> float:
+        d = on_targets(problem, design | {k: math.exp(x) if log[k] else x for k, x in zip(names, z, strict=True)})
+        v = None if d is None or outside(problem, d) > 0 else _value(problem, d, branch)
+        if v is None:
+            return math.inf
+        if best[0] is None or v < best[0][0]:
+            best[0] = (v, d)
+        return v
+
+    z0 = np.array([math.log(design[k]) if log[k] else design[k] for k in names])
+    opts = {"maxfev": evals or DESCENT_EVALS, "xatol": 1e-9, "fatol": 1e-12, "adaptive": True}
+    minimize(value, z0, method="Nelder-Mead", options=opts)
+    return best[0]
+
+
+def descended(problem, generations: int, seed: int, keep: int = KEEP, evals: int | None = None) -> list[dict]:
+    """The designs of an evolution, each put on the targets and descended: the descents' ends, best first."""
+    ends = []
+    for d in evolve(problem, generations, seed, keep):
+        on = on_targets(problem, d)
+        got = descend(problem, on, evals) if on is not None else None
+        if got is not None:
+            ends.append(got)
+    return [d for _, d in sorted(ends, key=lambda e: e[0])]
+
+
+__all__ = ["applies", "evolve", "on_targets", "descend", "descended", "outside", "CRANK", "WINDOW"]

@@ -1,0 +1,78 @@
+"""Designs on the targets without the NLP (``qropt.synthesis.evolution``): the evolution's designs lie on the
+targets, its root search meets the TR exactly, and its descent on the exact objective reaches the optimum the
+solver certifies by another route."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from benchmarks.tasks import LOADS, MASSES, OMEGA2
+from qropt import solve
+from qropt.studies._design import type_problem
+from qropt.synthesis import evolution
+from qropt.synthesis.criteria import objective_of
+
+KW = {"objective": "min_peak_torque", "masses": MASSES, "loads": LOADS, "omega2": OMEGA2}
+
+
+def _exact(problem, d):
+    m = problem.build(d, {k: b[0] for k, b in problem.branches.items()})
+    return m.time_ratio(), m.stroke(), objective_of(problem, m)
+
+
+def test_the_evolution_hands_on_designs_on_the_targets():
+    """Each design within the TR window, at the stroke, inside the box, best first by the exact objective; the
+    root search meets the TR to 1e-12; the descent stays on the targets, ends no worse than where it began and
+    reaches the design the solver's family walk certifies (the slider-crank by peak torque: its least lies on a
+    one-parameter family, which the evolution does not use)."""
+    problem = type_problem("slider-crank", 1.3, 0.2, **KW)
+    assert evolution.applies(problem)
+    found = evolution.evolve(problem, 20, seed=3, keep=3)
+    assert found
+    values = []
+    for d in found:
+        tr, stroke, v = _exact(problem, d)
+        assert abs(math.log(tr / 1.3)) <= evolution.WINDOW
+        assert stroke == pytest.approx(0.2, rel=1e-12)
+        assert evolution.outside(problem, d) == 0.0
+        values.append(v)
+    assert values == sorted(values)
+    on = evolution.on_targets(problem, found[0])
+    tr, stroke, start = _exact(problem, on)
+    assert tr == pytest.approx(1.3, rel=1e-12) and stroke == pytest.approx(0.2, rel=1e-12)
+    value, d = evolution.descend(problem, on, evals=200)
+    tr, stroke, v = _exact(problem, d)
+    assert tr == pytest.approx(1.3, rel=1e-12) and stroke == pytest.approx(0.2, rel=1e-12)
+    assert v == pytest.approx(value, rel=1e-12) and v <= start
+    # two routes to one optimum: the family walk's certified design and the descent on the exact objective
+    assert v == pytest.approx(solve(problem).objective, rel=1e-8)
+
+
+def test_what_the_evolution_needs():
+    """A TR and a stroke target, a free crank and free scale; a fixed length stops it."""
+    problem = type_problem("drag-link-slider", 1.5, 0.3, **KW)
+    assert evolution.applies(problem)
+    fixed = problem.replace(fixed={"r1": 0.1}, free={k: v for k, v in problem.free.items() if k != "r1"})
+    assert not evolution.applies(fixed)
+
+
+def test_a_solve_without_a_design_from_its_passes_starts_from_descents(monkeypatch):
+    """Where neither the multi-start nor its guarded pass certifies a design (here: no Sobol starts and no closed
+    forms), the solve starts local runs from descents on the exact objective, certifies the design they reach and
+    says so in its claim. Shortened (20 generations, 200 evaluations a descent)."""
+    from qropt import Solver
+    from qropt.synthesis import multistart
+
+    monkeypatch.setattr(multistart, "EVOLUTION_GENERATIONS", 20)
+    monkeypatch.setattr(evolution, "DESCENT_EVALS", 200)
+    problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
+    r = Solver(starts_n=0).solve(problem, use_analytic=False, diagnose=False)
+    assert r.status in ("optimal", "acceptable"), r.message
+    assert "differential evolution of 20 generations" in r.certificate.global_claim
+    free = {k: r.params[k] for k in problem.free}
+    m = problem.build(free, {k: r.params[k] for k in problem.branches})
+    tr, stroke, v = m.time_ratio(), m.stroke(), objective_of(problem, m)
+    assert tr == pytest.approx(1.6, rel=1e-8) and stroke == pytest.approx(0.3, rel=1e-8)
+    assert v == pytest.approx(r.objective, rel=1e-9)
