@@ -14,8 +14,8 @@ For a problem with TR and stroke targets whose lengths scale freely and whose cr
   targets by ``on_targets``: no samples between which a torque spike could hide.
 
 Grid values place candidates; the values that rank them are exact. The designs are starts (``MultiStart``) and
-an independent reference (``benchmarks.search``), never results by themselves: they meet the targets exactly but
-carry no optimality conditions.
+part of a benchmark's reference (``benchmarks.search``), never a solve's result: they meet the targets exactly
+but carry no optimality conditions.
 """
 
 from __future__ import annotations
