@@ -38,13 +38,12 @@ import time
 import numpy as np
 
 from qropt import Solver
-from qropt.errors import QroptError
 from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle
 from qropt.kinematics.ops import NUMPY
 from qropt.mechanisms import REQUIRED
 from qropt.studies._design import TYPES, design, type_problem
 from qropt.synthesis import criteria, evolution
-from qropt.synthesis.criteria import objective_of, sense
+from qropt.synthesis.criteria import sense
 from qropt.synthesis.result import SOLUTION_PRESENT
 
 M = 64  # crank angles of the grid
@@ -152,22 +151,12 @@ def shapes(problem, n: int, seed: int, window: float = 0.02):
         }.get(problem.objective)
         for i in np.flatnonzero(keep):
             design = {k: float(p[k][i] * (s[i] if k in scaled_names else 1.0)) for k in problem.free}
-            v = _exact(problem, design) if value is None else float(value[i])
+            v = evolution.value(problem, design) if value is None else float(value[i])
             if v is not None:
                 found.append(design)
                 values.append(v)
     order = np.argsort(values)
     return [found[i] for i in order], [values[i] for i in order], counted
-
-
-def _exact(problem, design: dict) -> float | None:
-    """The problem's objective of a design (free parameters), exactly, minimised; None where it does not
-    assemble or its analysis fails."""
-    try:
-        v = objective_of(problem, problem.build(design, {k: b[0] for k, b in problem.branches.items()}))
-    except QroptError:
-        return None
-    return -sense(problem.objective) * v if v is not None and math.isfinite(v) else None
 
 
 EVOLVE_SEEDS = 2  # evolutions per row, each from its own seed
@@ -184,13 +173,11 @@ def reference(
     t0 = time.perf_counter()
     found, values, counted = shapes(problem, n, seed)
     t_shapes = time.perf_counter() - t0
-    best = None
+    best = None  # (found by, the objective minimised, the objective, the design's parameters)
     polished = solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=found[:polish], diagnose=False)
     multi = solver.solve(problem, starts_n=starts, use_analytic=False, seed=seed, diagnose=False)
-    for how, r in (("shapes", polished), ("multistart", multi)):
-        if r.status in SOLUTION_PRESENT and (best is None or -sense(problem.objective) * r.objective < best[1]):
-            best = (how, -sense(problem.objective) * r.objective, r)
-    evolved = {}
+    solves = [("shapes", polished), ("multistart", multi)]
+    evolved, exact = {}, None
     if evolve_generations:
         t1 = time.perf_counter()
         kept = [
@@ -199,20 +186,20 @@ def reference(
         on = [x for d in kept if (x := evolution.on_targets(problem, d)) is not None]
         descents = [got for x in on if (got := evolution.descend(problem, x, DESCENT_EVALS))]
         solved = solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=kept, diagnose=False)
-        v = -sense(problem.objective) * solved.objective if solved.status in SOLUTION_PRESENT else None
+        solves.append(("evolution", solved))
         exact = min(descents, key=lambda t: t[0], default=None)
         evolved = {
             "evolved": len(kept),
             "descent": None if exact is None else -sense(problem.objective) * exact[0],
             "descent_params": None if exact is None else exact[1],
-            "evolution_solve": None if v is None else solved.objective,
+            "evolution_solve": solved.objective if solved.status in SOLUTION_PRESENT else None,
             "seconds_evolution": time.perf_counter() - t1,
         }
-        if v is not None and (best is None or v < best[1]):
-            best = ("evolution", v, solved)
-        if exact is not None and (best is None or exact[0] < best[1]):
-            best = ("evolution, exact", exact[0], None)
-            evolved["objective"], evolved["params"] = -sense(problem.objective) * exact[0], exact[1]
+    for how, r in solves:
+        if r.status in SOLUTION_PRESENT and (best is None or -sense(problem.objective) * r.objective < best[1]):
+            best = (how, -sense(problem.objective) * r.objective, r.objective, dict(r.params))
+    if exact is not None and (best is None or exact[0] < best[1]):
+        best = ("evolution, exact", exact[0], -sense(problem.objective) * exact[0], exact[1])
     return {
         "shapes": n,
         "valid": counted,
@@ -221,9 +208,9 @@ def reference(
         "seconds_shapes": t_shapes,
         "seconds": time.perf_counter() - t0,
         "found_by": None if best is None else best[0],
-        "objective": None if best is None else best[2].objective if best[2] is not None else evolved["objective"],
-        "params": None if best is None else dict(best[2].params) if best[2] is not None else evolved["params"],
-    } | {k: v for k, v in evolved.items() if k not in ("objective", "params")}
+        "objective": None if best is None else best[2],
+        "params": None if best is None else best[3],
+    } | evolved
 
 
 def compare(

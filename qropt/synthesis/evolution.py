@@ -25,7 +25,6 @@ import math
 import numpy as np
 
 from qropt.errors import QroptError
-from qropt.kinematics.ops import NUMPY
 from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
 
@@ -52,21 +51,16 @@ def applies(problem) -> bool:
     )
 
 
-def _value(problem, design: dict, branch: dict) -> float | None:
-    """The exact objective of a design, minimised (negated where it is maximised); None where it fails."""
+def value(problem, design: dict, branch: dict | None = None) -> float | None:
+    """The exact objective of a design (free parameters; the first branch unless given), minimised (negated
+    where it is maximised); None where it does not build or its analysis fails."""
     try:
-        v = criteria.objective_of(problem, problem.build(design, branch))
+        v = criteria.objective_of(problem, problem.build(design, branch or starts_.branches(problem)[0]))
     except QroptError:
         return None
     if v is None or not math.isfinite(v):
         return None
     return -v if criteria.maximises(problem.objective) else v
-
-
-def _box(problem, u, k: str):
-    """Free parameter k at unit coordinates u: log-uniform for a length, uniform otherwise."""
-    lo, hi = problem.free[k]
-    return lo * (hi / lo) ** u if problem.mechanism.kinds()[k] == "length" else lo + (hi - lo) * u
 
 
 def outside(problem, design: dict) -> float:
@@ -81,10 +75,9 @@ def outside(problem, design: dict) -> float:
     return out
 
 
-def _scaled(problem, design: dict, stroke: float) -> dict:
-    """The design scaled from its stroke to the target's (TR and angles do not change with scale)."""
-    s, scalable = problem.targets["stroke"] / stroke, problem.mechanism.scalable()
-    return {k: v * s if k in scalable else v for k, v in design.items()}
+def _to_stroke(problem, design: dict, stroke: float) -> dict:
+    """The design scaled from its stroke to the target's."""
+    return starts_.scaled(problem, design, problem.targets["stroke"] / stroke)
 
 
 def _grid_miss(problem, cols: dict) -> np.ndarray:
@@ -95,13 +88,8 @@ def _grid_miss(problem, cols: dict) -> np.ndarray:
     miss = np.full(n, np.nan)
     with np.errstate(all="ignore"):
         for i, part, loop, x in starts_.grid_loops(problem, cols, theta):
-            ok = starts_.turns(loop, x)
-            p = {**problem.fixed, **part, **starts_.branches(problem)[0]}
-            for rule in problem.mechanism.rules(NUMPY, p, problem.conditions.get("grashof")):
-                ok &= np.broadcast_to(np.asarray(rule.value) >= 0, ok.shape)
-            (t_hi, _), (t_lo, _) = starts_.vertex(x, np.argmax(x, axis=1)), starts_.vertex(x, np.argmin(x, axis=1))
-            a = (t_lo - t_hi) % (2 * np.pi)
-            tr = np.maximum(a, 2 * np.pi - a) / np.minimum(a, 2 * np.pi - a)
+            ok = starts_.turns(loop, x) & starts_.rules_kept(problem, part)
+            tr, _ = starts_.refined_cycle(x)
             miss[i : i + x.shape[0]] = np.where(ok, np.log(tr / problem.targets["time_ratio"]), np.nan)
     return miss
 
@@ -125,17 +113,17 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
             return INFEASIBLE * (3.0 + (float(near.min()) if near.size else 10.0))
         c = ends[np.argmin(np.abs(ends + 0.5 - gene * (NODES - 1)))]  # the crossing nearest the crank gene
         u = nodes[c] + row[c] / (row[c] - row[c + 1]) * (nodes[c + 1] - nodes[c])
-        d = d | {CRANK: float(_box(problem, u, CRANK))}
+        d = d | {CRANK: float(starts_.from_unit(problem, CRANK, u))}
         try:
             m = problem.build(d, branch)
             miss = abs(math.log(m.time_ratio() / problem.targets["time_ratio"]))
-            d = _scaled(problem, d, m.stroke())
+            d = _to_stroke(problem, d, m.stroke())
         except (QroptError, ValueError, ZeroDivisionError):
             return INFEASIBLE * 2.0
         off = outside(problem, d)
         if off > 0 or miss > WINDOW:
             return INFEASIBLE * (1.0 + off + miss)
-        v = _value(problem, d, branch)
+        v = value(problem, d, branch)
         if v is None:
             return INFEASIBLE * 2.0
         found.append((v, d))
@@ -143,8 +131,8 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
 
     def values(u: np.ndarray) -> np.ndarray:  # u: (parameters, candidates), SciPy's vectorised call
         n = u.shape[1]
-        cols = {k: np.repeat(_box(problem, u[names.index(k)], k), NODES) for k in others}
-        cols[CRANK] = np.tile(_box(problem, nodes, CRANK), n)
+        cols = {k: np.repeat(starts_.from_unit(problem, k, u[names.index(k)]), NODES) for k in others}
+        cols[CRANK] = np.tile(starts_.from_unit(problem, CRANK, nodes), n)
         miss = _grid_miss(problem, cols).reshape(n, NODES)
         gene = u[names.index(CRANK)]
         return np.array(
@@ -152,7 +140,7 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
         )
 
     try:  # one small vectorised call first
-        _grid_miss(problem, {k: np.full(2, _box(problem, 0.5, k)) for k in names})
+        _grid_miss(problem, {k: np.full(2, starts_.from_unit(problem, k, 0.5)) for k in names})
     except (TypeError, ValueError, IndexError):  # a user type's loop that takes one design at a time
         return []
     differential_evolution(
@@ -214,7 +202,7 @@ def on_targets(problem, design: dict) -> dict | None:
     if root is None:
         return None
     try:
-        return _scaled(problem, design | {CRANK: root}, problem.build(design | {CRANK: root}, branch).stroke())
+        return _to_stroke(problem, design | {CRANK: root}, problem.build(design | {CRANK: root}, branch).stroke())
     except (QroptError, ValueError, ZeroDivisionError):
         return None
 
@@ -229,18 +217,18 @@ def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dic
     branch = starts_.branches(problem)[0]
     best: list = [None]
 
-    def value(z: np.ndarray) -> float:
+    def cost(z: np.ndarray) -> float:
         d = on_targets(problem, design | {k: math.exp(x) if log[k] else x for k, x in zip(names, z, strict=True)})
-        v = None if d is None or outside(problem, d) > 0 else _value(problem, d, branch)
-        if v is None:
+        f = None if d is None or outside(problem, d) > 0 else value(problem, d, branch)
+        if f is None:
             return math.inf
-        if best[0] is None or v < best[0][0]:
-            best[0] = (v, d)
-        return v
+        if best[0] is None or f < best[0][0]:
+            best[0] = (f, d)
+        return f
 
     z0 = np.array([math.log(design[k]) if log[k] else design[k] for k in names])
     opts = {"maxfev": evals or DESCENT_EVALS, "xatol": 1e-9, "fatol": 1e-12, "adaptive": True}
-    minimize(value, z0, method="Nelder-Mead", options=opts)
+    minimize(cost, z0, method="Nelder-Mead", options=opts)
     return best[0]
 
 
@@ -255,4 +243,4 @@ def descended(problem, generations: int, seed: int, keep: int = KEEP, evals: int
     return [d for _, d in sorted(ends, key=lambda e: e[0])]
 
 
-__all__ = ["applies", "evolve", "on_targets", "descend", "descended", "outside", "CRANK", "WINDOW"]
+__all__ = ["applies", "evolve", "on_targets", "descend", "descended", "outside", "value", "CRANK", "WINDOW"]

@@ -81,19 +81,28 @@ def rule_points(problem, n: int, seed: int, least: int = 1) -> list[dict]:
     while drawn < RULE_DRAWS and (not drawn or len(kept) < least):
         u = sampler.random(draw)
         drawn += draw
-        cols = {}
-        for j, k in enumerate(names):
-            lo, hi = problem.free[k]
-            log = k in problem.mechanism.LENGTHS and lo > 0
-            cols[k] = lo * (hi / lo) ** u[:, j] if log else lo + (hi - lo) * u[:, j]
-        p = {**problem.fixed, **cols, **branches(problem)[0]}
-        ok = np.ones(u.shape[0], bool)
-        for rule in problem.mechanism.rules(NUMPY, p, problem.conditions.get("grashof")):
-            ok &= np.broadcast_to(np.asarray(rule.value) >= 0, ok.shape)
+        cols = {k: from_unit(problem, k, u[:, j]) for j, k in enumerate(names)}
+        ok = rules_kept(problem, cols)
         kept += [{k: float(cols[k][i]) for k in names} for i in np.flatnonzero(ok).tolist()]
         first = first or [{k: float(cols[k][i]) for k in names} for i in range(min(n, u.shape[0]))]
         draw = min(4 * draw, RULE_DRAWS - drawn)
     return kept or first
+
+
+def from_unit(problem, k: str, u):
+    """Free parameter k at unit coordinates u (0..1): log-uniform over its bounds for a length, uniform else."""
+    lo, hi = problem.free[k]
+    return lo * (hi / lo) ** u if k in problem.mechanism.LENGTHS and lo > 0 else lo + (hi - lo) * u
+
+
+def rules_kept(problem, cols: dict) -> np.ndarray:
+    """Which designs, given as columns (free parameter -> 1-D array, first branch), keep the type's rules
+    (Grashof class and the like), in one vectorised check."""
+    p = {**problem.fixed, **cols, **branches(problem)[0]}
+    ok = np.ones(next(iter(cols.values())).shape[0], bool)
+    for rule in problem.mechanism.rules(NUMPY, p, problem.conditions.get("grashof")):
+        ok &= np.broadcast_to(np.asarray(rule.value) >= 0, ok.shape)
+    return ok
 
 
 MAX_CORNERS = 64  # the corners of the free bounds tried as designs (every one up to six free parameters)
@@ -263,10 +272,8 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
             _, cols, loop, x = chunk
             rows = x.shape[0]
             ok = turns(loop, x)
-            (t_hi, x_hi), (t_lo, x_lo) = vertex(x, np.argmax(x, axis=1)), vertex(x, np.argmin(x, axis=1))
-            a = (t_lo - t_hi) % (2 * np.pi)
-            tr = np.maximum(a, 2 * np.pi - a) / np.minimum(a, 2 * np.pi - a)
-            scale = target / (x_hi - x_lo)
+            tr, stroke = refined_cycle(x)
+            scale = target / stroke
             ok &= np.abs(tr / tr_target - 1.0) <= SHAPES_WINDOW
             for k in names:
                 lo, hi = problem.free[k]
@@ -293,6 +300,14 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
                 found.append((float(value[j]), v))
     found.sort(key=lambda f: f[0])
     return [v for _, v in found[:n]]
+
+
+def refined_cycle(x) -> tuple[np.ndarray, np.ndarray]:
+    """(TR, stroke) of each row of x (designs, uniform angles over a turn) from its grid extremes refined by the
+    grid parabola (``vertex``): the longer interval between them over the shorter."""
+    (t_hi, x_hi), (t_lo, x_lo) = vertex(x, np.argmax(x, axis=1)), vertex(x, np.argmin(x, axis=1))
+    a = (t_lo - t_hi) % (2 * np.pi)
+    return np.maximum(a, 2 * np.pi - a) / np.minimum(a, 2 * np.pi - a), x_hi - x_lo
 
 
 def vertex(x, j):
@@ -354,9 +369,16 @@ def _to_stroke(problem, values, branch, build, stroke: float | None = None) -> d
         return values
     if not math.isfinite(k) or k <= 0:
         return values
-    scaled = {name: x * k if name in scalable else x for name, x in values.items()}
-    inside = all(lo <= scaled[name] <= hi for name, (lo, hi) in problem.free.items())
-    return scaled if inside else values
+    out = scaled(problem, values, k)
+    inside = all(lo <= out[name] <= hi for name, (lo, hi) in problem.free.items())
+    return out if inside else values
+
+
+def scaled(problem, values: dict, k: float) -> dict:
+    """The design with its lengths and offsets (the type's scalable parameters) times k: TR and angles do not
+    change with scale."""
+    scalable = problem.mechanism.scalable()
+    return {name: x * k if name in scalable else x for name, x in values.items()}
 
 
 def orientation(problem, values, branch, build=None) -> int | None:
@@ -413,4 +435,8 @@ __all__ = [
     "grid_loops",
     "turns",
     "vertex",
+    "refined_cycle",
+    "from_unit",
+    "rules_kept",
+    "scaled",
 ]
