@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from benchmarks.tasks import LOADS, MASSES, OMEGA2
@@ -76,3 +77,53 @@ def test_a_solve_without_a_design_from_its_passes_starts_from_descents(monkeypat
     tr, stroke, v = m.time_ratio(), m.stroke(), objective_of(problem, m)
     assert tr == pytest.approx(1.6, rel=1e-8) and stroke == pytest.approx(0.3, rel=1e-8)
     assert v == pytest.approx(r.objective, rel=1e-9)
+
+
+def test_a_descents_end_stands_as_a_feasible_design_where_no_start_certifies(monkeypatch):
+    """Where no local solve certifies a design (here IPOPT gets no iteration), the best descent's end is the
+    result: status 'feasible', its targets met exactly (checked by brute force over a fine crank grid), its
+    objective exact (a dense grid of the Newton-Euler torque comes within 1e-4 below it), no optimality claimed."""
+    from qropt import Result, Solver
+    from qropt.synthesis import multistart
+    from tests import brute
+
+    monkeypatch.setattr(multistart, "EVOLUTION_GENERATIONS", 20)
+    monkeypatch.setattr(evolution, "DESCENT_EVALS", 200)
+    problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
+    r = Solver(starts_n=0, ipopt_options={"ipopt.max_iter": 0}).solve(problem, use_analytic=False, diagnose=False)
+    assert r.status == "feasible" and r.success, r.message
+    assert "not certified" in r.message and r.certificate.local.startswith("none")
+    assert "differential evolution of 20 generations, 0 certified" in r.certificate.global_claim
+    assert r.local_optima == () and r.stats["origin"] == "descent"
+    grid = np.linspace(0.0, 2 * np.pi, 200_001)
+    x = np.real(brute.output("crank-shaper", dict(r.params), grid))
+    i, k = int(np.argmax(x)), int(np.argmin(x))
+    a = (grid[k] - grid[i]) % (2 * np.pi)
+    assert max(a, 2 * np.pi - a) / min(a, 2 * np.pi - a) == pytest.approx(1.6, rel=1e-4)
+    assert x[i] - x[k] == pytest.approx(0.3, rel=1e-8)
+    torque = np.abs(r.mechanism.dynamics(grid[::10], OMEGA2, masses=MASSES, loads=LOADS).torque)
+    assert torque.max() <= r.objective * (1 + 1e-9) and torque.max() == pytest.approx(r.objective, rel=1e-4)
+    back = Result.from_dict(r.to_dict())
+    assert back.status == "feasible" and back.objective == r.objective
+
+
+def test_a_descents_end_stands_only_where_it_beats_every_certified_design():
+    """The certified optimum (the slider-crank's least peak torque, by its family walk) keeps its place against the
+    descents' ends, which reach it but not below; against a certified design 20 % worse, the best end stands,
+    'feasible', with the certified designs as its local optima."""
+    import dataclasses
+
+    from qropt import Solver
+
+    problem = type_problem("slider-crank", 1.3, 0.2, **KW)
+    s = Solver()
+    r = s.solve(problem)
+    assert r.status == "optimal"
+    ends = evolution.descended(problem, 20, seed=3, keep=2, evals=300, valued=True)
+    assert ends and ends[0][0] >= r.objective * (1 - 1e-9)
+    assert s.descended(problem, r, ends, "") is r
+    worse = dataclasses.replace(r, objective=r.objective * 1.2, local_optima=())
+    stood = s.descended(problem, worse, ends, "")
+    assert stood.status == "feasible" and stood.objective == pytest.approx(ends[0][0], rel=1e-12)
+    assert [x.status for x in stood.local_optima] == ["local_optimum"]
+    assert stood.local_optima[0].objective == worse.objective

@@ -8,14 +8,15 @@ For a problem with TR and stroke targets whose lengths scale freely and whose cr
   parabola), the crossing of the target nearest the candidate's own crank gene interpolated. It is then built,
   scaled to the stroke and, within WINDOW of the TR exactly and inside the box, valued by the exact objective
   (minimised); off the targets its value is INFEASIBLE plus how far off, so the evolution moves toward them first.
-- ``on_targets``: a design with its crank length moved until the exact TR meets the target (Brent's root search
-  in a bracket grown from 0.2 % to 30 %), then scaled to the stroke.
+- ``on_targets``: a design with its crank length moved until the exact TR meets the target (secant steps from
+  its own, else Brent's root search in a bracket grown from 0.2 % to 30 %), then scaled to the stroke.
 - ``descend``: Nelder-Mead on the exact objective over every free parameter but the crank, each point put on the
   targets by ``on_targets``: no samples between which a torque spike could hide.
 
-Grid values place candidates; the values that rank them are exact. The designs are starts (``MultiStart``) and
-part of a benchmark's reference (``benchmarks.search``), never a solve's result: they meet the targets exactly
-but carry no optimality conditions.
+Grid values place candidates; the values that rank them are exact. The descents' ends are starts
+(``MultiStart.evolved``), part of a benchmark's reference (``benchmarks.search``) and, where one beats every
+certified design, a solve's ``feasible`` result (``Solver.descended``): they meet the targets exactly but carry
+no optimality conditions.
 """
 
 from __future__ import annotations
@@ -37,6 +38,8 @@ KEEP = 4  # distinct designs an evolution hands on
 DISTINCT = 0.05  # designs differ when some parameter differs by this much (in log, or of its range)
 DESCENT_EVALS = 1000  # exact evaluations of a Nelder-Mead descent
 INFEASIBLE = 1e12  # the value of a candidate off the targets (plus how far off)
+SECANT_STEP, SECANT_STEPS, SECANT_TOL = 1e-4, 8, 1e-14  # ``on_targets``'s secant steps: first step (relative),
+SECANT_REACH = 0.05  # most steps, |log TR ratio| that ends them, and how far (relative) they may take the crank
 
 
 def applies(problem) -> bool:
@@ -53,9 +56,12 @@ def applies(problem) -> bool:
 
 def value(problem, design: dict, branch: dict | None = None) -> float | None:
     """The exact objective of a design (free parameters; the first branch unless given), minimised (negated
-    where it is maximised); None where it does not build or its analysis fails."""
+    where it is maximised); None where it does not build, its analysis fails or it breaks a bound condition."""
     try:
-        v = criteria.objective_of(problem, problem.build(design, branch or starts_.branches(problem)[0]))
+        m = problem.build(design, branch or starts_.branches(problem)[0])
+        if any(v > 0.0 for v in criteria.violations(problem, m).values()):
+            return None
+        v = criteria.objective_of(problem, m)
     except QroptError:
         return None
     if v is None or not math.isfinite(v):
@@ -175,17 +181,39 @@ def _apart(problem, a: dict, b: dict) -> bool:
     return False
 
 
+def _secant(miss, c0: float, e0: float, lo: float, hi: float) -> float | None:
+    """The crank length where ``miss`` (the log TR ratio) is zero by secant steps from c0 (e0 = miss(c0)):
+    converged to SECANT_TOL, or None (then the bracket and Brent's search)."""
+    a, fa, b = c0, e0, c0 * (1.0 + SECANT_STEP)
+    fb = miss(b)
+    for _ in range(SECANT_STEPS):
+        if not math.isfinite(fb) or fb == fa:
+            return None
+        if abs(fb) <= SECANT_TOL:
+            return b
+        c = b - fb * (b - a) / (fb - fa)
+        if not lo <= c <= hi or abs(c - c0) > SECANT_REACH * c0:
+            return None
+        a, fa, b = b, fb, c
+        fb = miss(b)
+    return None
+
+
 def on_targets(problem, design: dict) -> dict | None:
-    """The design with its crank length moved to the nearest one whose exact TR meets the target and scaled to
-    the stroke (module docstring); None if no bracket is found."""
+    """The design with its crank length moved to one whose exact TR meets the target (by secant steps from its
+    own, else the nearest by Brent's search in a growing bracket) and scaled to the stroke (module docstring);
+    None if neither finds one."""
     from scipy.optimize import brentq
 
     branch = starts_.branches(problem)[0]
     lo, hi = problem.free[CRANK]
+    built: dict = {}  # crank length -> its mechanism, the last one only (the root's is built once)
 
     def miss(c: float) -> float:
         try:
-            return math.log(problem.build(design | {CRANK: c}, branch).time_ratio() / problem.targets["time_ratio"])
+            built.clear()
+            built[c] = problem.build(design | {CRANK: c}, branch)
+            return math.log(built[c].time_ratio() / problem.targets["time_ratio"])
         except (QroptError, ValueError, ZeroDivisionError):
             return math.nan
 
@@ -193,16 +221,20 @@ def on_targets(problem, design: dict) -> dict | None:
     e0 = miss(c0)
     if not math.isfinite(e0):
         return None
-    root = c0 if e0 == 0.0 else None
+    root = c0 if e0 == 0.0 else _secant(miss, c0, e0, lo, hi)
     for step in (1.002, 1.01, 1.03, 1.1, 1.3):
         for c1 in (c0 * step, c0 / step):
             e1 = miss(c1) if root is None and lo <= c1 <= hi else math.nan
             if math.isfinite(e1) and e1 * e0 <= 0.0:
-                root = brentq(miss, min(c0, c1), max(c0, c1), xtol=1e-15, rtol=1e-14)
+                try:
+                    root = brentq(miss, min(c0, c1), max(c0, c1), xtol=1e-15, rtol=1e-14)
+                except ValueError:  # a crank length inside the bracket where the loop does not close
+                    continue
     if root is None:
         return None
     try:
-        return _to_stroke(problem, design | {CRANK: root}, problem.build(design | {CRANK: root}, branch).stroke())
+        m = built.get(root) or problem.build(design | {CRANK: root}, branch)
+        return _to_stroke(problem, design | {CRANK: root}, m.stroke())
     except (QroptError, ValueError, ZeroDivisionError):
         return None
 
@@ -232,15 +264,19 @@ def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dic
     return best[0]
 
 
-def descended(problem, generations: int, seed: int, keep: int = KEEP, evals: int | None = None) -> list[dict]:
-    """The designs of an evolution, each put on the targets and descended: the descents' ends, best first."""
+def descended(
+    problem, generations: int, seed: int, keep: int = KEEP, evals: int | None = None, valued: bool = False
+) -> list:
+    """The designs of an evolution, each put on the targets and descended: the descents' ends, best first (as
+    (exact value, design) where ``valued``)."""
     ends = []
     for d in evolve(problem, generations, seed, keep):
         on = on_targets(problem, d)
         got = descend(problem, on, evals) if on is not None else None
         if got is not None:
             ends.append(got)
-    return [d for _, d in sorted(ends, key=lambda e: e[0])]
+    ends.sort(key=lambda e: e[0])
+    return ends if valued else [d for _, d in ends]
 
 
 __all__ = ["applies", "evolve", "on_targets", "descend", "descended", "outside", "value", "CRANK", "WINDOW"]

@@ -4,7 +4,9 @@ Statuses (grouped as cvxpy groups its own):
 - ``optimal``: the best certified design found (the global claim in its certificate says how far that goes);
 - ``local_optimum``: another certified local optimum (the entries of ``local_optima`` after the first);
 - ``acceptable``: certified, but IPOPT stopped at its acceptable tolerance rather than its full one;
-- ``feasible``: a certified design of a problem without an objective;
+- ``feasible``: a design that meets every target and condition, checked exactly, with no optimality claimed: a
+  certified design of a problem without an objective, or the end of a descent on the exact objective that beats
+  every certified design (or stands where none certified; its certificate's ``local`` says so);
 - ``infeasible``: no design meets the targets and conditions (with the reachable range of each target);
 - ``failed``: no start converged to a certified design (with IPOPT's reasons, and a design meeting every target and
   condition where one is known: the optimum was not reached, not proved absent).

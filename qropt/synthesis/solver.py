@@ -17,10 +17,10 @@ import time
 import numpy as np
 
 from qropt.errors import ProblemError, QroptError
-from qropt.synthesis import criteria, scaling
+from qropt.synthesis import criteria, evolution, scaling
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import Ipopt, Status
-from qropt.synthesis.certificate import Certificate, Designs, objective_value, quantities
+from qropt.synthesis.certificate import Certificate, Designs, objective_value, quantities, residuals
 from qropt.synthesis.diagnosis import Diagnosis
 from qropt.synthesis.formulation import BASE_SAMPLES, EXTRA_SAMPLES, Formulation, RowKind
 from qropt.synthesis.local import Candidate, Formulations, LocalSolve
@@ -30,12 +30,20 @@ from qropt.synthesis.result import Result
 
 TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
 TIE_TOL = 1e-9  # relative: designs this close to an optimum tie with it (see Solver.least_size)
+STANDS = 1e-6  # relative: a descent's end this much better than every certified design is the result (descended)
+DESCENT_LOCAL = "none: the end of a Nelder-Mead descent on the exact objective, every point on the targets"
 REFRESHES = 3  # a dynamic objective's best design solved again from itself at most this often (Solver.refreshed)
 RANGE_SAMPLES = 64  # designs spread over the bounds whose exact target values start a reachable range
 RANGE_SOLVES = 4  # local solves that push a reachable range's ends out from the samples
 RANGE_FREE = (RowKind.DEAD_CENTRE, RowKind.ORIENTATION, RowKind.TARGET)  # rows a range's designs need not meet
 TIE_SCAN = 24  # common scales of a continuum's tied lengths evaluated exactly, log-spaced over what the bounds allow
 TIE_BISECT = 24  # bisections of the least scale whose size is the least (to 2^-24 of a scan step)
+
+
+def _relabelled(r: Result) -> Result:
+    """A certified design as another local optimum (a better design stands before it)."""
+    claim = r.message.split("; global: ", 1)[-1]
+    return dataclasses.replace(r, status="local_optimum", message=f"another certified local optimum; global: {claim}")
 
 
 class Solver:
@@ -180,7 +188,7 @@ class Solver:
         cands, claim, retry = self.multistart.candidates(
             problem, plan, extra, targets, starts_n, seed, max_rounds, designs, retry=not diagnose, hint=hint
         )
-        guard, spent = "", {}
+        guard, spent, ends = "", {}, []
         if not extra:  # a criterion the NLP sees badly near a toggle: the same starts under its transmission guard too
             more, guard, found = self.multistart.guarded(problem, plan, targets, starts_n, seed, max_rounds, designs)
             if found:
@@ -190,12 +198,12 @@ class Solver:
                     "t_ipopt_guarded": sum(c.t_ipopt for c in found),
                 }
             t_evolved = time.perf_counter()
-            evolved, how = self.multistart.evolved(problem, plan, cands + more, targets, seed, max_rounds, designs)
-            if how:  # no design yet: starts from descents on the exact objective too
+            evolved, how, ends = self.multistart.evolved(problem, plan, targets, seed, max_rounds, designs)
+            if how:  # starts from descents on the exact objective too
                 more += evolved
                 guard = f"{guard}; {how}" if guard else how
                 spent["t_evolution"] = time.perf_counter() - t_evolved
-            if retry is not None and any(c.ok for c in more) and not any(c.ok for c in cands):
+            if retry is not None and (any(c.ok for c in more) or ends) and not any(c.ok for c in cands):
                 # the guarded and evolved designs do not stand in for the searches the diagnosis runs after a first
                 # pass without one: they run here, and the best of all is taken
                 cands, claim, plan = self.diagnosis.searched(
@@ -219,7 +227,13 @@ class Solver:
             r = self.best(problem, cands, claim, plan, t0, guard)
             r = self.refreshed(problem, r, targets, seed, max_rounds) if not extra else r
             r = self.least_size(problem, r, targets, seed, max_rounds)
+            r = self.descended(problem, r, ends, guard)
             return dataclasses.replace(r, stats={**r.stats, **spent, "t_total": time.perf_counter() - t0})
+        if ends:  # no certified design, but a descent's end meets every target and condition
+            stats = {**self._stats(problem, cands, plan), **spent}
+            r = self.descended(problem, None, ends, guard, stats)
+            if r is not None:
+                return dataclasses.replace(r, stats={**r.stats, "t_total": time.perf_counter() - t0})
         if not diagnose:
             stats = {**self._stats(problem, cands, plan), **spent}
             stats["t_total"] = time.perf_counter() - t0
@@ -271,6 +285,54 @@ class Solver:
             ]
             return self._result(problem, best_first[0], None, claim, stats, local)
         raise AssertionError("best() of candidates without a certified one")
+
+    def descended(self, problem, r: Result | None, ends: list, how: str, stats: dict | None = None) -> Result | None:
+        """The best end of the evolution's descents (``MultiStart.evolved``: (exact value, design), best first) that
+        meets every target, condition, rule and bound exactly, as a ``feasible`` Result where it beats ``r`` (the
+        best certified design, or None) by more than STANDS (relative): the design is exact, not certified (no
+        optimality conditions hold at a descent's end); the certified designs stay as its local optima. ``r``
+        otherwise; not for a free counterweight (the descents keep it at its start)."""
+        if not ends or (problem.masses is not None and problem.masses.balancing):
+            return r
+        branch, feasible = starts_.branches(problem)[0], self.tolerances["feasibility"]
+        for _, d in ends:
+            try:
+                m = problem.build(d, branch)
+                q = quantities(problem, m)
+                res = residuals(problem, {}, m, problem.targets)
+            except QroptError:
+                continue
+            kept = starts_.rules_kept(problem, {k: np.array([v]) for k, v in d.items()})[0]
+            if not kept or evolution.outside(problem, d) > 0 or max(res.values(), default=0.0) > feasible:
+                continue
+            value = objective_value(problem, q)
+            if value is None or not math.isfinite(value):
+                continue
+            if r is not None:
+                margin = STANDS * max(1.0, abs(r.objective))
+                if not (criteria.better(problem, value, r.objective) and abs(value - r.objective) > margin):
+                    return r
+                claim = f"the best of {len(ends)} descents' ends; certified: {r.certificate.global_claim}"
+                head = f"better than the best certified design, {r.objective:.6g}, by exact evaluation"
+                local = tuple(_relabelled(x) for x in r.local_optima or (r,))
+                stats = r.stats
+            else:
+                claim = f"the best of {len(ends)} descents' ends ({how})"
+                head, local = "no start gave a certified design", ()
+            cert = Certificate(True, None, value, 0.0, 0, DESCENT_LOCAL, claim)
+            return Result(
+                status="feasible",
+                message=f"a design meeting every target and condition exactly, not certified ({head}); global: {claim}",
+                params=dict(m.params),
+                mechanism=m,
+                objective=value,
+                quantities=q,
+                residuals=res,
+                certificate=cert,
+                stats={**(stats or {}), "branch": dict(branch), "origin": "descent"},
+                local_optima=local,
+            )
+        return r
 
     def refreshed(self, problem, r: Result, targets, seed, max_rounds) -> Result:
         """For a dynamic objective, the best design solved again from itself with a fresh NLP (its samples and
