@@ -105,6 +105,18 @@ def test_a_descents_end_stands_as_a_feasible_design_where_no_start_certifies(mon
     assert torque.max() <= r.objective * (1 + 1e-9) and torque.max() == pytest.approx(r.objective, rel=1e-4)
     back = Result.from_dict(r.to_dict())
     assert back.status == "feasible" and back.objective == r.objective
+    # without the evolution (Solver(evolution=False)) the same solve has no design and says why
+    off = Solver(starts_n=0, ipopt_options={"ipopt.max_iter": 0}, evolution=False)
+    assert Solver(**off.options()).evolution is False  # the options rebuild an equal Solver (a worker's)
+    r = off.solve(problem, use_analytic=False, diagnose=False)
+    assert r.status == "failed" and "evolution" not in r.message, r.message
+
+
+def test_the_evolution_option_is_true_or_false():
+    from qropt import ProblemError, Solver
+
+    with pytest.raises(ProblemError, match="evolution is True or False"):
+        Solver(evolution="no")
 
 
 def test_a_descents_end_stands_only_where_it_beats_every_certified_design():

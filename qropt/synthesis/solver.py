@@ -56,7 +56,10 @@ class Solver:
     starts_n, seed: the Sobol multi-start used where no closed form enumerates the solutions (where none
     enumerates or walks them, starts_n per two free parameters unless a solve names its own); backend: an NLP
     backend (``qropt.synthesis.backends``; default IPOPT); atlas: start a problem whose shape is in the atlas
-    (``qropt.synthesis.atlas``) from its designs first, and run the multi-start only where none certifies.
+    (``qropt.synthesis.atlas``) from its designs first, and run the multi-start only where none certifies;
+    evolution: where the objective names a transmission guard (the peak torque), descents on the exact objective
+    from a differential evolution too (``MultiStart.evolved``, ``Solver.descended``: minutes of a four-bar-driven
+    design row, and better designs at some; False leaves them out).
     Results do not depend on what the Solver solved before: formulations take every value as a parameter.
     """
 
@@ -72,6 +75,7 @@ class Solver:
         max_rounds: int = 30,
         backend=None,
         atlas: bool = True,
+        evolution: bool = True,
     ):
         tol = {**TOLERANCES, **(tolerances or {})}
         if set(tol) != set(TOLERANCES) or not all(_positive(v) for v in tol.values()):
@@ -90,9 +94,10 @@ class Solver:
             raise ProblemError(f"Solver: backend must have a run(form, w0, p, lbx, ubx, warm) method, got {backend!r}")
         self.tolerances, self.ipopt_options = tol, dict(ipopt_options or {})
         self.samples, self.extra, self.starts_n, self.seed, self.max_rounds = samples, extra, starts_n, seed, max_rounds
-        if not isinstance(atlas, bool):
-            raise ProblemError(f"Solver: atlas is True or False, got {atlas!r}")
-        self.atlas = atlas
+        for name, v in (("atlas", atlas), ("evolution", evolution)):
+            if not isinstance(v, bool):
+                raise ProblemError(f"Solver: {name} is True or False, got {v!r}")
+        self.atlas, self.evolution = atlas, evolution
         self.backend = backend or Ipopt(self.ipopt_options)
         self._formulations = Formulations(samples, extra)
         self.local_solve = LocalSolve(self._formulations, self.backend, tol, max_rounds)
@@ -116,6 +121,7 @@ class Solver:
             "seed": self.seed,
             "max_rounds": self.max_rounds,
             "atlas": self.atlas,
+            "evolution": self.evolution,
         }
 
     # ---- formulations ----------------------------------------------------------------------------
@@ -198,7 +204,9 @@ class Solver:
                     "t_ipopt_guarded": sum(c.t_ipopt for c in found),
                 }
             t_evolved = time.perf_counter()
-            evolved, how, ends = self.multistart.evolved(problem, plan, targets, seed, max_rounds, designs)
+            evolved, how, ends = [], "", []
+            if self.evolution:
+                evolved, how, ends = self.multistart.evolved(problem, plan, targets, seed, max_rounds, designs)
             if how:  # starts from descents on the exact objective too
                 more += evolved
                 guard = f"{guard}; {how}" if guard else how
