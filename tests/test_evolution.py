@@ -131,7 +131,7 @@ def test_a_descents_end_stands_only_where_it_beats_every_certified_design():
     s = Solver()
     r = s.solve(problem)
     assert r.status == "optimal"
-    ends = evolution.descended(problem, 20, seed=3, keep=2, evals=300, valued=True)
+    ends = evolution.descended(problem, 20, seed=3, keep=2, evals=300)
     assert ends and ends[0][0] >= r.objective * (1 - 1e-9)
     assert s.descended(problem, r, ends, "") is r
     worse = dataclasses.replace(r, objective=r.objective * 1.2, local_optima=())

@@ -264,19 +264,16 @@ def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dic
     return best[0]
 
 
-def descended(
-    problem, generations: int, seed: int, keep: int = KEEP, evals: int | None = None, valued: bool = False
-) -> list:
-    """The designs of an evolution, each put on the targets and descended: the descents' ends, best first (as
-    (exact value, design) where ``valued``)."""
+def descended(problem, generations: int, seed: int, keep: int = KEEP, evals: int | None = None) -> list:
+    """The designs of an evolution, each put on the targets and descended: the descents' ends as (exact value,
+    design), best first."""
     ends = []
     for d in evolve(problem, generations, seed, keep):
         on = on_targets(problem, d)
         got = descend(problem, on, evals) if on is not None else None
         if got is not None:
             ends.append(got)
-    ends.sort(key=lambda e: e[0])
-    return ends if valued else [d for _, d in ends]
+    return sorted(ends, key=lambda e: e[0])
 
 
 __all__ = ["applies", "evolve", "on_targets", "descend", "descended", "outside", "value", "CRANK", "WINDOW"]

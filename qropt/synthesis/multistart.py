@@ -148,7 +148,7 @@ class MultiStart:
             return [], "", []
         if not evolution.applies(problem):
             return [], "", []
-        ends = evolution.descended(problem, EVOLUTION_GENERATIONS, seed, valued=True)
+        ends = evolution.descended(problem, EVOLUTION_GENERATIONS, seed)
         runs = [("evolution", v) for _, v in ends]
         out = self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
         how = (
