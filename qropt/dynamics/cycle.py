@@ -1,8 +1,10 @@
 """Cycle quantities of the inverse dynamics: exact extremes (peak torque, peak force at each joint, peak shaking
 force), quadratures over the turn (RMS torque, the energy per stroke) and the flywheel.
 
-Extremes: a grid of the turn (of each stroke, closed at its dead centres, where the loads switch there), then a
-bounded scalar search around the largest grid maxima (to 1e-12 rad). Quadratures:
+Extremes: a grid of the turn (of each stroke, closed at its dead centres, where the loads switch there), a
+sub-grid within a step of each grid maximum and of the least transmission angle's crank angle (a torque spike
+near a toggle can be narrower than the grid step), then a bounded scalar search around the largest (to 1e-12
+rad). Quadratures:
 Gauss-Legendre on each stroke separately (the cutting force switches at the dead centres, so the integrand is
 smooth only within a stroke). SI units.
 """
@@ -21,6 +23,7 @@ from qropt.dynamics.model import Loads, Masses
 GRID = 720  # crank angles of the search grid
 GAUSS = 48  # Gauss-Legendre nodes per piece of a stroke
 REFINED, NEAR = 3, 0.01  # a peak: the grid's local maxima refined, at most 3 and within 1 % of the grid's best
+SUB = 32  # sub-grid points each side of a grid maximum, within a grid step (``CycleDynamics.peaks``)
 TWO_PI = 2 * math.pi
 
 
@@ -105,25 +108,48 @@ class CycleDynamics:
         return self.peaks(f, REFINED, NEAR, jumps)[0]
 
     def peaks(self, f, n: int, near: float | None = None, jumps: bool = False) -> list[Peak]:
-        """The n largest local maxima of f(Dynamics) over the turn, largest first (``near``: only those whose grid
-        value is within that fraction of the grid's best), each refined by a bounded search to 1e-12 rad. A
-        quantity that ``jumps`` where the loads switch (a joint force, at the dead centres) is searched over each
-        stroke closed at its ends with its own load: such a quantity may peak at a dead centre, on the working
-        side."""
+        """The n largest local maxima of f(Dynamics) over the turn, largest first (``near``: only those within that
+        fraction of the largest). Each maximum of the grid, and the crank angle of the least transmission angle
+        (where a torque spike near a toggle lives), is searched on a sub-grid of SUB points each side within a
+        grid step (one vectorised call: a spike narrower than the grid step, which the grid samples low, is seen)
+        and refined by a bounded search to 1e-12 rad. A quantity that ``jumps`` where the loads switch (a joint
+        force, at the dead centres) is searched over each stroke closed at its ends with its own load: such a
+        quantity may peak at a dead centre, on the working side."""
         found = []
         split = jumps and self.switching
         pieces = zip(self.pieces, self.working_pieces, strict=True) if split else [((0.0, TWO_PI), None)]
+        toggle = self.m.gamma_min().theta2
         for (lo, hi), on in pieces:
             k = max(8, math.ceil(GRID * (hi - lo) / TWO_PI))
             closed = on is not None
             t = np.linspace(lo, hi, k + 1) if closed else np.linspace(lo, hi, k, endpoint=False)
+            h = (hi - lo) / k
             v = f(self.at(t % TWO_PI, on))
             last = t.size - 1
+            sites = []
             for i in range(t.size):
                 left = v[i - 1] if i > 0 or not closed else -np.inf
                 right = v[i + 1] if i < last else (-np.inf if closed else v[0])
                 if v[i] >= left and v[i] >= right:
-                    found.append((float(v[i]), float(t[i]), lo, hi, (hi - lo) / k, closed, on))
+                    sites.append(float(t[i]))
+            at = lo + (toggle - lo) % TWO_PI
+            toggled = not closed or at <= hi
+            if toggled:
+                sites.append(at)
+            sub = np.linspace(-h, h, 2 * SUB + 1)
+            grid = np.array(sites)[:, None] + sub[None, :]
+            if closed:
+                grid = np.clip(grid, lo, hi)
+            w = f(self.at(grid.ravel() % TWO_PI, on)).reshape(grid.shape)
+            best = np.argmax(w, axis=1)
+            seen = set()
+            for j, b in enumerate(best):
+                key, x = round(float(grid[j, b]) / (h / SUB)), float(grid[j, b])
+                if j == len(sites) - 1 and toggled and b in (0, 2 * SUB) and not (closed and x in (lo, hi)):
+                    continue  # the toggle's window rises out of it: no maximum inside (a grid site holds it)
+                if key not in seen:
+                    seen.add(key)
+                    found.append((float(w[j, b]), float(grid[j, b]), lo, hi, h / SUB, closed, on))
         found.sort(key=lambda c: -c[0])
         if near is not None:
             found = [c for c in found if c[0] >= found[0][0] - near * abs(found[0][0])]

@@ -11,17 +11,20 @@ For a problem with TR and stroke targets whose lengths scale freely and whose cr
 - ``on_targets``: a design with its crank length moved until the exact TR meets the target (secant steps from
   its own, else Brent's root search in a bracket grown from 0.2 % to 30 %), then scaled to the stroke.
 - ``descend``: Nelder-Mead on the exact objective over every free parameter but the crank, each point put on the
-  targets by ``on_targets``: no samples between which a torque spike could hide.
+  targets by ``on_targets``: no samples between which a torque spike could hide. A peak over the turn is
+  descended by an SQP on its exact extremes instead (``minimax.polish``), which does not stall where peaks are
+  equal (``descended``).
 
 Grid values place candidates; the values that rank them are exact. The descents' ends are starts
 (``MultiStart.evolved``), part of a benchmark's reference (``benchmarks.search``) and, where one beats every
-certified design, a solve's ``feasible`` result (``Solver.descended``): they meet the targets exactly but carry
-no optimality conditions.
+certified design, a solve's ``feasible`` result (``Solver.descended``): they meet the targets exactly; the NLP
+does not certify them (an SQP's end is first-order stationary, a Nelder-Mead end carries nothing).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -40,6 +43,17 @@ DESCENT_EVALS = 1000  # exact evaluations of a Nelder-Mead descent
 INFEASIBLE = 1e12  # the value of a candidate off the targets (plus how far off)
 SECANT_STEP, SECANT_STEPS, SECANT_TOL = 1e-4, 8, 1e-14  # ``on_targets``'s secant steps: first step (relative),
 SECANT_REACH = 0.05  # most steps, |log TR ratio| that ends them, and how far (relative) they may take the crank
+DESCENT_LOCAL = "none: the end of a Nelder-Mead descent on the exact objective, every point on the targets"
+
+
+@dataclass(frozen=True)
+class End:
+    """A descent's end: its exact objective (minimised: negated where it is maximised), the design (free
+    parameters) and what holds there (a certificate's ``local`` words)."""
+
+    value: float
+    design: dict
+    local: str
 
 
 def applies(problem) -> bool:
@@ -199,14 +213,14 @@ def _secant(miss, c0: float, e0: float, lo: float, hi: float) -> float | None:
     return None
 
 
-def on_targets(problem, design: dict) -> dict | None:
+def on_targets(problem, design: dict, bounds: tuple | None = None) -> dict | None:
     """The design with its crank length moved to one whose exact TR meets the target (by secant steps from its
     own, else the nearest by Brent's search in a growing bracket) and scaled to the stroke (module docstring);
-    None if neither finds one."""
+    None if neither finds one. ``bounds``: the crank lengths searched (default: its box)."""
     from scipy.optimize import brentq
 
     branch = starts_.branches(problem)[0]
-    lo, hi = problem.free[CRANK]
+    lo, hi = bounds or problem.free[CRANK]
     built: dict = {}  # crank length -> its mechanism, the last one only (the root's is built once)
 
     def miss(c: float) -> float:
@@ -264,16 +278,32 @@ def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dic
     return best[0]
 
 
-def descended(problem, generations: int, seed: int, keep: int = KEEP, evals: int | None = None) -> list:
-    """The designs of an evolution, each put on the targets and descended: the descents' ends as (exact value,
-    design), best first."""
-    ends = []
+def descended(
+    problem, generations: int, seed: int, keep: int = KEEP, evals: int | None = None, sqp: bool = False
+) -> list[End]:
+    """The designs of an evolution, each put on the targets and descended by Nelder-Mead (``descend``, ``evals``
+    evaluations); with ``sqp``, where the objective is a peak over the turn, the SQP on its exact extremes
+    (``minimax.polish``) runs from the design and from Nelder-Mead's end too (the two often reach different
+    minima; the ends then kept where they differ, ``_apart``). The ends, best first."""
+    from qropt.synthesis import minimax  # it builds on this module
+
+    ends: list[End] = []
+    sqp = sqp and minimax.applies(problem)
     for d in evolve(problem, generations, seed, keep):
         on = on_targets(problem, d)
-        got = descend(problem, on, evals) if on is not None else None
+        if on is None:
+            continue
+        got = descend(problem, on, evals)
+        for x in ([on] + ([got[1]] if got is not None else [])) if sqp else []:
+            if (p := minimax.polish(problem, x)) is not None:
+                ends.append(End(p.value, p.design, p.local))  # first: at a tie its end says what holds
         if got is not None:
-            ends.append(got)
-    return sorted(ends, key=lambda e: e[0])
+            ends.append(End(got[0], got[1], DESCENT_LOCAL))
+    distinct: list[End] = []
+    for e in sorted(ends, key=lambda e: e.value):
+        if not sqp or all(_apart(problem, e.design, x.design) for x in distinct):
+            distinct.append(e)
+    return distinct
 
 
-__all__ = ["applies", "evolve", "on_targets", "descend", "descended", "outside", "value", "CRANK", "WINDOW"]
+__all__ = ["End", "applies", "evolve", "on_targets", "descend", "descended", "outside", "value", "CRANK", "WINDOW"]

@@ -135,11 +135,13 @@ class MultiStart:
         )
         return out, how, found
 
-    def evolved(self, problem, plan, targets, seed, max_rounds, designs) -> tuple[list, str, list]:
+    def evolved(self, problem, plan, targets, seed, max_rounds, designs, sqp=False) -> tuple[list, str, list]:
         """Where the guard applies (``guarded``): local solves from the ends of descents on the exact objective
-        from an evolution's designs (``evolution.descended``: EVOLUTION_GENERATIONS generations from ``seed``).
-        (candidates, the claim's words, the descents' ends as (exact value, design), best first, which the solver
-        compares with the certified designs, ``Solver.descended``; [], '' and [] where it does not apply.) Run
+        from an evolution's designs (``evolution.descended``: EVOLUTION_GENERATIONS generations from ``seed``; sqp:
+        the SQP on the exact peak too).
+        (candidates, the claim's words, the descents' distinct ends, ``evolution.End``s best first, which the
+        solver compares with the certified designs, ``Solver.descended``; [], '' and [] where it does not apply;
+        the local solves start from the KEEP best.) Run
         whether or not the passes certify a design: of the 36 four-bar-driven rows of the benchmark's 12 tasks it
         made 7 better and gave 1 its only design (docs/benchmarks.md)."""
         c = criteria.of_problem(problem)
@@ -148,11 +150,11 @@ class MultiStart:
             return [], "", []
         if not evolution.applies(problem):
             return [], "", []
-        ends = evolution.descended(problem, EVOLUTION_GENERATIONS, seed)
-        runs = [("evolution", v) for _, v in ends]
+        ends = evolution.descended(problem, EVOLUTION_GENERATIONS, seed, sqp=sqp)
+        runs = [("evolution", e.design) for e in ends[: evolution.KEEP]]  # the best distinct ends
         out = self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
         how = (
-            f"{len(ends)} starts from descents on the exact objective after a differential evolution of "
+            f"{len(runs)} starts from descents on the exact objective after a differential evolution of "
             f"{EVOLUTION_GENERATIONS} generations, {sum(x.ok for x in out)} certified"
         )
         return out, how, ends

@@ -31,7 +31,6 @@ from qropt.synthesis.result import Result
 TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
 TIE_TOL = 1e-9  # relative: designs this close to an optimum tie with it (see Solver.least_size)
 STANDS = 1e-6  # relative: a descent's end this much better than every certified design is the result (descended)
-DESCENT_LOCAL = "none: the end of a Nelder-Mead descent on the exact objective, every point on the targets"
 REFRESHES = 3  # a dynamic objective's best design solved again from itself at most this often (Solver.refreshed)
 RANGE_SAMPLES = 64  # designs spread over the bounds whose exact target values start a reachable range
 RANGE_SOLVES = 4  # local solves that push a reachable range's ends out from the samples
@@ -59,7 +58,10 @@ class Solver:
     (``qropt.synthesis.atlas``) from its designs first, and run the multi-start only where none certifies;
     evolution: where the objective names a transmission guard (the peak torque), descents on the exact objective
     from a differential evolution too (``MultiStart.evolved``, ``Solver.descended``: minutes of a four-bar-driven
-    design row, and better designs at some; False leaves them out).
+    design row, and better designs at some; False leaves them out); sqp: where the objective is a peak over the
+    turn, each design of the evolution and each Nelder-Mead end descended again by the SQP on the exact peak
+    (``minimax.polish``: its ends first-order stationary; on the benchmark's 12 tasks it made 7 rows better and 10
+    worse, docs/benchmarks.md, so it is off unless asked).
     Results do not depend on what the Solver solved before: formulations take every value as a parameter.
     """
 
@@ -76,6 +78,7 @@ class Solver:
         backend=None,
         atlas: bool = True,
         evolution: bool = True,
+        sqp: bool = False,
     ):
         tol = {**TOLERANCES, **(tolerances or {})}
         if set(tol) != set(TOLERANCES) or not all(_positive(v) for v in tol.values()):
@@ -94,10 +97,10 @@ class Solver:
             raise ProblemError(f"Solver: backend must have a run(form, w0, p, lbx, ubx, warm) method, got {backend!r}")
         self.tolerances, self.ipopt_options = tol, dict(ipopt_options or {})
         self.samples, self.extra, self.starts_n, self.seed, self.max_rounds = samples, extra, starts_n, seed, max_rounds
-        for name, v in (("atlas", atlas), ("evolution", evolution)):
+        for name, v in (("atlas", atlas), ("evolution", evolution), ("sqp", sqp)):
             if not isinstance(v, bool):
                 raise ProblemError(f"Solver: {name} is True or False, got {v!r}")
-        self.atlas, self.evolution = atlas, evolution
+        self.atlas, self.evolution, self.sqp = atlas, evolution, sqp
         self.backend = backend or Ipopt(self.ipopt_options)
         self._formulations = Formulations(samples, extra)
         self.local_solve = LocalSolve(self._formulations, self.backend, tol, max_rounds)
@@ -122,6 +125,7 @@ class Solver:
             "max_rounds": self.max_rounds,
             "atlas": self.atlas,
             "evolution": self.evolution,
+            "sqp": self.sqp,
         }
 
     # ---- formulations ----------------------------------------------------------------------------
@@ -206,7 +210,9 @@ class Solver:
             t_evolved = time.perf_counter()
             evolved, how, ends = [], "", []
             if self.evolution:
-                evolved, how, ends = self.multistart.evolved(problem, plan, targets, seed, max_rounds, designs)
+                evolved, how, ends = self.multistart.evolved(
+                    problem, plan, targets, seed, max_rounds, designs, self.sqp
+                )
             if how:  # starts from descents on the exact objective too
                 more += evolved
                 guard = f"{guard}; {how}" if guard else how
@@ -295,15 +301,17 @@ class Solver:
         raise AssertionError("best() of candidates without a certified one")
 
     def descended(self, problem, r: Result | None, ends: list, how: str, stats: dict | None = None) -> Result | None:
-        """The best end of the evolution's descents (``MultiStart.evolved``: (exact value, design), best first) that
+        """The best end of the evolution's descents (``MultiStart.evolved``: ``evolution.End``s, best first) that
         meets every target, condition, rule and bound exactly, as a ``feasible`` Result where it beats ``r`` (the
-        best certified design, or None) by more than STANDS (relative): the design is exact, not certified (no
-        optimality conditions hold at a descent's end); the certified designs stay as its local optima. ``r``
-        otherwise; not for a free counterweight (the descents keep it at its start)."""
+        best certified design, or None) by more than STANDS (relative): the design is exact, not certified by the
+        NLP (its certificate's ``local`` says what holds at the end: first-order stationarity of the peak where the
+        SQP on the exact peak ends at a stationary point, else nothing); the certified designs stay as its local
+        optima. ``r`` otherwise; not for a free counterweight (the descents keep it at its start)."""
         if not ends or (problem.masses is not None and problem.masses.balancing):
             return r
         branch, feasible = starts_.branches(problem)[0], self.tolerances["feasibility"]
-        for _, d in ends:
+        for end in ends:
+            d = end.design
             try:
                 m = problem.build(d, branch)
                 q = quantities(problem, m)
@@ -327,7 +335,7 @@ class Solver:
             else:
                 claim = f"the best of {len(ends)} descents' ends ({how})"
                 head, local = "no start gave a certified design", ()
-            cert = Certificate(True, None, value, 0.0, 0, DESCENT_LOCAL, claim)
+            cert = Certificate(True, None, value, 0.0, 0, end.local, claim)
             return Result(
                 status="feasible",
                 message=f"a design meeting every target and condition exactly, not certified ({head}); global: {claim}",
