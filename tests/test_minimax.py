@@ -14,7 +14,7 @@ import pytest
 import qropt
 from benchmarks.tasks import LOADS, MASSES, OMEGA2
 from qropt.studies._design import type_problem
-from qropt.synthesis import evolution, minimax
+from qropt.synthesis import evolution, minimax, starts
 from qropt.synthesis.dynamic import _cycle
 from tests import brute
 
@@ -29,9 +29,7 @@ def _start(problem, generations=20, seed=0):
 
 def _near_peak(problem, d, angle):
     """The exact local maximum of |T| nearest a crank angle (refined), for a difference of the peak itself."""
-    peaks = _cycle(problem, problem.build(d, evolution.starts_.branches(problem)[0])).peaks(
-        lambda x: np.abs(x.torque), 12, 0.9
-    )
+    peaks = _cycle(problem, problem.build(d, starts.branches(problem)[0])).peaks(lambda x: np.abs(x.torque), 12, 0.9)
     return min(peaks, key=lambda p: abs((p.theta2 - angle + math.pi) % (2 * math.pi) - math.pi)).value
 
 

@@ -149,7 +149,7 @@ class CycleDynamics:
                     continue  # the toggle's window rises out of it: no maximum inside (a grid site holds it)
                 if key not in seen:
                     seen.add(key)
-                    found.append((float(w[j, b]), float(grid[j, b]), lo, hi, h / SUB, closed, on))
+                    found.append((float(w[j, b]), x, lo, hi, h / SUB, closed, on))
         found.sort(key=lambda c: -c[0])
         if near is not None:
             found = [c for c in found if c[0] >= found[0][0] - near * abs(found[0][0])]

@@ -11,9 +11,9 @@ For a problem with TR and stroke targets whose lengths scale freely and whose cr
 - ``on_targets``: a design with its crank length moved until the exact TR meets the target (secant steps from
   its own, else Brent's root search in a bracket grown from 0.2 % to 30 %), then scaled to the stroke.
 - ``descend``: Nelder-Mead on the exact objective over every free parameter but the crank, each point put on the
-  targets by ``on_targets``: no samples between which a torque spike could hide. A peak over the turn is
-  descended by an SQP on its exact extremes instead (``minimax.polish``), which does not stall where peaks are
-  equal (``descended``).
+  targets by ``on_targets``: no samples between which a torque spike could hide. With ``Solver(sqp=True)`` a
+  peak over the turn is descended by an SQP on its exact extremes too (``minimax.polish``), which does not stall
+  where peaks are equal (``descended``).
 
 Grid values place candidates; the values that rank them are exact. The descents' ends are starts
 (``MultiStart.evolved``), part of a benchmark's reference (``benchmarks.search``) and, where one beats every

@@ -189,7 +189,7 @@ def _model(problem, c, xy: _Coordinates, d: dict, angles: np.ndarray) -> tuple:
         C[:, j] = (xy.coords(dj) - c0) / (signs[j] * STEP)
         a[j] = (r - r0) / (signs[j] * STEP)
     try:
-        H, Hr, qjj = _curvatures(problem, c, xy, d, angles, base, r0)
+        H, Hr, qjj = _curvatures(problem, c, xy, d, shifted, base, r0)
     except _Failed:
         return f, G, C, a, np.zeros((m, n, n)), np.zeros((n, n))
     # the forward differences' first error term, -h/2 times the second derivative (near a toggle q_zz is large)
@@ -198,11 +198,11 @@ def _model(problem, c, xy: _Coordinates, d: dict, angles: np.ndarray) -> tuple:
     return f, G, C, a, H, Hr
 
 
-def _curvatures(problem, c, xy: _Coordinates, d: dict, angles: np.ndarray, base: np.ndarray, r0: float) -> tuple:
-    """The extremes' Hessians q_zz - q_zt^2 / q_tt, the TR residual's and q_zz's diagonals (``_model``); ``base``:
-    q at the angles and ANGLE either side."""
-    z, m, n, br = xy.z(d), angles.size, len(xy.names), xy.branch
-    shifted, f = np.concatenate([angles, angles + ANGLE, angles - ANGLE]), base[: angles.size]
+def _curvatures(problem, c, xy: _Coordinates, d: dict, shifted: np.ndarray, base: np.ndarray, r0: float) -> tuple:
+    """The extremes' Hessians q_zz - q_zt^2 / q_tt, the TR residual's and q_zz's diagonals (``_model``);
+    ``shifted``: the extremes' angles and those ANGLE either side, ``base``: q there."""
+    z, m, n, br = xy.z(d), shifted.size // 3, len(xy.names), xy.branch
+    angles, f = shifted[:m], base[:m]
     once, r1, side = [], np.zeros(n), np.zeros(n)
     for j in range(n):
         side[j], dj, r1[j] = _sided(xy, d, z, j, CURVE)
@@ -325,19 +325,21 @@ def polish(problem, design: dict, steps: int = STEPS) -> Polished | None:
             delta /= 4
             if delta < DELTA_LEAST:
                 break
-    predicted = _predicted(problem, c, xy, d, F)
+    predicted = _predicted(problem, c, xy, d, F, None if fresh else (f, G, C, a))
     return Polished(F, d, taken, predicted <= FIRST_ORDER, predicted, count)
 
 
-def _predicted(problem, c, xy: _Coordinates, d: dict, F: float) -> float:
+def _predicted(problem, c, xy: _Coordinates, d: dict, F: float, model: tuple | None) -> float:
     """The decrease (relative) the linear model of the end's extremes, TR and box predicts within a step of CHECK:
     zero at a first-order stationary point whatever the radius, unlike the last step's prediction, which shrinks
-    with the trust region."""
-    try:
-        angles, _ = _extremes(problem, c, d, xy.branch)
-        f, G, C, a, H, Hr = _model(problem, c, xy, d, angles)
-    except (_Failed, QroptError):
-        return math.inf
+    with the trust region. ``model``: (f, G, C, a) at d where the last step built it, else built here."""
+    if model is None:
+        try:
+            angles, _ = _extremes(problem, c, d, xy.branch)
+            model = _model(problem, c, xy, d, angles)[:4]
+        except (_Failed, QroptError):
+            return math.inf
+    f, G, C, a = model
     B = np.zeros((G.shape[1], G.shape[1]))
     got = _qp(F, f, G, C, xy.coords(d), a, xy, B, CHECK)
     return math.inf if got is None else max(got[-1], 0.0)
