@@ -26,10 +26,33 @@ PATH = Path(__file__).with_name("atlas.json")
 SHAPE_CONDITIONS = ("grashof", "gamma_min")  # conditions that do not change with the scale
 SAME = 0.02  # a node's designs this close in every parameter (strokes for lengths and offsets, rad for angles) are
 # one start: the solve from the second ended where the first's did (docs/benchmarks.md)
+SAME_SHAPE = ("mechanism", "fixed", "free", "branches")  # what a problem shares with the atlas entries ``related``
+# gives it
 
 
 def _round(x: float) -> float:
     return float(f"{x:.9g}")  # scaled problems' bounds agree to rounding
+
+
+def _shape(problem) -> dict:
+    """The problem's shape: its mechanism, fixed values and bounds (lengths in strokes), branches and what it
+    asks for (conditions, objective, size, accel_over)."""
+    s = float(problem.targets["stroke"])
+
+    def rel(k, v):
+        return _round(v / s if scaling.scales(problem, k) else v)
+
+    d = problem.to_dict()
+    return {
+        "mechanism": d["mechanism"],
+        "fixed": {k: rel(k, v) for k, v in d["fixed"].items()},
+        "free": {k: [rel(k, lo), rel(k, hi)] for k, (lo, hi) in d["free"].items()},
+        "conditions": d["conditions"],
+        "objective": d["objective"],
+        "size": d["size"],
+        "accel_over": d["accel_over"],
+        "branches": d["branches"],
+    }
 
 
 def signature(problem) -> str | None:
@@ -40,23 +63,7 @@ def signature(problem) -> str | None:
     c = criteria.of_problem(problem)
     if c is None or not (c.kinematic or c.size) or set(problem.conditions) - set(SHAPE_CONDITIONS):
         return None
-    s = float(problem.targets["stroke"])
-
-    def rel(k, v):
-        return _round(v / s if scaling.scales(problem, k) else v)
-
-    d = problem.to_dict()
-    shape = {
-        "mechanism": d["mechanism"],
-        "fixed": {k: rel(k, v) for k, v in d["fixed"].items()},
-        "free": {k: [rel(k, lo), rel(k, hi)] for k, (lo, hi) in d["free"].items()},
-        "conditions": d["conditions"],
-        "objective": d["objective"],
-        "size": d["size"],
-        "accel_over": d["accel_over"],
-        "branches": d["branches"],
-    }
-    return json.dumps(shape, sort_keys=True)
+    return json.dumps(_shape(problem), sort_keys=True)
 
 
 @dataclass(frozen=True)
@@ -89,30 +96,59 @@ def starts(problem) -> Starts:
     bounds; empty where its signature is not in the atlas or its TR is outside the nodes."""
     key = signature(problem)
     entry = _entries().get(key) if key else None
-    if entry is None:
+    return Starts() if entry is None else _around(problem, [entry])
+
+
+def related(problem) -> Starts:
+    """Where a problem's optima do not scale with its stroke (a dynamic objective): the atlas's designs of the same
+    mechanism, fixed values, bounds and branches by every objective the atlas holds for them (optima by the
+    transmission angle and the acceleration), as ``starts`` gives them; empty where ``signature`` applies, the
+    targets are not a TR and a stroke, or the atlas holds none."""
+    if set(problem.targets) != {"time_ratio", "stroke"} or not problem.objective or signature(problem) is not None:
         return Starts()
-    tr, nodes = float(problem.targets["time_ratio"]), entry["nodes"]
+    entries = _by_shape().get(_shared(_shape(problem)), [])
+    return _around(problem, entries) if entries else Starts()
+
+
+def _shared(shape: dict) -> str:
+    return json.dumps({k: shape[k] for k in SAME_SHAPE}, sort_keys=True)
+
+
+@functools.cache
+def _by_shape() -> dict:
+    """The atlas's entries by what they share with a problem that ``related`` serves (``SAME_SHAPE``)."""
+    out: dict = {}
+    for key, e in _entries().items():
+        out.setdefault(_shared(json.loads(key)), []).append(e)
+    return out
+
+
+def _around(problem, entries: list) -> Starts:
+    """The designs of entries (with the same nodes) at the nodes around the problem's TR (``starts``)."""
+    tr, nodes = float(problem.targets["time_ratio"]), entries[0]["nodes"]
     if not nodes[0] <= tr <= nodes[-1]:
         return Starts()
     i = max(bisect.bisect_right(nodes, tr) - 1, 0)
     around = sorted({i, min(i + 1, len(nodes) - 1)})
     s = float(problem.targets["stroke"])
     out, node = [], []
-    for n, j in enumerate(around):
-        kept = []
-        for d in entry["designs"][j]:
-            if any(_same(d, e) for e in kept):
-                continue
-            kept.append(d)
-            v = {k: x * s if scaling.scales(problem, k) else x for k, x in d["params"].items()}
-            v = {k: min(max(v[k], lo), hi) for k, (lo, hi) in problem.free.items()}
-            out.append((v, {k: float(b) for k, b in d["branch"].items()}))
-            node.append(n)
+    for entry in entries:
+        for n, j in enumerate(around):
+            kept = []
+            for d in entry["designs"][j]:
+                if any(_same(d, e) for e in kept):
+                    continue
+                kept.append(d)
+                v = {k: x * s if scaling.scales(problem, k) else x for k, x in d["params"].items()}
+                v = {k: min(max(v[k], lo), hi) for k, (lo, hi) in problem.free.items()}
+                out.append((v, {k: float(b) for k, b in d["branch"].items()}))
+                node.append(n)
     at = " and ".join(f"{nodes[j]:g}" for j in around)
-    how = f"{len(out)} designs of the atlas at TR {at} (each node's best of a {entry['starts']}-start search"
-    how += f", of the best of {entry['shapes']:,} random shapes near it" if entry.get("shapes") else ""
+    by = " and ".join(e["objective"] for e in entries)
+    how = f"{len(out)} designs of the atlas at TR {at} by {by} (each node's best of a {entries[0]['starts']}-start"
+    how += f" search, of the best of {entries[0]['shapes']:,} random shapes near it" if entries[0].get("shapes") else ""
     how += " and of solves from its neighbours' designs)"
     return Starts(tuple(out), how, tuple(node), tuple(float(nodes[j]) for j in around))
 
 
-__all__ = ["signature", "starts", "Starts", "PATH"]
+__all__ = ["signature", "starts", "related", "Starts", "PATH"]

@@ -31,6 +31,8 @@ WALK_XTOL = 1e-12  # a family walk's search tolerance relative to its parameter 
 MANY_STARTS = 6  # more closed-form points than this are scored exactly and only the best few refined
 WIDER = 4  # a wider multi-start runs this many times the starts (measured: the drag-link slider's least peak
 # acceleration at TR 2.479, stroke 0.2952 m and TR 2.004, 1.37 m needs 96 starts, not 24)
+FULL_TURN = 2 * math.pi * (1 - 1e-9)  # an angle's box this wide holds every angle: its edges are one (``wrapped``)
+WRAP_EDGE = 1e-6  # rad: a design's angle this near such an edge is at it
 EVOLUTION_GENERATIONS = 100  # an evolution's generations where the guard applies (``evolved``)
 THIN = 3  # a multi-start whose second pass (both TR orientations) certifies fewer designs than this is thin
 # evidence: the diagnosis's wider multi-start runs too (``Diagnosis.run``)
@@ -90,6 +92,10 @@ class MultiStart:
                 runs += [("analytic", v) for v in plan.analytic]
             if not extra:  # shapes best by the objective among many, on a grid
                 runs += [("shape", v) for v in starts_.shapes(problem, starts_.SHAPES_KEEP, seed)]
+                # and, for a dynamic objective, the atlas's optima of the same shape by the kinematic ones, from the
+                # default barrier (from the small one none of the 8 at the coupler slider's least peak torque at TR
+                # 2.479, 0.2952 m gave a design; from the default 2 gave 103.146 N m, which 36 starts had missed)
+                runs += [("related", v, b) for v, b in plan.related.designs]
             runs += [("multistart", v) for v in starts_.sobol(problem, starts_n, seed, designs)]
         cands += self.run(problem, runs, targets, max_rounds, designs, both_ways=False, hint=hint)
         if plan.kind == "family" and plan.walk is not None and not extra and problem.objective:
@@ -158,6 +164,27 @@ class MultiStart:
             f"{EVOLUTION_GENERATIONS} generations, {sum(x.ok for x in out)} certified"
         )
         return out, how, ends
+
+    def wrapped(self, problem, cands, targets, max_rounds, designs) -> tuple[list, str]:
+        """Each distinct certified design with an angle at an edge of a full-turn box (its width 2 pi), solved again
+        from that angle taken across the edge (2 pi less or more: the same mechanism), where the box cut its descent.
+        The coupler slider's beta ended at pi with 1,155.33 N m at TR 2.004, 1.37 m; from -pi it goes on to
+        -2.761 rad and 1,127.31 N m. (candidates, the claim's words; '' where no design is at such an edge)."""
+        kinds, runs = problem.mechanism.kinds(), []
+        turns = [k for k, (lo, hi) in problem.free.items() if kinds[k] == "angle" and hi - lo >= FULL_TURN]
+        for c in distinct([c for c in cands if c.ok]) if turns else []:
+            for k in turns:
+                lo, hi = problem.free[k]
+                x = c.values[k]
+                if min(x - lo, hi - x) <= WRAP_EDGE:
+                    across = x - 2 * math.pi if hi - x <= WRAP_EDGE else x + 2 * math.pi
+                    runs.append(("wrapped", {**c.values, k: min(max(across, lo), hi)}, c.branch))
+        if not runs:
+            return [], ""
+        out = self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
+        n = len(runs)
+        how = f"{n} design{'s' * (n != 1)} at an edge of a full-turn angle's box solved again from across it, "
+        return out, how + f"{sum(c.ok for c in out)} certified"
 
     def continued(self, problem, start: Candidate, guard: float, targets, max_rounds, designs) -> Candidate | None:
         """A design certified under a transmission guard, solved again under guards GUARD_STEP times smaller in turn

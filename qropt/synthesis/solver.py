@@ -224,6 +224,10 @@ class Solver:
                     problem, plan, cands, claim, retry, targets, starts_n, seed
                 )
             cands += more
+        wrapped, how = self.multistart.wrapped(problem, cands, targets, max_rounds, designs)
+        if how:  # a box that cut a full-turn angle's descent: on from across its edge
+            cands += wrapped
+            guard = f"{guard}; {how}" if guard else how
         good = [c for c in cands if c.ok]
         if plan.kind == "enumeration" and not extra and not good and not diagnose:  # every design, none valid
             why = sorted({c.info.get("reason", "") or "it breaks a condition" for c in cands})
@@ -288,8 +292,11 @@ class Solver:
             k = len(best_first)
             if not claim:
                 shaped = sum(c.origin == "shape" for c in cands)
-                how = f" ({shaped} chosen by the objective among {starts_.SHAPES} grid shapes)" if shaped else ""
-                started = sum(c.origin != "guard" for c in cands)
+                related = sum(c.origin == "related" for c in cands)
+                how = [f"{shaped} chosen by the objective among {starts_.SHAPES} grid shapes"] if shaped else []
+                how += [f"{related} the atlas's optima of this shape by kinematic objectives"] if related else []
+                how = f" ({'; '.join(how)})" if how else ""
+                started = sum(c.origin not in ("guard", "wrapped") for c in cands)
                 claim = f"best of {k} distinct local optima from {started} starts{how}"
             if guard:
                 claim += f"; with {guard}"

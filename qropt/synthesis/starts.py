@@ -30,6 +30,7 @@ class Plan:
     outside: int = 0  # closed-form points of an enumeration left out as outside the bounds
     ranges: dict = field(default_factory=dict)  # target -> (low, high) over the bounds, by the closed form
     atlas: atlas_.Starts = atlas_.Starts()  # where no closed form enumerates or walks every solution
+    related: atlas_.Starts = atlas_.Starts()  # the same, where the objective is dynamic: the atlas's kinematic optima
     walk: analytic.Walk | None = None  # a family's designs as a function of its parameter (``analytic.Walk``)
 
 
@@ -47,7 +48,9 @@ def plan(problem, use_analytic: bool = True, use_atlas: bool = False) -> Plan:
     """The closed-form starts (clipped to the bounds) and what they cover; with ``use_atlas``, the atlas's designs
     where the closed forms neither enumerate nor walk every solution."""
     if not use_analytic:
-        return Plan((), "none", "closed forms not used", atlas=atlas_.starts(problem) if use_atlas else atlas_.Starts())
+        return Plan(
+            (), "none", "closed forms not used", atlas=_atlas(problem, use_atlas), related=_related(problem, use_atlas)
+        )
     w = analytic.warm_starts(problem)
 
     def clip(v):
@@ -56,8 +59,23 @@ def plan(problem, use_analytic: bool = True, use_atlas: bool = False) -> Plan:
     if w.kind == "enumeration":  # every design: one outside the bounds is no start, it is not a design here
         inside = [v for v in w.points if all(lo <= v[k] <= hi for k, (lo, hi) in problem.free.items())]
         return Plan(tuple(inside), w.kind, w.how, len(w.points) - len(inside), dict(w.ranges))
-    found = atlas_.starts(problem) if use_atlas and w.kind != "family" else atlas_.Starts()
-    return Plan(tuple(clip(v) for v in w.points), w.kind, w.how, atlas=found, walk=w.walk)
+    use_atlas = use_atlas and w.kind != "family"
+    return Plan(
+        tuple(clip(v) for v in w.points),
+        w.kind,
+        w.how,
+        atlas=_atlas(problem, use_atlas),
+        related=_related(problem, use_atlas),
+        walk=w.walk,
+    )
+
+
+def _atlas(problem, use: bool) -> atlas_.Starts:
+    return atlas_.starts(problem) if use else atlas_.Starts()
+
+
+def _related(problem, use: bool) -> atlas_.Starts:
+    return atlas_.related(problem) if use else atlas_.Starts()
 
 
 POOL = 64  # Sobol points drawn per start wanted: the type's rules (one vectorised check) thin them first
