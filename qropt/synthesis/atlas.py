@@ -102,9 +102,12 @@ def starts(problem) -> Starts:
 def related(problem) -> Starts:
     """Where a problem's optima do not scale with its stroke (a dynamic objective): the atlas's designs of the same
     mechanism, fixed values, bounds and branches by every objective the atlas holds for them (optima by the
-    transmission angle and the acceleration), as ``starts`` gives them; empty where ``signature`` applies, the
-    targets are not a TR and a stroke, or the atlas holds none."""
-    if set(problem.targets) != {"time_ratio", "stroke"} or not problem.objective or signature(problem) is not None:
+    transmission angle and the acceleration), as ``starts`` gives them; empty where the objective is kinematic or
+    a size, the targets are not a TR and a stroke, or the atlas holds none."""
+    if set(problem.targets) != {"time_ratio", "stroke"} or not problem.objective:
+        return Starts()
+    c = criteria.of_problem(problem)
+    if c is None or c.kinematic or c.size:
         return Starts()
     entries = _by_shape().get(_shared(_shape(problem)), [])
     return _around(problem, entries) if entries else Starts()
