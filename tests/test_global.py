@@ -55,13 +55,13 @@ def test_every_row_is_as_good_as_the_search():
 
 
 FAST_DYNAMIC = ["slider-crank", "crank-shaper", "slot-ram-shaper"]  # a closed-form family holds every design
-SLOTTED = ["crank-shaper-rod", "whitworth"]  # three free parameters and more: one a run, drawn with the task
+SLOTTED = ["crank-shaper-rod", "whitworth"]  # three degrees of freedom: one a run, drawn with the task
 
 
 def test_every_fast_row_by_peak_torque_is_as_good_as_the_search():
     """By min_peak_torque (benchmarks.tasks' mass model: steel links, a 20 kg ram, 1,000 N at 10 rad/s) the rows of
-    one degree of freedom and one of the crank-and-slotted-lever rows of three or four (drawn with the task; each
-    takes a minute with its search) against the search at a task drawn for this run. The search ranks the shapes
+    one degree of freedom and one of the two crank-and-slotted-lever rows of three (drawn with the task; each takes
+    a minute with its search) against the search at a task drawn for this run. The search ranks the shapes
     near the task by their exact peak torque (it does not scale with the stroke). The four-bar-driven rows take
     minutes a task (``python -m benchmarks.search --objectives min_peak_torque``; docs/benchmarks.md)."""
     from benchmarks.tasks import LOADS, MASSES, OMEGA2
