@@ -48,9 +48,7 @@ def plan(problem, use_analytic: bool = True, use_atlas: bool = False) -> Plan:
     """The closed-form starts (clipped to the bounds) and what they cover; with ``use_atlas``, the atlas's designs
     where the closed forms neither enumerate nor walk every solution."""
     if not use_analytic:
-        return Plan(
-            (), "none", "closed forms not used", atlas=_atlas(problem, use_atlas), related=_related(problem, use_atlas)
-        )
+        return Plan((), "none", "closed forms not used", **_from_atlas(problem, use_atlas))
     w = analytic.warm_starts(problem)
 
     def clip(v):
@@ -59,23 +57,15 @@ def plan(problem, use_analytic: bool = True, use_atlas: bool = False) -> Plan:
     if w.kind == "enumeration":  # every design: one outside the bounds is no start, it is not a design here
         inside = [v for v in w.points if all(lo <= v[k] <= hi for k, (lo, hi) in problem.free.items())]
         return Plan(tuple(inside), w.kind, w.how, len(w.points) - len(inside), dict(w.ranges))
-    use_atlas = use_atlas and w.kind != "family"
-    return Plan(
-        tuple(clip(v) for v in w.points),
-        w.kind,
-        w.how,
-        atlas=_atlas(problem, use_atlas),
-        related=_related(problem, use_atlas),
-        walk=w.walk,
-    )
+    found = _from_atlas(problem, use_atlas and w.kind != "family")
+    return Plan(tuple(clip(v) for v in w.points), w.kind, w.how, walk=w.walk, **found)
 
 
-def _atlas(problem, use: bool) -> atlas_.Starts:
-    return atlas_.starts(problem) if use else atlas_.Starts()
-
-
-def _related(problem, use: bool) -> atlas_.Starts:
-    return atlas_.related(problem) if use else atlas_.Starts()
+def _from_atlas(problem, use: bool) -> dict:
+    """A plan's ``atlas`` and ``related`` starts (none unless ``use``)."""
+    if not use:
+        return {"atlas": atlas_.Starts(), "related": atlas_.Starts()}
+    return {"atlas": atlas_.starts(problem), "related": atlas_.related(problem)}
 
 
 POOL = 64  # Sobol points drawn per start wanted: the type's rules (one vectorised check) thin them first
