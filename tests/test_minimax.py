@@ -111,3 +111,66 @@ def test_where_the_sqp_applies():
     balanced = MASSES.replace(counterweight=qropt.Counterweight.balancing(0.05, 5.0))
     assert balanced.balancing
     assert not minimax.applies(type_problem("drag-link-slider", 1.5, 0.3, **(KW | {"masses": balanced})))
+
+
+def test_the_solver_descends_the_descents_ends_again_by_the_sqp_and_counts_them():
+    """``Solver.polished``: the Nelder-Mead ends of a short evolution (the crank-rocker slider by peak torque at the
+    benchmark's TR 2.017, 1.9568 m) stall; the SQP from them ends lower and stationary, its end is the result
+    (``feasible``, the claim counting both kinds of end), it meets the TR and stroke (brute force) and its peak is
+    exact (a dense Newton-Euler grid). Without a peak over the turn nothing is added."""
+    problem = type_problem("crank-rocker-slider", 2.017, 1.9568, **KW)
+    ends = evolution.descended(problem, 20, seed=0, keep=2, evals=300)
+    s = qropt.Solver()
+    more, added = s.polished(problem, None, ends)
+    assert added >= 1 and len(more) == len(ends) + added
+    assert [e.value for e in more] == sorted(e.value for e in more)
+    assert more[0].value < ends[0].value * (1 - 1e-3), (more[0].value, ends[0].value)
+    assert more[0].local.startswith("first-order stationary")
+    r = s.descended(problem, None, more, "how", {}, polished=added)
+    assert r.status == "feasible" and r.objective == pytest.approx(more[0].value, rel=1e-12)
+    words = f"the best of {len(ends)} descents' ends and {added} ends of the SQP on the exact peak"
+    assert r.certificate.global_claim.startswith(words), r.certificate.global_claim
+    assert r.certificate.local.startswith("first-order stationary")
+    p = dict(problem.fixed) | {k: b[0] for k, b in problem.branches.items()} | more[0].design
+    tmax, tmin, xmax, xmin = brute.dead_centres("crank-rocker-slider", p)
+    assert brute.time_ratio(tmax, tmin) == pytest.approx(2.017, rel=1e-9)
+    assert xmax - xmin == pytest.approx(1.9568, rel=1e-9)
+    grid = np.abs(r.mechanism.dynamics(np.linspace(0, 2 * np.pi, 40_001), OMEGA2, masses=MASSES, loads=LOADS).torque)
+    assert grid.max() <= r.objective * (1 + 1e-12) and grid.max() == pytest.approx(r.objective, rel=1e-6)
+    kinematic = type_problem("crank-rocker-slider", 2.017, 1.9568, objective="min_peak_accel")
+    assert s.polished(kinematic, None, ends) == (ends, 0)
+
+
+def test_the_steps_qp_is_the_qp_a_modelling_layer_states():
+    """The QP stated row by row for Clarabel against the same QP stated in cvxpy (its own canonicalisation), at a
+    real model's rows (the crank-rocker slider, a short evolution's design) with trust regions from tight to
+    wide and a positive definite Hessian: the same predicted decrease, a step meeting every row, multipliers
+    that are non-negative and sum to one (t's coefficient: the stationarity of t)."""
+    import cvxpy as cp
+
+    problem = type_problem("crank-rocker-slider", 2.004, 1.37, **KW)
+    c, xy = minimax.criteria.of_problem(problem), minimax._Coordinates(problem)
+    d = _start(problem)
+    angles, _ = minimax._extremes(problem, c, d, xy.branch)
+    f, G, C, a, _, _ = minimax._model(problem, c, xy, d, angles)
+    F, c0, n = float(f.max()), xy.coords(d), G.shape[1]
+    rng = np.random.default_rng(3)
+    for delta in (1e-4, 1e-2, 0.3):
+        R = rng.normal(size=(n, n))
+        B = R @ R.T / n + 1e-3 * np.eye(n)
+        s, lam, mu, pred = minimax._qp(F, f, G, C, c0, a, xy, B, delta)
+        v, t = cp.Variable(n), cp.Variable()
+        rows = [
+            (f - F) / F + (G / F) @ v <= t,
+            a @ v == 0.0,
+            C @ v <= xy.hi - minimax.MARGIN - c0,
+            -C @ v <= c0 - xy.lo - minimax.MARGIN,
+            cp.abs(v) <= delta,
+        ]
+        cp.Problem(cp.Minimize(t + 0.5 * cp.quad_form(v, B)), rows).solve(solver="SCS", eps=1e-10, max_iters=200_000)
+        assert pred == pytest.approx(-(t.value + 0.5 * v.value @ B @ v.value), rel=1e-5, abs=1e-9)
+        t_s = float(np.max((f - F) / F + (G / F) @ s))
+        assert pred == pytest.approx(-(t_s + 0.5 * s @ B @ s), rel=1e-6, abs=1e-10)
+        assert abs(a @ s) <= 1e-8 * np.linalg.norm(a) and np.max(np.abs(s)) <= delta * (1 + 1e-8)
+        assert np.all(C @ s <= xy.hi - c0 + 1e-10) and np.all(-C @ s <= c0 - xy.lo + 1e-10)
+        assert np.all(lam >= 0) and lam.sum() == pytest.approx(1.0, abs=1e-6) and math.isfinite(mu)

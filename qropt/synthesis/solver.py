@@ -17,7 +17,7 @@ import time
 import numpy as np
 
 from qropt.errors import ProblemError, QroptError
-from qropt.synthesis import criteria, evolution, scaling
+from qropt.synthesis import criteria, evolution, minimax, scaling
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import Ipopt, Status
 from qropt.synthesis.certificate import Certificate, Designs, objective_value, quantities, residuals
@@ -31,6 +31,7 @@ from qropt.synthesis.result import Result
 TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
 TIE_TOL = 1e-9  # relative: designs this close to an optimum tie with it (see Solver.least_size)
 STANDS = 1e-6  # relative: a descent's end this much better than every certified design is the result (descended)
+POLISHED = 3  # the best certified designs the SQP on the exact peak descends again (with every descent's end)
 REFRESHES = 3  # a dynamic objective's best design solved again from itself at most this often (Solver.refreshed)
 RANGE_SAMPLES = 64  # designs spread over the bounds whose exact target values start a reachable range
 RANGE_SOLVES = 4  # local solves that push a reachable range's ends out from the samples
@@ -61,7 +62,8 @@ class Solver:
     design row, and better designs at some; False leaves them out); sqp: where the objective is a peak over the
     turn, each design of the evolution and each Nelder-Mead end descended again by the SQP on the exact peak
     (``minimax.polish``: its ends first-order stationary; on the benchmark's 12 tasks it made 7 rows better and 10
-    worse, docs/benchmarks.md, so it is off unless asked).
+    worse, docs/benchmarks.md, so it is off unless asked). Whatever ``sqp`` says, the SQP descends the best
+    certified designs and every descent's end once more at the end of a solve (``polished``).
     Results do not depend on what the Solver solved before: formulations take every value as a parameter.
     """
 
@@ -245,11 +247,18 @@ class Solver:
             r = self.best(problem, cands, claim, plan, t0, guard)
             r = self.refreshed(problem, r, targets, seed, max_rounds) if not extra else r
             r = self.least_size(problem, r, targets, seed, max_rounds)
-            r = self.descended(problem, r, ends, guard)
+            if not extra:
+                t_sqp = time.perf_counter()
+                ends, spent["sqp_ends"] = self.polished(problem, r, ends)
+                spent["t_sqp"] = time.perf_counter() - t_sqp
+            r = self.descended(problem, r, ends, guard, polished=spent.get("sqp_ends", 0))
             return dataclasses.replace(r, stats={**r.stats, **spent, "t_total": time.perf_counter() - t0})
         if ends:  # no certified design, but a descent's end meets every target and condition
+            t_sqp = time.perf_counter()
+            ends, spent["sqp_ends"] = self.polished(problem, None, ends)
+            spent["t_sqp"] = time.perf_counter() - t_sqp
             stats = {**self._stats(problem, cands, plan), **spent}
-            r = self.descended(problem, None, ends, guard, stats)
+            r = self.descended(problem, None, ends, guard, stats, polished=spent["sqp_ends"])
             if r is not None:
                 return dataclasses.replace(r, stats={**r.stats, "t_total": time.perf_counter() - t0})
         if not diagnose:
@@ -307,15 +316,41 @@ class Solver:
             return self._result(problem, best_first[0], None, claim, stats, local)
         raise AssertionError("best() of candidates without a certified one")
 
-    def descended(self, problem, r: Result | None, ends: list, how: str, stats: dict | None = None) -> Result | None:
-        """The best end of the evolution's descents (``MultiStart.evolved``: ``evolution.End``s, best first) that
-        meets every target, condition, rule and bound exactly, as a ``feasible`` Result where it beats ``r`` (the
-        best certified design, or None) by more than STANDS (relative): the design is exact, not certified by the
-        NLP (its certificate's ``local`` says what holds at the end: first-order stationarity of the peak where the
-        SQP on the exact peak ends at a stationary point, else nothing); the certified designs stay as its local
-        optima. ``r`` otherwise; not for a free counterweight (the descents keep it at its start)."""
+    def polished(self, problem, r: Result | None, ends: list) -> tuple[list, int]:
+        """Where the objective is a peak over the turn (``minimax.applies``): ``ends`` (``evolution.End``s, best
+        first) with the ends of the SQP on the exact peak (``minimax.polish``) from the POLISHED best certified
+        designs (``r`` and its local optima) and from each of ``ends``, where it moves them; best first, and how
+        many were added. A Nelder-Mead descent stalls where peaks are equal, and a certified design
+        can be a point the SQP leaves (the crank-rocker slider by peak torque at TR 2.017, 1.9568 m: a descent's
+        end, 3,588.27 N m, goes to 3,514.80, docs/benchmarks.md). Only ends: a design is not moved, so what the
+        solve found stands (``descended`` takes the best)."""
+        if not minimax.applies(problem):
+            return ends, 0
+        certified = [r, *(r.local_optima or ())[1:]][:POLISHED] if r is not None else []
+        seeds = [{k: x.params[k] for k in problem.free} for x in certified] + [e.design for e in ends]
+        added = []
+        for d in seeds:
+            p = minimax.polish(problem, d)
+            if p is not None and p.steps:
+                added.append(evolution.End(p.value, p.design, p.local))
+        return sorted([*ends, *added], key=lambda e: e.value), len(added)
+
+    def descended(
+        self, problem, r: Result | None, ends: list, how: str, stats: dict | None = None, polished: int = 0
+    ) -> Result | None:
+        """The best end of the evolution's descents (``MultiStart.evolved``: ``evolution.End``s, best first; of
+        them ``polished`` the SQP's, ``polished``) that meets every target, condition, rule and
+        bound exactly, as a ``feasible`` Result where it beats ``r`` (the best certified design, or None) by more
+        than STANDS (relative): the design is exact, not certified by the NLP (its certificate's ``local`` says
+        what holds at the end: first-order stationarity of the peak where the SQP on the exact peak ends at a
+        stationary point, else nothing); the certified designs stay as its local optima. ``r`` otherwise; not for
+        a free counterweight (the descents keep it at its start)."""
         if not ends or (problem.masses is not None and problem.masses.balancing):
             return r
+        n = len(ends) - polished
+        best_of = f"the best of {n} descents' ends" if n else "the best of "
+        if polished:
+            best_of += f"{' and ' if n else ''}{polished} ends of the SQP on the exact peak from the best designs"
         branch, feasible = starts_.branches(problem)[0], self.tolerances["feasibility"]
         for end in ends:
             d = end.design
@@ -335,12 +370,12 @@ class Solver:
                 margin = STANDS * max(1.0, abs(r.objective))
                 if not (criteria.better(problem, value, r.objective) and abs(value - r.objective) > margin):
                     return r
-                claim = f"the best of {len(ends)} descents' ends; certified: {r.certificate.global_claim}"
+                claim = f"{best_of}; certified: {r.certificate.global_claim}"
                 head = f"better than the best certified design, {r.objective:.6g}, by exact evaluation"
                 local = tuple(_relabelled(x) for x in r.local_optima or (r,))
                 stats = r.stats
             else:
-                claim = f"the best of {len(ends)} descents' ends ({how})"
+                claim = f"{best_of} ({how})"
                 head, local = "no start gave a certified design", ()
             cert = Certificate(True, None, value, 0.0, 0, end.local, claim)
             return Result(
