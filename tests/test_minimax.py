@@ -1,6 +1,7 @@
 """The SQP on the exact peak (``qropt.synthesis.minimax``): its derivatives against differences of the exact peak,
 its ends on the targets (brute force) at a least peak no neighbour on the targets beats, and the crank-rocker
-slider's row by peak torque that the solver once missed, against the independent search's design."""
+slider's row by peak torque that the solver once missed, against the independent search's design; its QP against
+the same QP stated in cvxpy; the solver's SQP on the descents' ends at the end of a solve."""
 
 from __future__ import annotations
 
