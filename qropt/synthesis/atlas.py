@@ -55,12 +55,17 @@ def _shape(problem) -> dict:
     }
 
 
+def _criterion(problem):
+    """The objective's criterion of a problem whose targets are a TR and a stroke; None otherwise."""
+    if set(problem.targets) != {"time_ratio", "stroke"} or not problem.objective:
+        return None
+    return criteria.of_problem(problem)
+
+
 def signature(problem) -> str | None:
     """The problem's shape as a key (JSON text): None where its optima do not scale with its stroke (other targets,
     a dynamic objective, or a condition with a length in it)."""
-    if set(problem.targets) != {"time_ratio", "stroke"} or not problem.objective:
-        return None
-    c = criteria.of_problem(problem)
+    c = _criterion(problem)
     if c is None or not (c.kinematic or c.size) or set(problem.conditions) - set(SHAPE_CONDITIONS):
         return None
     return json.dumps(_shape(problem), sort_keys=True)
@@ -104,9 +109,7 @@ def related(problem) -> Starts:
     mechanism, fixed values, bounds and branches by every objective the atlas holds for them (optima by the
     transmission angle and the acceleration), as ``starts`` gives them; empty where the objective is kinematic or
     a size, the targets are not a TR and a stroke, or the atlas holds none."""
-    if set(problem.targets) != {"time_ratio", "stroke"} or not problem.objective:
-        return Starts()
-    c = criteria.of_problem(problem)
+    c = _criterion(problem)
     if c is None or c.kinematic or c.size:
         return Starts()
     entries = _by_shape().get(_shared(_shape(problem)), [])

@@ -248,15 +248,13 @@ class Solver:
             r = self.refreshed(problem, r, targets, seed, max_rounds) if not extra else r
             r = self.least_size(problem, r, targets, seed, max_rounds)
             if not extra:
-                t_sqp = time.perf_counter()
-                ends, spent["sqp_ends"] = self.polished(problem, r, ends)
-                spent["t_sqp"] = time.perf_counter() - t_sqp
+                ends, sqp = self.polished(problem, r, ends)
+                spent.update(sqp)
             r = self.descended(problem, r, ends, guard, polished=spent.get("sqp_ends", 0))
             return dataclasses.replace(r, stats={**r.stats, **spent, "t_total": time.perf_counter() - t0})
         if ends:  # no certified design, but a descent's end meets every target and condition
-            t_sqp = time.perf_counter()
-            ends, spent["sqp_ends"] = self.polished(problem, None, ends)
-            spent["t_sqp"] = time.perf_counter() - t_sqp
+            ends, sqp = self.polished(problem, None, ends)
+            spent.update(sqp)
             stats = {**self._stats(problem, cands, plan), **spent}
             r = self.descended(problem, None, ends, guard, stats, polished=spent["sqp_ends"])
             if r is not None:
@@ -316,16 +314,17 @@ class Solver:
             return self._result(problem, best_first[0], None, claim, stats, local)
         raise AssertionError("best() of candidates without a certified one")
 
-    def polished(self, problem, r: Result | None, ends: list) -> tuple[list, int]:
+    def polished(self, problem, r: Result | None, ends: list) -> tuple[list, dict]:
         """Where the objective is a peak over the turn (``minimax.applies``): ``ends`` (``evolution.End``s, best
         first) with the ends of the SQP on the exact peak (``minimax.polish``) from the POLISHED best certified
-        designs (``r`` and its local optima) and from each of ``ends``, where it moves them; best first, and how
-        many were added. A Nelder-Mead descent stalls where peaks are equal, and a certified design
-        can be a point the SQP leaves (the crank-rocker slider by peak torque at TR 2.017, 1.9568 m: a descent's
-        end, 3,588.27 N m, goes to 3,514.80, docs/benchmarks.md). Only ends: a design is not moved, so what the
-        solve found stands (``descended`` takes the best)."""
+        designs (``r`` and its local optima) and from each of ``ends``, where it moves them; best first, and
+        {'sqp_ends': how many were added, 't_sqp': the time taken, s}. A Nelder-Mead descent stalls where peaks
+        are equal, and a certified design can be a point the SQP leaves (the crank-rocker slider by peak torque at
+        TR 2.017, 1.9568 m: a descent's end, 3,588.27 N m, goes to 3,514.80, docs/benchmarks.md). Only ends: a
+        design is not moved, so what the solve found stands (``descended`` takes the best)."""
+        t0 = time.perf_counter()
         if not minimax.applies(problem):
-            return ends, 0
+            return ends, {"sqp_ends": 0, "t_sqp": time.perf_counter() - t0}
         certified = [r, *(r.local_optima or ())[1:]][:POLISHED] if r is not None else []
         seeds = [{k: x.params[k] for k in problem.free} for x in certified] + [e.design for e in ends]
         added = []
@@ -333,7 +332,8 @@ class Solver:
             p = minimax.polish(problem, d)
             if p is not None and p.steps:
                 added.append(evolution.End(p.value, p.design, p.local))
-        return sorted([*ends, *added], key=lambda e: e.value), len(added)
+        spent = {"sqp_ends": len(added), "t_sqp": time.perf_counter() - t0}
+        return sorted([*ends, *added], key=lambda e: e.value), spent
 
     def descended(
         self, problem, r: Result | None, ends: list, how: str, stats: dict | None = None, polished: int = 0
