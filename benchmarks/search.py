@@ -15,13 +15,14 @@ For a task (TR, stroke) and a row of ``design`` (its problem ``type_problem(kind
    shapes.
 2. **Polish.** The ``polish`` designs within ``window`` of the TR that are best by the objective start local
    solves (the row's NLP, no closed forms, no Sobol points): each ends at an exact, certified design.
-3. **Multi-start.** The row's problem solved with ``starts`` Sobol starts (default: many times the default),
-   without the atlas that a default solve starts from.
+3. **Multi-start.** The row's problem solved with ``starts`` Sobol starts per two free parameters (a default
+   solve has 8), without the atlas that a default solve starts from.
 4. **Evolution** (``evolve`` generations, 0 for none; ``qropt.synthesis.evolution``, with more generations,
    seeds and designs than a solve's): differential evolution over the box, each candidate moved onto the TR by
    its crank length and scaled to the stroke, ranked by the exact objective. Its best distinct designs go two
    ways: a Nelder-Mead descent on the exact objective with every point put on the targets exactly, which needs
-   no NLP at all; and local solves of the row's NLP, as in 2.
+   no NLP at all (where the objective is a peak over the turn, the SQP on its exact extremes from each design and
+   each descent's end too, ``minimax.polish``); and local solves of the row's NLP, as in 2.
 
 The reference is the best design of 2, 3 and 4 (certified by the solver, or, for the descent, evaluated
 exactly on the targets); ``design``'s row misses when it is worse than the
@@ -42,7 +43,7 @@ from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle
 from qropt.kinematics.ops import NUMPY
 from qropt.mechanisms import REQUIRED
 from qropt.studies._design import TYPES, design, type_problem
-from qropt.synthesis import criteria, evolution
+from qropt.synthesis import criteria, evolution, minimax
 from qropt.synthesis.criteria import sense
 from qropt.synthesis.result import SOLUTION_PRESENT
 
@@ -165,17 +166,18 @@ DESCENT_EVALS = 1500  # exact evaluations of a descent
 
 
 def reference(
-    problem, n: int, seed: int, polish: int = 16, starts: int = 256, evolve_generations: int = 0, solver=None
+    problem, n: int, seed: int, polish: int = 16, starts: int = 64, evolve_generations: int = 0, solver=None
 ) -> dict:
-    """The best design of the polished shapes, a large multi-start and, with ``evolve_generations``, the
-    evolution's descents and solves (see the module docstring)."""
+    """The best design of the polished shapes, a multi-start of ``starts`` Sobol starts per two free parameters
+    and, with ``evolve_generations``, the evolution's descents and solves (see the module docstring)."""
     solver = solver or Solver(atlas=False)  # independent of the atlas, which a default solve starts from
     t0 = time.perf_counter()
     found, values, counted = shapes(problem, n, seed)
     t_shapes = time.perf_counter() - t0
     best = None  # (found by, the objective minimised, the objective, the design's parameters)
     polished = solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=found[:polish], diagnose=False)
-    multi = solver.solve(problem, starts_n=starts, use_analytic=False, seed=seed, diagnose=False)
+    n_starts = starts * max(1, len(problem.free) // 2)
+    multi = solver.solve(problem, starts_n=n_starts, use_analytic=False, seed=seed, diagnose=False)
     solves = [("shapes", polished), ("multistart", multi)]
     evolved, exact = {}, None
     if evolve_generations:
@@ -185,6 +187,9 @@ def reference(
         ]
         on = [x for d in kept if (x := evolution.on_targets(problem, d)) is not None]
         descents = [got for x in on if (got := evolution.descend(problem, x, DESCENT_EVALS))]
+        if minimax.applies(problem):  # a peak over the turn: the SQP on its exact extremes from both, as a solve's
+            ends = [p for x in on + [d for _, d in descents] if (p := minimax.polish(problem, x)) is not None]
+            descents += [(-sense(problem.objective) * p.value, p.design) for p in ends]
         solved = solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=kept, diagnose=False)
         solves.append(("evolution", solved))
         exact = min(descents, key=lambda t: t[0], default=None)
@@ -202,6 +207,7 @@ def reference(
         best = ("evolution, exact", exact[0], -sense(problem.objective) * exact[0], exact[1])
     return {
         "shapes": n,
+        "starts": n_starts,
         "valid": counted,
         "near_task": len(found),
         "best_grid": None if not values else values[0],
@@ -220,7 +226,7 @@ def compare(
     n: int,
     seed: int,
     types=None,
-    starts: int = 256,
+    starts: int = 64,
     evolve_generations: int = 0,
     **kw,
 ):
@@ -262,7 +268,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m benchmarks.search", description=__doc__.split("\n\n")[0])
     ap.add_argument("--tasks", type=int, default=4)
     ap.add_argument("--shapes", type=int, default=1_000_000)
-    ap.add_argument("--starts", type=int, default=256)
+    ap.add_argument("--starts", type=int, default=64, help="Sobol starts per two free parameters (a solve's: 8)")
     ap.add_argument("--objectives", nargs="+", default=["max_gamma_min", "min_peak_accel"])
     ap.add_argument("--types", nargs="+", default=None, help="rows of design() (default: every row)")
     ap.add_argument("--evolve", type=int, default=0, help="generations of the evolution (default: none)")

@@ -126,6 +126,31 @@ def test_the_evolution_options_are_true_or_false():
         Solver(evolution="no")
     with pytest.raises(ProblemError, match="sqp is True or False"):
         Solver(sqp=1)
+    for bad in (0, 1.5, True, "2"):
+        with pytest.raises(ProblemError, match="evolutions must be an integer >= 1"):
+            Solver(evolutions=bad)
+
+
+def test_more_evolutions_add_their_ends_to_the_first_ones(monkeypatch):
+    """``Solver(evolutions=2)`` runs the evolution from seeds 0 and 1: the first is the one evolution of a default
+    solve, so with no certified design (IPOPT gets no iteration) its best end is at least as good, and better
+    where the second seed's basin is; the claim names both seeds. Shortened (20 generations, 200 evaluations)."""
+    from qropt import Solver
+    from qropt.synthesis import multistart
+
+    monkeypatch.setattr(multistart, "EVOLUTION_GENERATIONS", 20)
+    monkeypatch.setattr(evolution, "DESCENT_EVALS", 200)
+    problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
+    kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}}
+    one = Solver(**kw).solve(problem, use_analytic=False, diagnose=False)
+    two = Solver(**kw, evolutions=2)
+    assert Solver(**two.options()).evolutions == 2  # the options rebuild an equal Solver (a worker's)
+    r = two.solve(problem, use_analytic=False, diagnose=False)
+    assert one.status == r.status == "feasible", (one.message, r.message)
+    assert "2 differential evolutions (seeds 0-1) of 20 generations" in r.certificate.global_claim
+    assert r.objective <= one.objective * (1 + 1e-12)
+    second = evolution.descended(problem, 20, 1)
+    assert r.objective <= second[0].value * (1 + 1e-12)
 
 
 def test_a_descents_end_stands_only_where_it_beats_every_certified_design():

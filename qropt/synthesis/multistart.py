@@ -141,13 +141,15 @@ class MultiStart:
         )
         return out, how, found
 
-    def evolved(self, problem, plan, targets, seed, max_rounds, designs, sqp=False) -> tuple[list, str, list]:
+    def evolved(
+        self, problem, plan, targets, seed, max_rounds, designs, sqp=False, count: int = 1
+    ) -> tuple[list, str, list]:
         """Where the guard applies (``guarded``): local solves from the ends of descents on the exact objective
-        from an evolution's designs (``evolution.descended``: EVOLUTION_GENERATIONS generations from ``seed``; sqp:
-        the SQP on the exact peak too).
+        from ``count`` evolutions' designs (``evolution.descended``: EVOLUTION_GENERATIONS generations each, from
+        seeds ``seed``, ``seed + 1``, ...; sqp: the SQP on the exact peak too).
         (candidates, the claim's words, the descents' distinct ends, ``evolution.End``s best first, which the
         solver compares with the certified designs, ``Solver.descended``; [], '' and [] where it does not apply;
-        the local solves start from the KEEP best.) Run
+        the local solves start from the KEEP best of each evolution.) Run
         whether or not the passes certify a design: of the 36 four-bar-driven rows of the benchmark's 12 tasks it
         made 7 better and gave 1 its only design (docs/benchmarks.md)."""
         c = criteria.of_problem(problem)
@@ -156,14 +158,19 @@ class MultiStart:
             return [], "", []
         if not evolution.applies(problem):
             return [], "", []
-        ends = evolution.descended(problem, EVOLUTION_GENERATIONS, seed, sqp=sqp)
-        runs = [("evolution", e.design) for e in ends[: evolution.KEEP]]  # the best distinct ends
+        each = [evolution.descended(problem, EVOLUTION_GENERATIONS, seed + i, sqp=sqp) for i in range(count)]
+        runs = [("evolution", e.design) for ends in each for e in ends[: evolution.KEEP]]  # the best distinct ends
         out = self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
+        which = (
+            "a differential evolution"
+            if count == 1
+            else f"{count} differential evolutions (seeds {seed}-{seed + count - 1})"
+        )
         how = (
-            f"{len(runs)} starts from descents on the exact objective after a differential evolution of "
+            f"{len(runs)} starts from descents on the exact objective after {which} of "
             f"{EVOLUTION_GENERATIONS} generations, {sum(x.ok for x in out)} certified"
         )
-        return out, how, ends
+        return out, how, sorted((e for ends in each for e in ends), key=lambda e: e.value)
 
     def wrapped(self, problem, cands, targets, max_rounds, designs) -> tuple[list, str]:
         """Each distinct certified design with an angle at an edge of a full-turn box (its width 2 pi), solved again

@@ -59,7 +59,9 @@ class Solver:
     (``qropt.synthesis.atlas``) from its designs first, and run the multi-start only where none certifies;
     evolution: where the objective names a transmission guard (the peak torque), descents on the exact objective
     from a differential evolution too (``MultiStart.evolved``, ``Solver.descended``: minutes of a four-bar-driven
-    design row, and better designs at some; False leaves them out); sqp: where the objective is a peak over the
+    design row, and better designs at some; False leaves them out); evolutions: how many independent evolutions
+    (seeds seed, seed + 1, ...; each about 35 s of a four-bar-driven row with its SQP): the basins they reach
+    differ from seed to seed, docs/benchmarks.md; sqp: where the objective is a peak over the
     turn, each design of the evolution and each Nelder-Mead end descended again by the SQP on the exact peak
     (``minimax.polish``: its ends first-order stationary; on the benchmark's 12 tasks it made 7 rows better and 10
     worse, docs/benchmarks.md, so it is off unless asked). Whatever ``sqp`` says, the SQP descends the best
@@ -80,6 +82,7 @@ class Solver:
         backend=None,
         atlas: bool = True,
         evolution: bool = True,
+        evolutions: int = 1,
         sqp: bool = False,
     ):
         tol = {**TOLERANCES, **(tolerances or {})}
@@ -90,6 +93,7 @@ class Solver:
             ("extra", extra, 1),
             ("starts_n", starts_n, 0),
             ("max_rounds", max_rounds, 1),
+            ("evolutions", evolutions, 1),
         ):
             if isinstance(v, bool) or not isinstance(v, int) or v < lo:
                 raise ProblemError(f"Solver: {name} must be an integer >= {lo}, got {v!r}")
@@ -102,7 +106,7 @@ class Solver:
         for name, v in (("atlas", atlas), ("evolution", evolution), ("sqp", sqp)):
             if not isinstance(v, bool):
                 raise ProblemError(f"Solver: {name} is True or False, got {v!r}")
-        self.atlas, self.evolution, self.sqp = atlas, evolution, sqp
+        self.atlas, self.evolution, self.evolutions, self.sqp = atlas, evolution, evolutions, sqp
         self.backend = backend or Ipopt(self.ipopt_options)
         self._formulations = Formulations(samples, extra)
         self.local_solve = LocalSolve(self._formulations, self.backend, tol, max_rounds)
@@ -127,6 +131,7 @@ class Solver:
             "max_rounds": self.max_rounds,
             "atlas": self.atlas,
             "evolution": self.evolution,
+            "evolutions": self.evolutions,
             "sqp": self.sqp,
         }
 
@@ -213,7 +218,7 @@ class Solver:
             evolved, how, ends = [], "", []
             if self.evolution:
                 evolved, how, ends = self.multistart.evolved(
-                    problem, plan, targets, seed, max_rounds, designs, self.sqp
+                    problem, plan, targets, seed, max_rounds, designs, self.sqp, self.evolutions
                 )
             if how:  # starts from descents on the exact objective too
                 more += evolved
