@@ -43,7 +43,8 @@ from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle
 from qropt.kinematics.ops import NUMPY
 from qropt.mechanisms import REQUIRED
 from qropt.studies._design import TYPES, design, type_problem
-from qropt.synthesis import criteria, evolution, minimax
+from qropt.synthesis import criteria, evolution
+from qropt.synthesis import starts as starts_
 from qropt.synthesis.criteria import sense
 from qropt.synthesis.result import SOLUTION_PRESENT
 
@@ -176,7 +177,7 @@ def reference(
     t_shapes = time.perf_counter() - t0
     best = None  # (found by, the objective minimised, the objective, the design's parameters)
     polished = solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=found[:polish], diagnose=False)
-    n_starts = starts * max(1, len(problem.free) // 2)
+    n_starts = starts_.grown(starts, problem, starts_.plan(problem, use_analytic=False))  # per two free parameters
     multi = solver.solve(problem, starts_n=n_starts, use_analytic=False, seed=seed, diagnose=False)
     solves = [("shapes", polished), ("multistart", multi)]
     evolved, exact = {}, None
@@ -185,14 +186,11 @@ def reference(
         kept = [
             d for s in range(EVOLVE_SEEDS) for d in evolution.evolve(problem, evolve_generations, seed + s, EVOLVE_KEEP)
         ]
-        on = [x for d in kept if (x := evolution.on_targets(problem, d)) is not None]
-        descents = [got for x in on if (got := evolution.descend(problem, x, DESCENT_EVALS))]
-        if minimax.applies(problem):  # a peak over the turn: the SQP on its exact extremes from both, as a solve's
-            ends = [p for x in on + [d for _, d in descents] if (p := minimax.polish(problem, x)) is not None]
-            descents += [(-sense(problem.objective) * p.value, p.design) for p in ends]
+        # each design descended on the targets; for a peak over the turn the SQP from it and its end too, as a solve's
+        ends = evolution.descents(problem, kept, DESCENT_EVALS, sqp=True)
         solved = solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=kept, diagnose=False)
         solves.append(("evolution", solved))
-        exact = min(descents, key=lambda t: t[0], default=None)
+        exact = (ends[0].value, ends[0].design) if ends else None
         evolved = {
             "evolved": len(kept),
             "descent": None if exact is None else -sense(problem.objective) * exact[0],

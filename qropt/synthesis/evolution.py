@@ -281,15 +281,20 @@ def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dic
 def descended(
     problem, generations: int, seed: int, keep: int = KEEP, evals: int | None = None, sqp: bool = False
 ) -> list[End]:
-    """The designs of an evolution, each put on the targets and descended by Nelder-Mead (``descend``, ``evals``
-    evaluations); with ``sqp``, where the objective is a peak over the turn, the SQP on its exact extremes
-    (``minimax.polish``) runs from the design and from Nelder-Mead's end too (the two often reach different
-    minima; the ends then kept where they differ, ``_apart``). The ends, best first."""
+    """The ``descents`` of an evolution's designs (``evolve``: ``generations`` from ``seed``, ``keep`` of them)."""
+    return descents(problem, evolve(problem, generations, seed, keep), evals, sqp)
+
+
+def descents(problem, designs: list[dict], evals: int | None = None, sqp: bool = False) -> list[End]:
+    """The designs, each put on the targets and descended by Nelder-Mead (``descend``, ``evals`` evaluations); with
+    ``sqp``, where the objective is a peak over the turn, the SQP on its exact extremes (``minimax.polish``) runs
+    from the design and from Nelder-Mead's end too (the two often reach different minima; the ends then kept where
+    they differ, ``_apart``). The ends, best first."""
     from qropt.synthesis import minimax  # it builds on this module
 
     ends: list[End] = []
     sqp = sqp and minimax.applies(problem)
-    for d in evolve(problem, generations, seed, keep):
+    for d in designs:
         on = on_targets(problem, d)
         if on is None:
             continue
@@ -306,4 +311,16 @@ def descended(
     return distinct
 
 
-__all__ = ["End", "applies", "evolve", "on_targets", "descend", "descended", "outside", "value", "CRANK", "WINDOW"]
+__all__ = [
+    "End",
+    "applies",
+    "evolve",
+    "on_targets",
+    "descend",
+    "descended",
+    "descents",
+    "outside",
+    "value",
+    "CRANK",
+    "WINDOW",
+]
