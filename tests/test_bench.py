@@ -60,3 +60,39 @@ def test_every_problem_declares_an_oracle():
         need = {"max_gamma_min", "min_size"} | (set() if t == "FourBar" else {"min_peak_accel"})
         assert need <= objectives, (t, objectives)
     assert set(METHODS) == {"qropt", "qropt-cold", "scipy-slsqp", "scipy-trust-constr", "scipy-de", "pylinkage"}
+
+
+def test_evolutions_summary_compares_each_row_with_the_default():
+    from benchmarks import evolutions
+
+    default = {
+        "tasks": [[1.5, 0.3], [2.0, 1.0]],
+        "results": {
+            "min_peak_torque": {
+                "types": {k: {"objective": [100.0, None], "median_s": 60.0, "worst_s": 90.0} for k in evolutions.TYPES}
+            }
+        },
+    }
+
+    def row(kind, i, obj, s):
+        tr, stroke = default["tasks"][i]
+        return {"k": 4, "i": i, "type": kind, "tr": tr, "stroke": stroke, "status": "optimal", "obj": obj, "s": s}
+
+    coupler, rocker, drag = evolutions.TYPES
+    found = [
+        row(coupler, 0, 99.0, 100.0),  # better
+        row(rocker, 0, 100.00001, 120.0),  # the same (1e-7)
+        row(drag, 0, 101.0, 140.0),  # worse
+        row(coupler, 1, 50.0, 200.0),  # a design where the default had none
+    ]
+    s = evolutions.summary(found, default)
+    assert s["counts"] == {"better": 2, "worse": 1, "same": 1}
+    assert [r["change"] for r in s["rows"]] == ["better", "same", "worse", "better"]
+    assert s["times"][coupler] == {
+        "median_s": 150.0,
+        "worst_s": 200.0,
+        "before_median_s": 60.0,
+        "before_worst_s": 90.0,
+    }
+    md = evolutions.markdown(s)
+    assert "2 better, 1 worse, 1 the same" in md and "| none | 50 (better) |" in md

@@ -127,7 +127,7 @@ def test_the_evolution_options_are_true_or_false():
     with pytest.raises(ProblemError, match="sqp is True or False"):
         Solver(sqp=1)
     for bad in (0, 1.5, True, "2"):
-        with pytest.raises(ProblemError, match="evolutions must be an integer >= 1"):
+        with pytest.raises(ProblemError, match=r"evolutions is None \(by the problem\) or an integer >= 1"):
             Solver(evolutions=bad)
 
 
@@ -151,6 +151,29 @@ def test_more_evolutions_add_their_ends_to_the_first_ones(monkeypatch):
     assert r.objective <= one.objective * (1 + 1e-12)
     second = evolution.descended(problem, 20, 1)
     assert r.objective <= second[0].value * (1 + 1e-12)
+
+
+def test_the_four_bar_driven_rows_run_four_evolutions_by_default(monkeypatch):
+    """``Solver()`` (evolutions None) runs ``evolution.count`` evolutions: four for the rows of seven and eight free
+    parameters, one for the others; a default solve's claim names the four seeds, an explicit count overrides it.
+    Shortened (5 generations, 50 evaluations a descent, IPOPT given no iteration, no SQP)."""
+    from qropt import Solver
+    from qropt.studies._design import TYPES
+    from qropt.synthesis import minimax, multistart
+
+    counts = {k: evolution.count(type_problem(k, 1.6, 0.3, **KW)) for k in TYPES}
+    assert counts == {k: 4 if k in ("crank-rocker-slider", "drag-link-slider", "coupler-slider") else 1 for k in TYPES}
+    monkeypatch.setattr(multistart, "EVOLUTION_GENERATIONS", 5)
+    monkeypatch.setattr(evolution, "DESCENT_EVALS", 50)
+    monkeypatch.setattr(minimax, "polish", lambda problem, design, steps=0: None)
+    problem = type_problem("crank-rocker-slider", 1.6, 0.3, **KW)
+    kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}}
+    assert Solver(**kw).evolutions is None and Solver(**kw).evolutions_of(problem) == 4
+    assert Solver(**Solver(**kw).options()).evolutions is None  # a worker's Solver decides the same way
+    r = Solver(**kw).solve(problem, use_analytic=False, diagnose=False)
+    assert "4 differential evolutions (seeds 0-3) of 5 generations" in r.certificate.global_claim, r.message
+    r = Solver(**kw, evolutions=1).solve(problem, use_analytic=False, diagnose=False)
+    assert "after a differential evolution of 5 generations" in r.certificate.global_claim, r.message
 
 
 def test_a_descents_end_stands_only_where_it_beats_every_certified_design():

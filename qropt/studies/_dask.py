@@ -1,11 +1,12 @@
 """The executors of a design chart's tiles: in this process, or on a Dask cluster.
 
-``'local'`` starts a ``dask.distributed.LocalCluster`` for the chart's duration (at most MAX_WORKERS_PER_CPU
-worker processes per CPU); any other string is the address of a running scheduler (``dask scheduler`` and
-``dask worker ADDRESS`` on the machines, or a dask-jobqueue cluster's ``scheduler_address``), which must answer
-within CONNECT_TIMEOUT seconds. A tile travels as plain numbers to ``worker_tile`` (pickled by reference: it
-stays importable as ``qropt.studies._dask.worker_tile``), which builds its Solver once per worker process (IPOPT
-is not thread-safe: one thread per worker process). Dask is imported only when a cluster is used.
+``'local'`` starts a ``dask.distributed.LocalCluster`` for the chart's duration (at most
+``_workers.MAX_WORKERS_PER_CPU`` worker processes per CPU); any other string is the address of a running
+scheduler (``dask scheduler`` and ``dask worker ADDRESS`` on the machines, or a dask-jobqueue cluster's
+``scheduler_address``), which must answer within CONNECT_TIMEOUT seconds. A tile travels as plain numbers to
+``worker_tile`` (pickled by reference: it stays importable as ``qropt.studies._dask.worker_tile``), which builds
+its Solver once per worker process (IPOPT is not thread-safe: one thread per worker process). Dask is imported
+only when a cluster is used.
 """
 
 from __future__ import annotations
@@ -14,10 +15,10 @@ import contextlib
 import logging
 import os
 
-from qropt.errors import ChartError, QroptError
+from qropt.errors import ChartError, ProblemError, QroptError
+from qropt.studies import _workers
 from qropt.studies._chart import Cell
 from qropt.studies._continuation import solve_tile
-from qropt.studies._workers import MAX_WORKERS_PER_CPU, max_workers
 
 CONNECT_TIMEOUT = 5  # s
 # Dask's workers return freed memory to the system at once (MALLOC_TRIM_THRESHOLD_=65536); a solve allocates
@@ -27,15 +28,12 @@ LOCAL_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": No
 
 
 def check_workers(workers: int) -> int:
-    """``workers`` for a local cluster, or ChartError when this machine cannot sensibly run that many."""
-    limit = max_workers()
-    if workers > limit:
-        raise ChartError(
-            f"workers = {workers:,} is more than the {limit} worker processes a local cluster may start "
-            f"here ({MAX_WORKERS_PER_CPU} per CPU, {os.cpu_count() or 1} CPUs); use a Dask cluster "
-            "(scheduler='tcp://...') for more"
-        )
-    return workers
+    """``workers`` for a local cluster (``_workers.check_workers``'s rule), or ChartError naming a Dask cluster
+    for more."""
+    try:
+        return _workers.check_workers(workers)
+    except ProblemError as e:
+        raise ChartError(f"{e}; use a Dask cluster (scheduler='tcp://...') for more") from None
 
 
 def run_here(specs: list, solver, progress) -> list:
@@ -137,4 +135,4 @@ def _size(spec) -> int:
     return (i1 - i0) * (j1 - j0)
 
 
-__all__ = ["run_here", "run_dask", "worker_tile", "max_workers"]
+__all__ = ["run_here", "run_dask", "worker_tile", "check_workers"]

@@ -44,6 +44,15 @@ INFEASIBLE = 1e12  # the value of a candidate off the targets (plus how far off)
 SECANT_STEP, SECANT_STEPS, SECANT_TOL = 1e-4, 8, 1e-14  # ``on_targets``'s secant steps: first step (relative),
 SECANT_REACH = 0.05  # most steps, |log TR ratio| that ends them, and how far (relative) they may take the crank
 DESCENT_LOCAL = "none: the end of a Nelder-Mead descent on the exact objective, every point on the targets"
+MANY_FREE, MANY = 7, 4  # a problem with this many free parameters or more runs MANY evolutions by default (``count``)
+
+
+def count(problem) -> int:
+    """The evolutions a solve runs by default: MANY where the problem has MANY_FREE free parameters or more (the
+    four-bar-driven rows), else one. Measured by peak torque on the 36 four-bar-driven rows of the benchmark's 12
+    tasks: four evolutions made 8 rows better by 0.2-5.6 %, none worse, in 2.1-2.4 times a row's time; the rows of
+    three and five free parameters met the independent search with one (docs/benchmarks.md)."""
+    return MANY if len(problem.free) >= MANY_FREE else 1
 
 
 @dataclass(frozen=True)
@@ -314,6 +323,7 @@ def descents(problem, designs: list[dict], evals: int | None = None, sqp: bool =
 __all__ = [
     "End",
     "applies",
+    "count",
     "evolve",
     "on_targets",
     "descend",

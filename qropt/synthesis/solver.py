@@ -61,7 +61,8 @@ class Solver:
     from a differential evolution too (``MultiStart.evolved``, ``Solver.descended``: minutes of a four-bar-driven
     design row, and better designs at some; False leaves them out); evolutions: how many independent evolutions
     (seeds seed, seed + 1, ...; each about 35 s of a four-bar-driven row with its SQP): the basins they reach
-    differ from seed to seed, docs/benchmarks.md; sqp: where the objective is a peak over the
+    differ from seed to seed; None: four where the problem has seven free parameters or more, else one
+    (``evolution.count``, measured in docs/benchmarks.md); sqp: where the objective is a peak over the
     turn, each design of the evolution and each Nelder-Mead end descended again by the SQP on the exact peak
     (``minimax.polish``: its ends first-order stationary; on the benchmark's 12 tasks it made 7 rows better and 10
     worse, docs/benchmarks.md, so it is off unless asked). Whatever ``sqp`` says, the SQP descends the best
@@ -82,7 +83,7 @@ class Solver:
         backend=None,
         atlas: bool = True,
         evolution: bool = True,
-        evolutions: int = 1,
+        evolutions: int | None = None,
         sqp: bool = False,
     ):
         tol = {**TOLERANCES, **(tolerances or {})}
@@ -93,10 +94,13 @@ class Solver:
             ("extra", extra, 1),
             ("starts_n", starts_n, 0),
             ("max_rounds", max_rounds, 1),
-            ("evolutions", evolutions, 1),
         ):
             if isinstance(v, bool) or not isinstance(v, int) or v < lo:
                 raise ProblemError(f"Solver: {name} must be an integer >= {lo}, got {v!r}")
+        if evolutions is not None and (
+            isinstance(evolutions, bool) or not isinstance(evolutions, int) or evolutions < 1
+        ):
+            raise ProblemError(f"Solver: evolutions is None (by the problem) or an integer >= 1, got {evolutions!r}")
         if ipopt_options is not None and not isinstance(ipopt_options, dict):
             raise ProblemError(f"Solver: ipopt_options must be a dict, got {ipopt_options!r}")
         if backend is not None and not callable(getattr(backend, "run", None)):
@@ -134,6 +138,10 @@ class Solver:
             "evolutions": self.evolutions,
             "sqp": self.sqp,
         }
+
+    def evolutions_of(self, problem: Problem) -> int:
+        """The evolutions a solve of ``problem`` runs where they apply: the Solver's, else ``evolution.count``."""
+        return self.evolutions if self.evolutions is not None else evolution.count(problem)
 
     # ---- formulations ----------------------------------------------------------------------------
     def formulation(self, problem: Problem, branch: dict, orientation: int, range_target=None, sense=1) -> Formulation:
@@ -218,7 +226,7 @@ class Solver:
             evolved, how, ends = [], "", []
             if self.evolution:
                 evolved, how, ends = self.multistart.evolved(
-                    problem, plan, targets, seed, max_rounds, designs, self.sqp, self.evolutions
+                    problem, plan, targets, seed, max_rounds, designs, self.sqp, self.evolutions_of(problem)
                 )
             if how:  # starts from descents on the exact objective too
                 more += evolved
