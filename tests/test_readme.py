@@ -50,15 +50,30 @@ def background_commands() -> list[str]:
     return [re.sub(r"\s*&\s*(#.*)?$", "", line) for line in lines if re.search(r"&\s*(#.*)?$", line)]
 
 
+def free_port() -> int:
+    """A TCP port that nothing on this machine listens on now (the system's choice)."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def on_port(command: str, port: str, free: int) -> str:
+    """The command with the page's port ``port`` (in --port N and host:N) replaced by ``free``."""
+    return re.sub(rf"(--port |:){port}\b", rf"\g<1>{free}", command)
+
+
 @contextlib.contextmanager
 def services(cwd, address):
     """The README's background lines running (in their own process groups) until the scheduler at ``address``
-    (tcp://host:port) answers and has workers; stopped afterwards."""
+    (tcp://host:port, the pages' port replaced by the caller with a free one) answers and has workers; stopped
+    afterwards."""
     bindir = Path(shutil.which("qropt")).parent
     env = {**os.environ, "PATH": f"{bindir}{os.pathsep}{os.environ['PATH']}"}
+    host, port = address.removeprefix("tcp://").split(":")
+    page_port = re.search(r"--port (\d+)", " ".join(background_commands())).group(1)
     procs = [
         subprocess.Popen(
-            c,
+            on_port(c, page_port, int(port)),
             shell=True,
             cwd=cwd,
             env=env,
@@ -69,7 +84,6 @@ def services(cwd, address):
         for c in background_commands()
     ]
     try:
-        host, port = address.removeprefix("tcp://").split(":")
         for _ in range(120):
             with contextlib.suppress(OSError), socket.create_connection((host, int(port)), timeout=1):
                 break
@@ -112,9 +126,12 @@ def test_readme_command_runs(command, workdir):
     shell = command.replace("qropt ", f"{shlex.quote(exe)} ") if command != "qropt" else exe
     if command.startswith("qropt bench"):
         pytest.skip("the benchmark suite runs from the repository root and takes minutes")
-    if command.startswith("qropt app"):
-        return _serves(shell, workdir)
-    address = re.search(r"--scheduler (tcp://\S+)", command)
+    if command.startswith("qropt app"):  # on a port the system picks (it prints the address)
+        return _serves(re.sub(r"--port \d+", "--port 0", shell), workdir)
+    address = re.search(r"--scheduler tcp://\S+:(\d+)", command)
+    if address:  # the scheduler on a free port, not the page's
+        shell = on_port(shell, address.group(1), free_port())
+        address = re.search(r"--scheduler (tcp://\S+)", shell)
     with services(workdir, address.group(1)) if address else contextlib.nullcontext():
         r = subprocess.run(shell, shell=True, cwd=workdir, capture_output=True, text=True, timeout=240)
     assert r.returncode == 0, (command, r.stdout[-2000:], r.stderr[-2000:])

@@ -260,7 +260,7 @@ def test_cli_units_and_bad_input(capsys):
     code, _, err = cli(["tolerance", "--limit", "time_ratio=0.01", "--params", "r1,sigma"], capsys)
     assert code == 1 and "branch signs have no tolerance" in err
     code, _, err = cli(["tolerance", "missing.json", "--limit", "time_ratio=0.01"], capsys)
-    assert code == 1 and "not a JSON design" in err
+    assert code == 1 and "no design file missing.json" in err
     code, _, err = cli(["tolerance", "--limit", "speed=1"], capsys)
     assert code == 2 and "not a limit: 'speed=1'" in err and err.count("\n") == 1
 

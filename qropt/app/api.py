@@ -15,6 +15,7 @@ from numbers import Real
 import numpy as np
 
 from qropt import units as units_
+from qropt import validate
 from qropt.errors import QroptError
 from qropt.io import records
 from qropt.mechanisms import REGISTRY, Mechanism, mechanism_type, type_reference
@@ -50,9 +51,24 @@ def number(d: dict, key: str, default=None, *, low=-math.inf, high=math.inf) -> 
     v = d.get(key, default)
     if isinstance(v, bool) or not isinstance(v, Real) or not math.isfinite(v):
         raise ApiError(f"{key} is a finite number, got {v!r:.60}")
-    if not low <= v <= high:
-        raise ApiError(f"{key} must lie in [{low:g}, {high:g}], got {v:g}")
-    return float(v)
+    return validate.within(key, v, low, high, error=ApiError)
+
+
+def flag(d: dict, key: str, default: bool) -> bool:
+    """A true-or-false field."""
+    return validate.flag(key, d.get(key, default), error=ApiError)
+
+
+def report_input(payload) -> dict:
+    """A report job's input ``{type, params, units?, theta2?, omega2?}`` (rad, rad/s), checked whole."""
+    d = fields(payload, ("type", "params"), ("units", "theta2", "omega2"))
+    mechanism(d)
+    out = dict(
+        d, theta2=number(d, "theta2", 0.0, low=-1e6, high=1e6), omega2=number(d, "omega2", 1.0, low=-1e4, high=1e4)
+    )
+    if out["omega2"] == 0.0:
+        raise ApiError("omega2 must be nonzero (rad/s; its sign is the crank's sense of rotation)")
+    return out
 
 
 def known_type(name) -> type[Mechanism]:
@@ -131,6 +147,7 @@ def analyze(payload) -> dict:
         raise ApiError(f"frames is an integer from 0 to {MAX_FRAMES}, got {frames!r:.40}")
     if omega2 == 0.0:
         raise ApiError("omega2 must be nonzero (rad/s; its sign is the crank's sense of rotation)")
+    show_polygons, extremes = flag(d, "polygons", True), flag(d, "extremes", True)
     m = mechanism(d)
     out = records.analysis(m, theta2, omega2, alpha2)
     peak = m.peak_acceleration(omega2)
@@ -147,12 +164,9 @@ def analyze(payload) -> dict:
         "working": working(th, start, length),
     }
     out["drawing"] = drawing(m, theta2, frames, start, length)
-    if d.get("polygons", True):
+    if show_polygons:
         out["polygons"] = polygons(m, theta2, omega2, alpha2)
     if d.get("masses") is not None:
-        extremes = d.get("extremes", True)
-        if not isinstance(extremes, bool):
-            raise ApiError(f"extremes is true or false, got {extremes!r:.40}")
         out["dynamics"] = forces(m, theta2, omega2, alpha2, d["masses"], d.get("loads"), extremes)
     return out
 

@@ -87,23 +87,22 @@ def _pareto(payload: dict, progress) -> dict:
 
 def _report(payload: dict, progress) -> dict:
     """``{type, params, units?, theta2?, omega2?}``: the design's HTML report (``report.design_page``)."""
-    from qropt.app.api import mechanism, number
+    from qropt.app.api import mechanism, report_input
     from qropt.io.report import design_page
 
-    m = mechanism(payload)
-    return {"html": design_page(m, number(payload, "theta2", 0.0), number(payload, "omega2", 1.0))}
+    d = report_input(payload)
+    return {"html": design_page(mechanism(d), d["theta2"], d["omega2"])}
 
 
 WORK = {"solve": _solve, "design": _design, "pareto": _pareto, "report": _report}  # kind -> what a worker runs
 
 
 def _child(conn, files) -> None:  # pragma: no cover - runs in the worker process
+    from qropt.cli import load_problem
     from qropt.errors import QroptError
 
     for f in files:
-        from qropt.app.server import load_file
-
-        load_file(f)
+        load_problem(f)
     while True:
         try:
             job = conn.recv()

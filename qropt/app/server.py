@@ -20,10 +20,13 @@ import tempfile
 from importlib import resources
 from pathlib import Path
 
+from qropt import validate
 from qropt.app import api
 from qropt.app.defaults import remember
 from qropt.app.jobs import Busy, Jobs
+from qropt.dynamics.model import Loads, Masses
 from qropt.errors import QroptError
+from qropt.studies._design import task_problems
 
 MAX_BODY = 1 << 20  # bytes of a request body
 STATIC = {"": ("index.html", "text/html"), "app.js": ("app.js", "text/javascript"), "app.css": ("app.css", "text/css")}
@@ -80,6 +83,11 @@ def _design_input(payload) -> dict:
             out[k] = d[k]
     if "bounds" in out:
         out["bounds"] = {k: tuple(v) if isinstance(v, list) else v for k, v in out["bounds"].items()}
+    task_problems(  # every argument checked here, before a job is queued
+        **{k: v for k, v in out.items() if k not in ("masses", "loads")},
+        masses=Masses.from_dict(out["masses"]) if "masses" in out else None,
+        loads=Loads.from_dict(out["loads"]) if "loads" in out else None,
+    )
     return out
 
 
@@ -104,10 +112,7 @@ def create_app(files=(), workers: int = 1, queue_size: int = 8, time_limit: floa
     app.extensions["qropt_jobs"] = jobs
 
     def body():
-        data = request.get_json(silent=True, force=True)
-        if data is None:
-            raise api.ApiError("the request body is not JSON")
-        return data
+        return validate.json_document(request.get_data(cache=True), "the request body", error=api.ApiError)
 
     @app.errorhandler(api.ApiError)
     def _api_error(e):
@@ -203,7 +208,7 @@ def create_app(files=(), workers: int = 1, queue_size: int = 8, time_limit: floa
                 raise api.ApiError(f"n (points of the front) is an integer from 2 to 50, got {n!r:.20}")
             payload = {"problem": prob.to_dict(), "objectives": p["objectives"], "n": n}
         elif kind == "report":
-            api.mechanism(api.fields(payload, ("type", "params"), ("units", "theta2", "omega2")))
+            payload = api.report_input(payload)
         else:
             raise api.ApiError(f"kind is solve, design, pareto or report, got {kind!r:.40}")
         return jsonify(submit_job(kind, payload).to_dict()), 202

@@ -638,22 +638,20 @@ def load_problem(path: str):
 
     from qropt.errors import ProblemError
     from qropt.synthesis.problem import Problem
+    from qropt.validate import read_text
 
     file = Path(path)
-    if not file.is_file():
+    if not file.exists():
         raise CliError(f"no problem file {path!r}")
+    if file.suffix not in (".toml", ".json", ".py"):
+        raise CliError(f"{path}: a problem file is .py (with build()), .toml or .json")
+    text = read_text(file, "problem file", error=ProblemError)
     if file.suffix in (".toml", ".json"):
         _importable(file)  # a type of one's own named "module:Class" may sit beside the file
-        try:
-            text = file.read_text()
-        except (OSError, UnicodeDecodeError) as e:
-            raise CliError(f"cannot read {path}: {e}") from None
         try:
             return Problem.from_toml(text) if file.suffix == ".toml" else Problem.from_json(text)
         except ProblemError as e:
             raise ProblemError(f"{path}: {e}") from None
-    if file.suffix != ".py":
-        raise CliError(f"{path}: a problem file is .py (with build()), .toml or .json")
     _importable(file)
     name = _module_name(file)
     spec = importlib.util.spec_from_file_location(name, file)

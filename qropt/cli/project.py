@@ -43,6 +43,8 @@ def _targets(args) -> list[tuple[int, Path]]:
 
     if args.seed < 0:
         raise CliError(f"--seed must be >= 0, got {args.seed}")
+    if args.output is not None and not args.output.strip():
+        raise CliError("-o: the output path is empty")
     if args.count is None:
         path = args.output or ("solution.html" if args.solution else "project.html")
         return [(args.seed, report_path(path))]

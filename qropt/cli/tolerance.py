@@ -11,7 +11,7 @@ from pathlib import Path
 
 from qropt import units as units_
 from qropt.convex.tolerance import QUANTITIES, allocate
-from qropt.errors import InvalidParameter, QroptError
+from qropt.errors import InvalidParameter
 from qropt.mechanisms import REGISTRY, mechanism_type, type_reference
 
 COMMAND = "tolerance"
@@ -106,21 +106,13 @@ def design_from(args):
         from qropt.examples import paper_mechanism
 
         declared, m, where = PAPER_UNIT, paper_mechanism(), "the paper's mechanism"
-    elif args.target.endswith(".json") or Path(args.target).is_file():
-        from qropt.io.export import declared_unit
+    elif args.target.endswith(".json") or (Path(args.target).exists() and not Path(args.target).is_dir()):
+        from qropt.io.export import declared_unit, read_design
 
-        try:
-            d = json.loads(Path(args.target).read_text())
-            kind, params = d["type"], {**d["params"], **given}
-            declared = declared_unit(d)
-        except (OSError, ValueError, KeyError, TypeError, AttributeError, RecursionError) as e:
-            why = "nested too deeply" if isinstance(e, RecursionError) else e
-            raise InvalidParameter(f"{args.target}: not a JSON design with 'type' and 'params' ({why})") from None
-        except QroptError as e:
-            raise InvalidParameter(f"{args.target}: {e}") from None
-        if not isinstance(kind, str) or not isinstance(params, dict):
-            raise InvalidParameter(f"{args.target}: not a JSON design with 'type' and 'params'")
-        m, where = mechanism_type(kind)(**params, units=declared or override or units_.DEFAULT), args.target
+        d = read_design(args.target)
+        declared = declared_unit(d)
+        params = {**d["params"], **given}
+        m, where = mechanism_type(d["type"])(**params, units=declared or override or units_.DEFAULT), args.target
     else:
         return mechanism_type(args.target)(**given, units=override or units_.DEFAULT), override
     if declared is not None and override is not None and override != declared:

@@ -31,12 +31,12 @@ from qropt.errors import InvalidParameter
 from qropt.io.paths import picture_path
 from qropt.mechanisms import Mechanism
 from qropt.units import to_metres
+from qropt.validate import MAGNITUDE, number
 
 OBJECTIVES = ("min_cycle_time", "min_return_time")
 MIN_CELLS, MAX_CELLS = 36, 100_000
 BINDING_TOL = 1e-6  # a phase-one slack or dual above this (relative) names a limit as binding
 SQUARED = ("omega_max", "v_max", "v_cut")  # limits stated on squares in b
-MAGNITUDE = 1e100  # limits beyond this (or positive ones below its inverse) overflow the program's coefficients
 BADLY_SCALED = 1e8  # a row coefficient above this: the limit allows changes of b below 1e-8 of omega_max^2
 
 
@@ -261,17 +261,13 @@ def in_metres(m: Mechanism) -> Mechanism:
 
 
 def _limit(name, value, *, required=False, zero_ok=False):
+    """A servo limit: None (no limit) or a finite number > 0 (>= 0 with ``zero_ok``) in [1e-100, 1e100]."""
     if value is None:
         if required:
             raise InvalidParameter(f"{name} is required")
         return None
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InvalidParameter(f"{name} must be a number, got {value!r}")
-    try:
-        v = float(value)
-    except OverflowError:
-        v = math.inf
-    if not math.isfinite(v) or v < 0 or (v == 0 and not zero_ok):
+    v = number(name, value, limit=math.inf)
+    if v < 0 or (v == 0 and not zero_ok):
         raise InvalidParameter(f"{name} must be {'>= 0' if zero_ok else 'positive'} and finite, got {v:g}")
     if v > MAGNITUDE or 0 < v < 1 / MAGNITUDE:
         raise InvalidParameter(

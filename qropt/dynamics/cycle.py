@@ -19,6 +19,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from qropt.dynamics.inverse import _solve, system_of
 from qropt.dynamics.model import Loads, Masses
+from qropt.validate import LIMIT, number
 
 GRID = 720  # crank angles of the search grid
 GAUSS = 48  # Gauss-Legendre nodes per piece of a stroke
@@ -71,10 +72,9 @@ class CycleDynamics:
     def __init__(self, m, omega2: float, alpha2: float = 0.0, masses=None, loads=None):
         from qropt.dynamics.inverse import _has_load
         from qropt.errors import InvalidParameter
-        from qropt.mechanisms.base import _finite
 
         self.m = m
-        self.omega2, self.alpha2 = _finite("omega2", omega2), _finite("alpha2", alpha2)
+        self.omega2, self.alpha2 = number("omega2", omega2, limit=LIMIT), number("alpha2", alpha2, limit=LIMIT)
         self.loads = Loads() if loads is None else loads
         if not isinstance(self.loads, Loads):
             raise InvalidParameter(f"loads is a qropt.Loads, got {type(self.loads).__name__}")

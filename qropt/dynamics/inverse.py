@@ -26,6 +26,7 @@ from qropt.dynamics.model import BodyMass, Loads, Masses, slender_bar, union
 from qropt.dynamics.rigid import body_motion
 from qropt.errors import DegenerateMechanism, InvalidParameter, SlideLocked
 from qropt.kinematics.ops import JET, Jet
+from qropt.validate import LIMIT, number
 
 LENGTH_GRID = 720  # crank angles where a lever's reach is sampled before its exact maximum is refined
 
@@ -347,13 +348,11 @@ class _System:
 
 def inverse_dynamics(m, theta2, omega2: float = 1.0, alpha2: float = 0.0, *, masses=None, loads=None) -> Dynamics:
     """Inverse dynamics of ``m`` at crank angles theta2 (rad); see ``Dynamics``."""
-    from qropt.mechanisms.base import _finite
-
     masses = Masses() if masses is None else masses
     loads = Loads() if loads is None else loads
     if not isinstance(loads, Loads):
         raise InvalidParameter(f"loads is a qropt.Loads, got {type(loads).__name__}")
-    omega2, alpha2 = _finite("omega2", omega2), _finite("alpha2", alpha2)
+    omega2, alpha2 = number("omega2", omega2, limit=LIMIT), number("alpha2", alpha2, limit=LIMIT)
     if omega2 == 0.0 and (_has_load(loads)):
         raise InvalidParameter("omega2 must be nonzero with a cutting force or friction: they resist the motion")
     t = m._angles(theta2)

@@ -13,25 +13,20 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qropt.errors import InvalidParameter
-
-LIMIT = 1e12  # largest |value| of a mass, force, torque, speed or inertia the dynamics takes
+from qropt.validate import LIMIT, number
 
 
 def _real(what, v, *, positive=False, nonneg=False, nonzero=False, allow_inf=False) -> float:
     """A finite number (|value| <= LIMIT; +inf too if ``allow_inf``), or InvalidParameter naming ``what``."""
-    ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
-    if ok:
-        v = float(v)
-        ok = (allow_inf and v == math.inf) or (math.isfinite(v) and abs(v) <= LIMIT)
-    if not ok:
-        raise InvalidParameter(f"{what} must be a finite number (|value| <= 1e12), got {v!r}")
+    if not (allow_inf and isinstance(v, (int, float, np.integer, np.floating)) and v == math.inf):
+        v = number(what, v, limit=LIMIT)
     if positive and v <= 0:
         raise InvalidParameter(f"{what} must be positive, got {v:g}")
     if nonneg and v < 0:
         raise InvalidParameter(f"{what} must be zero or positive, got {v:g}")
     if nonzero and v == 0:
         raise InvalidParameter(f"{what} must be nonzero (its sign is the sense of rotation), got 0")
-    return v
+    return float(v)
 
 
 @dataclass(frozen=True)
@@ -131,8 +126,14 @@ class Masses:
         object.__setattr__(self, "bodies", bodies)
         cw = self.counterweight
         if cw is not None and not isinstance(cw, Counterweight):
-            if not isinstance(cw, dict) or set(cw) - {"mass", "radius", "angle", "free"}:
-                raise InvalidParameter(f"counterweight is a Counterweight or {{mass, radius, angle, free}}, got {cw!r}")
+            if (
+                not isinstance(cw, dict)
+                or set(cw) - {"mass", "radius", "angle", "free"}
+                or {"mass", "radius"} - set(cw)
+            ):
+                raise InvalidParameter(
+                    f"counterweight is a Counterweight or {{mass, radius, angle?, free?}} (kg, m, rad), got {cw!r:.120}"
+                )
             object.__setattr__(self, "counterweight", Counterweight(**cw))
 
     @classmethod

@@ -12,11 +12,10 @@ from __future__ import annotations
 
 import json
 import math
-import os
-from pathlib import Path
 from xml.sax.saxutils import escape
 
 from qropt import units as units_
+from qropt import validate
 from qropt.errors import InvalidParameter, QroptError
 from qropt.io import drawing
 from qropt.io.paths import output_path
@@ -177,31 +176,29 @@ def save_design(m: Mechanism, path, **extra) -> None:
     _write(p, lambda q: q.write_text(text))
 
 
-def load_design(path) -> Mechanism:
-    """The mechanism of a design file (``save_design``, or the JSON of ``qropt synth/analyze --json``) in the unit
-    the file states (the default unit, ``qropt.units.DEFAULT``, for a file that states none)."""
-    if isinstance(path, bytes) or not isinstance(path, (str, os.PathLike)):
-        raise InvalidParameter(f"a design file path is a str or path-like, got {path!r}")
-    p = Path(path)
-    try:
-        d = json.loads(p.read_text())
-    except FileNotFoundError:
-        raise InvalidParameter(f"no design file {path}") from None
-    except RecursionError:
-        raise InvalidParameter(f"{path} is not a JSON design: it is nested too deeply") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise InvalidParameter(f"{path} is not a JSON design: {e}") from None
+def read_design(path) -> dict:
+    """The table of a design file (``save_design``, or the JSON of ``qropt synth/analyze --json``): a JSON object
+    with a type name under 'type' and a table under 'params'. InvalidParameter naming the file for a path that is
+    not a regular file of at most ``qropt.validate.MAX_FILE`` bytes, or text that is not such a table."""
+    d = validate.json_document(validate.read_text(path, "design file"), str(path), "design")
     if not isinstance(d, dict) or not isinstance(d.get("params"), dict) or not d.get("type"):
         raise InvalidParameter(f"{path}: a design file has 'type' and 'params'")
     if not isinstance(d["type"], str):
         raise InvalidParameter(f"{path}: the design's 'type' is a type name, got {d['type']!r:.80}")
+    return d
+
+
+def load_design(path) -> Mechanism:
+    """The mechanism of a design file (``read_design``) in the unit the file states (the default unit,
+    ``qropt.units.DEFAULT``, for a file that states none)."""
+    d = read_design(path)
     try:
         unit = declared_unit(d) or units_.DEFAULT
         return mechanism_type(d["type"])(**d["params"], units=unit)
     except QroptError as e:
         raise InvalidParameter(f"{path}: {e}") from None
-    except (TypeError, RecursionError) as e:
+    except TypeError as e:
         raise InvalidParameter(f"{path}: {type(e).__name__}: {e}") from None
 
 
-__all__ = ["LAYERS", "geometry", "to_dxf", "to_svg", "save_design", "load_design", "declared_unit"]
+__all__ = ["LAYERS", "geometry", "to_dxf", "to_svg", "save_design", "read_design", "load_design", "declared_unit"]

@@ -14,6 +14,8 @@ def output_path(path, suffixes, what: str) -> Path:
     can be written (and, if the file exists, a file that can be overwritten)."""
     if isinstance(path, bytes) or not isinstance(path, (str, os.PathLike)):
         raise InvalidParameter(f"the {what} path must be a str or path-like, got {path!r}")
+    if not os.fspath(path).strip():
+        raise InvalidParameter(f"the {what} path is empty")
     p = Path(path)
     if p.is_dir():
         raise InvalidParameter(f"{path}: is a directory, not a {what} file")

@@ -8,6 +8,7 @@ closure has a real solution, < 0 where it cannot assemble.
 from __future__ import annotations
 
 import math
+from typing import Any, NamedTuple
 
 
 def circle_circle(xp, p, a, q, b, sigma, around=0.0):
@@ -109,3 +110,19 @@ def slot_line_lines(pivot, pin):
     """A slotted lever driving a pin on a +x slide line: the lever pushes along its normal and the pin moves along
     x, so the transmission angle is the acute angle between the lever (pivot -> pin) and the slide line."""
     return (pin[0] - pivot[0], pin[1] - pivot[1]), (1.0, 0.0)
+
+
+class Loop(NamedTuple):
+    """One evaluation of a mechanism's closed-form loop.
+
+    points: joint name -> (x, y); angles: link angle name -> angle (direction
+    from the first-named joint to the second, e.g. theta3 = A->B); x: the output
+    (slider position along +x, or theta4 for FourBar); transmission: joint -> its
+    lines (see the functions above) or RIGHT_ANGLE; margins: (closure, margin >= 0 if it assembles).
+    """
+
+    points: dict
+    angles: dict
+    x: Any
+    transmission: dict
+    margins: list

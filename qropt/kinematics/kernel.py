@@ -24,8 +24,9 @@ from typing import NamedTuple
 import casadi
 import numpy as np
 
+from qropt.errors import InvalidParameter
 from qropt.kinematics import cycle, driver, native
-from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle, transmission_cos2
+from qropt.kinematics.closures import RIGHT_ANGLE, Loop, transmission_angle, transmission_cos2
 from qropt.kinematics.ops import CASADI, NUMPY, Jet
 
 NEWTON_STEPS = 2  # from the grid parabola's vertex (error <~1e-4 rad), two steps reach ~1e-16 rad
@@ -185,6 +186,11 @@ class Kernel:
         t, P = casadi.SX.sym("t"), casadi.SX.sym("p", len(names))
         p = {k: P[i] for i, k in enumerate(names)}
         lp = cls.loop(CASADI, t, p)
+        if not isinstance(lp, Loop):
+            raise InvalidParameter(
+                f"{cls.__name__}.loop must return a Loop (qropt.mechanisms.Loop: points, angles, x, transmission, "
+                f"margins), got {type(lp).__name__}"
+            )
         self.joints = [j for j, lines in lp.transmission.items() if lines is not RIGHT_ANGLE]
         self.right_joints = [j for j, lines in lp.transmission.items() if lines is RIGHT_ANGLE]
         self.margin_names = [what for what, _ in lp.margins]

@@ -21,14 +21,14 @@ import numpy as np
 from qropt import units as units_
 from qropt.errors import AssemblyError, DegenerateMechanism, InvalidParameter, NoDeadCentres
 from qropt.kinematics import cycle
-from qropt.kinematics.closures import transmission_angle
+from qropt.kinematics.closures import Loop, transmission_angle
 from qropt.kinematics.kernel import kernel, resolved_spectrum, spectral_derivative, spectrum
 from qropt.kinematics.ops import NUMPY
+from qropt.validate import MAGNITUDE, branch_sign, number
 
 REQUIRED = object()  # a PARAMS default: the parameter has none and must be given
 REGISTRY: dict[str, type[Mechanism]] = {}  # KIND -> the type (shipped types and every user type with a KIND)
 PARAMETER_KINDS = ("length", "offset", "angle", "branch")  # what ``Mechanism.kinds()`` says of each parameter
-MAGNITUDE = 1e100  # lengths and offsets beyond this (or lengths below its inverse) overflow their squares
 MAX_ANGLES = 10_000_000  # crank angles evaluated in one call
 
 
@@ -46,23 +46,6 @@ class cached_property:  # noqa: N801 - functools.cached_property without its loc
             return self
         value = obj.__dict__[self.name] = self.func(obj)
         return value
-
-
-def _finite(name: str, value) -> float:
-    """A finite real number from the API, or InvalidParameter naming it."""
-    if type(value) is float and -MAGNITUDE <= value <= MAGNITUDE:  # the common case, checked first
-        return value
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InvalidParameter(f"{name} must be a number, got {value!r}")
-    try:
-        v = float(value)
-    except OverflowError:
-        v = math.inf
-    if not math.isfinite(v):
-        raise InvalidParameter(f"{name} must be finite, got {v}")
-    if abs(v) > MAGNITUDE:
-        raise InvalidParameter(f"{name} = {v:g} is out of range (|value| <= 1e100)")
-    return v
 
 
 @functools.cache
@@ -140,22 +123,6 @@ class Rule(NamedTuple):
 
     name: str
     value: Any
-
-
-class Loop(NamedTuple):
-    """One evaluation of a mechanism's closed-form loop.
-
-    points: joint name -> (x, y); angles: link angle name -> angle (direction
-    from the first-named joint to the second, e.g. theta3 = A->B); x: the output
-    (slider position along +x, or theta4 for FourBar); transmission: joint -> its
-    lines (see ``closures``) or RIGHT_ANGLE; margins: (closure, margin >= 0 if it assembles).
-    """
-
-    points: dict
-    angles: dict
-    x: Any
-    transmission: dict
-    margins: list
 
 
 @dataclass(frozen=True)
@@ -295,6 +262,24 @@ class Body(NamedTuple):
     kind: str
 
 
+def _check_declaration(cls) -> None:
+    """InvalidParameter naming the type where its PARAMS is not a dict of parameter name -> default (a number, None
+    for an optional parameter, or REQUIRED)."""
+    params = cls.PARAMS
+    if not isinstance(params, dict):
+        raise InvalidParameter(
+            f"{cls.__name__}: PARAMS is a dict of parameter name -> default (a number, None or REQUIRED), "
+            f"got {type(params).__name__} {params!r:.80}"
+        )
+    for k, v in params.items():
+        if not isinstance(k, str) or not k.isidentifier():
+            raise InvalidParameter(f"{cls.__name__}: a parameter is named by an identifier, got {k!r:.80} in PARAMS")
+        if not (v is REQUIRED or v is None or (isinstance(v, (int, float)) and not isinstance(v, bool))):
+            raise InvalidParameter(
+                f"{cls.__name__}: parameter {k}'s default is a number, None or REQUIRED, got {v!r:.80}"
+            )
+
+
 class Mechanism:
     """Base of every quick-return type; instances are immutable."""
 
@@ -324,8 +309,15 @@ class Mechanism:
 
     def __init_subclass__(cls, **kw):
         super().__init_subclass__(**kw)
+        _check_declaration(cls)
         if "BRANCHES" not in cls.__dict__:
             cls.BRANCHES = tuple(k for k in cls.PARAMS if k.startswith("sigma"))
+        linkage = getattr(getattr(cls, "loop", None), "__self__", None)  # a loop of the linkage builder
+        if not isinstance(linkage, type) and callable(getattr(linkage, "check", None)):
+            try:
+                linkage.check(cls.PARAMS, cls.BRANCHES)
+            except InvalidParameter as e:
+                raise type(e)(f"{cls.__name__}: {e}") from None
         register(cls)
 
     @classmethod
@@ -422,13 +414,13 @@ class Mechanism:
             if v is None:
                 continue
             if type(v) is not float or not -MAGNITUDE <= v <= MAGNITUDE:  # the name only where it is needed
-                v = _finite(f"{name}: {k}", v)
+                v = number(f"{name}: {k}", v)
             if k in self.LENGTHS and v <= 0:
                 raise InvalidParameter(f"{name}: length {k} must be positive, got {v:g}")
             if abs(v) > MAGNITUDE or (k in self.LENGTHS and v < 1 / MAGNITUDE):
                 raise InvalidParameter(f"{name}: {k} = {v:g} is out of range (|value| in [1e-100, 1e100])")
-            if k in self.BRANCHES and v not in (-1.0, 1.0):
-                raise InvalidParameter(f"{name}: branch sign {k} must be +1 or -1, got {v:g}")
+            if k in self.BRANCHES:
+                v = branch_sign(f"{name}: branch sign {k}", v)
             values[k] = v
         object.__setattr__(self, "params", values)
         self.validate()
@@ -540,13 +532,13 @@ class Mechanism:
     def motion(self, theta2, omega2: float = 1.0, alpha2: float = 0.0) -> Motion:
         """Exact output and link rates at theta2 (rad) for crank rate omega2 (rad/s) and alpha2 (rad/s^2)."""
         t = self._angles(theta2)
-        return self._motion(t, _finite("omega2", omega2), _finite("alpha2", alpha2), "all")
+        return self._motion(t, number("omega2", omega2), number("alpha2", alpha2), "all")
 
     def slider(self, theta2, omega2: float = 1.0, alpha2: float = 0.0) -> Motion:
         """Slider position x, velocity v, acceleration a at theta2 (the link rates are computed if asked for);
         see ``motion``."""
         t = self._angles(theta2)
-        return self._motion(t, _finite("omega2", omega2), _finite("alpha2", alpha2), "x")
+        return self._motion(t, number("omega2", omega2), number("alpha2", alpha2), "x")
 
     def _motion(self, t, omega2, alpha2, which) -> Motion:
         k = self._kernel
@@ -682,7 +674,7 @@ class Mechanism:
         """'+x' or '-x': the way the output moves during the slow (working) stroke; None if TR = 1.
 
         omega2 (rad/s, nonzero): its sign is the crank's sense of rotation."""
-        if _finite("omega2", omega2) == 0.0:
+        if number("omega2", omega2) == 0.0:
             raise InvalidParameter("omega2 must be nonzero: its sign sets the working direction")
         a, b = self.stroke_angles()
         if a == b:
@@ -726,7 +718,7 @@ class Mechanism:
     def peak_acceleration(self, omega2: float = 1.0, over: str = "cycle") -> PeakAcceleration:
         """Largest |slider acceleration| at constant omega2 (rad/s) over the turn ('cycle') or the working
         (slow) stroke ('working'), exact: the extremes of d2x/dtheta2 refined with exact derivatives."""
-        omega2 = _finite("omega2", omega2)
+        omega2 = number("omega2", omega2)
         if over not in ("cycle", "working"):
             raise InvalidParameter(f"peak_acceleration: over is 'cycle' or 'working', got {over!r}")
         self._require_full_turn()
@@ -783,7 +775,7 @@ class Mechanism:
     def peak_velocity(self, omega2: float = 1.0) -> PeakVelocity:
         """Largest |slider velocity| over the working (slow) stroke at constant omega2 (rad/s), exact, with the
         crank angle and the peak crank torque per newton of a constant cutting force, |dx/dtheta2| (length)."""
-        omega2 = _finite("omega2", omega2)
+        omega2 = number("omega2", omega2)
         lo, length = self.working_arc(omega2)
         ex = self.velocity_extremes()
         ts = np.concatenate([ex.maxima[0], ex.minima[0]])
@@ -881,7 +873,7 @@ class Mechanism:
         piece's gradient, ``left`` and ``right`` the one-sided derivatives and ``kink`` says why."""
         if quantity not in SENSITIVE:
             raise InvalidParameter(f"sensitivity: unknown quantity {quantity!r}; one of {list(SENSITIVE)}")
-        if quantity == "peak_acceleration" and (omega2 is None or _finite("omega2", omega2) == 0.0):
+        if quantity == "peak_acceleration" and (omega2 is None or number("omega2", omega2) == 0.0):
             raise InvalidParameter(f"the peak acceleration's sensitivity needs a nonzero omega2 (rad/s), got {omega2}")
         self._require_full_turn()
         k, p = self._kernel, self._vector
@@ -942,7 +934,7 @@ class Mechanism:
         if not qs or any(q not in SENSITIVE for q in qs):
             raise InvalidParameter(f"nearby: quantities are among {list(SENSITIVE)}, got {quantities!r}")
         if "peak_acceleration" in qs:
-            if omega2 is None or _finite("omega2", omega2) == 0.0:
+            if omega2 is None or number("omega2", omega2) == 0.0:
                 raise InvalidParameter("nearby: the peak acceleration needs a nonzero omega2 (rad/s)")
             omega2 = float(omega2)
         P = np.asarray(P)

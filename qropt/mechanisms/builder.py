@@ -25,6 +25,9 @@ what the hand-written loop did. A type then says::
 Numbers and parameters. A coordinate, length or slide-line height is a number, a parameter name, or a short linear
 expression of them (``"-r1 + h"``, ``"2*r1 - e"``), evaluated left to right exactly as written (``-r1 + h`` is
 ``-p["r1"] + p["h"]``); or a callable ``f(xp, p)``. A branch sign is a parameter name (``"sigma"``) or +1 / -1.
+Each declaration is checked as it is made (LinkageError): numbers finite, a literal link length (a crank's, a
+dyad's) positive, a dyad's two centres distinct, its bodies a pair; and when a type takes the loop, every name
+the linkage reads is one of its PARAMS and every sign one of its BRANCHES.
 
 Points are emitted in declaration order and may refer to points declared later (the loop is evaluated in dependency
 order), so a type reproduces a hand-written loop's point order. Angles, transmission joints and margins are
@@ -86,6 +89,7 @@ from typing import NamedTuple
 from qropt.errors import InvalidParameter
 from qropt.kinematics import closures as cl
 from qropt.mechanisms.base import Body, Loop
+from qropt.validate import branch_sign, number
 
 __all__ = ["Linkage", "LinkageError", "Connection"]
 
@@ -111,19 +115,25 @@ _TERM = re.compile(
 )
 
 
-class _Scalar:
-    """A number, a parameter, a linear expression of parameters (left to right) or a callable f(xp, p)."""
+_NOT_NAMES = ("nan", "inf", "infinity")  # read as numbers by float(), never parameter names here
 
-    def __init__(self, spec, what: str):
-        self.spec, self.names, self.zero = spec, (), False
+
+class _Scalar:
+    """A number, a parameter, a linear expression of parameters (left to right) or a callable f(xp, p).
+    ``positive``: a literal (or an expression of literals only) must be > 0 (a link's length)."""
+
+    def __init__(self, spec, what: str, positive: bool = False):
+        self.spec, self.names, self.zero, self.constant = spec, (), False, None
         if callable(spec):
             self.f = lambda xp, p: spec(xp, p)
             self.code = None  # the compiled loop calls it: f(xp, p)
             return
         if isinstance(spec, bool) or not isinstance(spec, (int, float, str)):
-            raise LinkageError(f"{what}: a number, a parameter name, a linear expression or f(xp, p); got {spec!r}")
+            raise LinkageError(f"{what}: a number, a parameter name, a linear expression or f(xp, p); got {spec!r:.80}")
         if not isinstance(spec, str):
-            v = float(spec)
+            v = self.constant = number(what, spec, error=LinkageError)
+            if positive and v <= 0:
+                raise LinkageError(f"{what} must be positive, got {v:g}")
             self.zero = v == 0.0
             self.f = lambda xp, p: v
             self.code = repr(v)
@@ -132,9 +142,12 @@ class _Scalar:
         while pos < len(spec):
             m = _TERM.match(spec, pos)
             if not m or m.end() == pos or (terms and not m.group(1)):
-                raise LinkageError(f"{what}: cannot read {spec!r} (terms like 'r1', '-r1 + h', '2*e')")
+                raise LinkageError(f"{what}: cannot read {spec!r:.80} (terms like 'r1', '-r1 + h', '2*e')")
             sign, num, name = m.group(1) or "+", m.group(2), m.group(3) or m.group(4)
-            terms.append((sign, float(num) if num is not None else None, name))
+            if name is not None and name.lower() in _NOT_NAMES:
+                raise LinkageError(f"{what}: {name!r} in {spec!r:.80} is not a parameter name (numbers are finite)")
+            coef = None if num is None else number(f"{what}: the number {num}", float(num), error=LinkageError)
+            terms.append((sign, coef, name))
             pos = m.end()
         if not terms:
             raise LinkageError(f"{what}: empty expression")
@@ -153,6 +166,10 @@ class _Scalar:
                 out = v if k == 0 else (out - v if sign == "-" else out + v)
             return out
 
+        if not self.names:
+            self.constant = number(f"{what} ({spec!r:.80})", f(None, {}), error=LinkageError)
+            if positive and self.constant <= 0:
+                raise LinkageError(f"{what} must be positive, got {spec!r:.80} = {self.constant:g}")
         self.f = f
         code = ""
         for k, (sign, coef, name) in enumerate(terms):  # the same operations, in the same order, as f
@@ -168,6 +185,22 @@ class _Scalar:
 
     def __call__(self, xp, p):
         return self.f(xp, p)
+
+
+def _sign(spec, what: str) -> _Scalar:
+    """A branch sign: a parameter name (the type lists it in BRANCHES) or the literal +1 or -1."""
+    if isinstance(spec, str) and re.fullmatch(r"[A-Za-z_]\w*", spec) and spec.lower() not in _NOT_NAMES:
+        return _Scalar(spec, what)
+    if isinstance(spec, bool) or not isinstance(spec, (int, float)):
+        raise LinkageError(f"{what}: a branch sign is a parameter name (e.g. 'sigma') or +1 or -1, got {spec!r:.80}")
+    return _Scalar(branch_sign(f"{what}: a branch sign", spec, error=LinkageError), what)
+
+
+def _names(v, n: int, what: str) -> tuple:
+    """n distinct non-empty names (a dyad's bodies or angles: None skips an angle)."""
+    if not isinstance(v, (tuple, list)) or len(v) != n:
+        raise LinkageError(f"{what}: {n} names, got {v!r:.80}")
+    return tuple(v)
 
 
 def _theta(length) -> str | None:
@@ -206,7 +239,7 @@ class _Crank(_Element):
 
     def __init__(self, name, about, length, angle, body):
         self.point, self.about, self.needs = name, about, (about,)
-        self.length, self.angle, self.body = _Scalar(length, f"crank {name} length"), angle, body
+        self.length, self.angle, self.body = _Scalar(length, f"crank {name} length", positive=True), angle, body
         self.pivot_zero = (False, False)  # set by the plan (a ground pivot at a literal 0 adds nothing)
 
     def angle_names(self):
@@ -218,12 +251,16 @@ class _RRR(_Element):
 
     def __init__(self, name, first, second, sign, around, angles, margin, bodies):
         (self.p_, a), (self.q_, b) = _pair(first, f"rrr {name}"), _pair(second, f"rrr {name}")
+        if self.p_ == self.q_:
+            raise LinkageError(f"rrr {name!r}: both circles are about {self.p_!r}; an RRR needs two centres")
         self.point, self.needs = name, (self.p_, self.q_)
-        self.a, self.b = _Scalar(a, f"rrr {name} first length"), _Scalar(b, f"rrr {name} second length")
-        self.sign, self.around = _Scalar(sign, f"rrr {name} sign"), float(around)
-        self.angles = (_theta(a), _theta(b)) if angles == "default" else tuple(angles)
+        self.a = _Scalar(a, f"rrr {name} first length", positive=True)
+        self.b = _Scalar(b, f"rrr {name} second length", positive=True)
+        self.sign = _sign(sign, f"rrr {name} sign")
+        self.around = number(f"rrr {name} around (rad)", around, error=LinkageError)
+        self.angles = (_theta(a), _theta(b)) if angles == "default" else _names(angles, 2, f"rrr {name!r} angles")
         self.margin = self.margin_given = margin  # the default name is set by the plan
-        self.bodies = tuple(bodies)
+        self.bodies = _names(bodies, 2, f"rrr {name!r} bodies (coupler, follower)")
 
     def angle_names(self):
         return tuple(a for a in self.angles if a)
@@ -241,11 +278,12 @@ class _RRP(_Element):
     def __init__(self, name, rod, line_y, sign, angle, margin, bodies):
         self.pin, r = _pair(rod, f"rrp {name}")
         self.point, self.needs = name, (self.pin,)
-        self.r, self.h = _Scalar(r, f"rrp {name} rod length"), _Scalar(line_y, f"rrp {name} line_y")
-        self.sign = _Scalar(sign, f"rrp {name} sign")
+        self.r = _Scalar(r, f"rrp {name} rod length", positive=True)
+        self.h = _Scalar(line_y, f"rrp {name} line_y")
+        self.sign = _sign(sign, f"rrp {name} sign")
         self.angle = _theta(r) if angle == "default" else angle
         self.margin = margin or f"rod {self.pin}{name} reaching the slide line"
-        self.bodies = tuple(bodies)
+        self.bodies = _names(bodies, 2, f"rrp {name!r} bodies (rod, ram)")
 
     def angle_names(self):
         return (self.angle,) if self.angle else ()
@@ -261,8 +299,10 @@ class _RPR(_Element):
     kind = "rpr"
 
     def __init__(self, pin, pivot, angle, bodies):
+        if pin == pivot:
+            raise LinkageError(f"rpr {pin!r}: the slot turns about its own pin; the pivot is another joint")
         self.pin, self.pivot, self.needs = pin, pivot, (pin, pivot)
-        self.angle, self.bodies = angle, tuple(bodies)
+        self.angle, self.bodies = angle, _names(bodies, 2, f"rpr {pin!r} bodies (block, lever)")
 
     def angle_names(self):
         return (self.angle,) if self.angle else ()
@@ -288,6 +328,8 @@ class _SlotLine(_Element):
         if not isinstance(lever, (tuple, list)) or len(lever) != 2 or not all(isinstance(j, str) for j in lever):
             raise LinkageError(f"slot_line {name!r}: the lever is (pivot, through), got {lever!r}")
         self.pivot, self.through = lever
+        if self.pivot == self.through:
+            raise LinkageError(f"slot_line {name!r}: the lever's line runs through two joints, got {lever!r}")
         self.point, self.needs = name, (self.pivot, self.through)
         self.h, self.margin, self.body = _Scalar(line_y, f"slot_line {name} line_y"), margin, body
 
@@ -302,11 +344,22 @@ class _OnBody(_Element):
     kind = "on_ray"
 
     def __init__(self, name, origin, through, length, angle):
+        if origin == through:
+            raise LinkageError(f"{name!r}: a ray runs from one joint through another, got {origin!r} twice")
         self.point, self.origin, self.through, self.needs = name, origin, through, (origin, through)
         self.length = _Scalar(length, f"{name} length")
         self.offset = None if angle is None else _Scalar(angle, f"{name} angle")
         if self.offset is not None:
             self.kind = "coupler_point"
+
+
+def _same_place(a: tuple, b: tuple) -> bool:
+    """Two ground pivots declared at one point: the same numbers or the same expressions."""
+
+    def key(c):
+        return c.spec if c.constant is None else c.constant
+
+    return not any(callable(c.spec) for c in (*a, *b)) and [key(c) for c in a] == [key(c) for c in b]
 
 
 def _pair(v, what):
@@ -378,10 +431,7 @@ class Linkage:
         """RRR: joint ``name`` at distance a from P and b from Q, ``first = (P, a)`` (the driving side),
         ``second = (Q, b)``, on the branch ``sign`` = sign((P - Q) x (X - Q)). ``angles``: names of P->X and Q->X
         (None to skip; default theta<k> for lengths r<k>); ``margin``: its name (default: see the module)."""
-        e = _RRR(name, first, second, sign, around, angles, margin, bodies)
-        if len(e.angles) != 2 or len(e.bodies) != 2:
-            raise LinkageError(f"rrr {name!r}: angles and bodies are pairs (P->X, Q->X)")
-        return self._add(e)
+        return self._add(_RRR(name, first, second, sign, around, angles, margin, bodies))
 
     def rrp(
         self,
@@ -470,6 +520,9 @@ class Linkage:
         grounds = {e.point for e in els if e.kind == "ground"}
         for e in els:
             if e.kind == "rrr":
+                p_, q_ = els[placed[e.p_]], els[placed[e.q_]]
+                if p_.kind == q_.kind == "ground" and _same_place(p_.xy, q_.xy):
+                    raise LinkageError(f"rrr {e.point!r}: its centres {e.p_!r} and {e.q_!r} are one point")
                 four = e.p_ in cranks and e.q_ in grounds
                 e.margin = e.margin_given or (f"four-bar closure at {e.point}" if four else f"closure at {e.point}")
         self._plan = (tuple(order), self._bodies(order), self._compile(order))
@@ -622,6 +675,24 @@ class Linkage:
         if dup:
             raise LinkageError(f"body names {dup} are used twice: name the dyads' bodies (bodies=...)")
         return tuple(Body(name, tuple(joints), kind) for _, _, name, joints, kind in bodies)
+
+    def check(self, params, branches=()) -> None:
+        """LinkageError unless every parameter the linkage reads is one of ``params`` and every branch sign it names
+        is one of ``branches`` (a type's PARAMS and BRANCHES: ``Mechanism`` checks its own linkage when defined),
+        and the declaration builds (every joint placed, no cycle, no degenerate dyad)."""
+        self._build()
+        missing = [n for n in self.parameters() if n not in params]
+        if missing:
+            raise LinkageError(
+                f"the linkage reads {missing}, which the type does not take: its PARAMS are {list(params)}"
+            )
+        for e in self._elements:
+            sign = getattr(e, "sign", None)
+            if sign is not None and sign.names and sign.names[0] not in branches:
+                raise LinkageError(
+                    f"{e.kind} {e.point!r}: its sign {sign.names[0]!r} is not a branch sign of the type "
+                    f"(BRANCHES: {list(branches)}); a branch sign is +1 or -1"
+                )
 
     # -- what a type reads
     def loop(self, xp, theta2, p) -> Loop:

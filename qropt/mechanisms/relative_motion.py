@@ -20,6 +20,7 @@ import numpy as np
 
 from qropt.errors import InvalidParameter
 from qropt.kinematics.ops import JET, Jet
+from qropt.validate import LIMIT, number
 
 
 class Term(NamedTuple):
@@ -146,11 +147,15 @@ def polygon_figure(rm: RelativeMotion, units: str = "m"):
 
 
 def relative_motion(m, theta2: float, omega2: float = 1.0, alpha2: float = 0.0) -> RelativeMotion:
-    """The velocity and acceleration equations of mechanism m at one crank angle (see the module docstring)."""
+    """The velocity and acceleration equations of mechanism m at one crank angle theta2 (rad), omega2 (rad/s) and
+    alpha2 (rad/s^2), each a finite number (|omega2|, |alpha2| <= 1e12); see the module docstring."""
+    theta2 = number("theta2 (rad)", theta2)
+    omega2, alpha2 = number("omega2 (rad/s)", omega2, limit=LIMIT), number("alpha2 (rad/s^2)", alpha2, limit=LIMIT)
     linkage = type(m).linkage(m.params)
     if linkage is None:
         raise InvalidParameter(f"{type(m).__name__} is not declared with the linkage builder: no polygons")
-    lp = m.evaluate(JET, Jet.seed(np.array([float(theta2)]), float(omega2), float(alpha2)))
+    t = m._angles(theta2)  # it assembles there (AssemblyError otherwise)
+    lp = m.evaluate(JET, Jet.seed(t, omega2, alpha2))
     pos, vel, acc = {}, {}, {}
     for name, (x, y) in lp.points.items():
         parts = [_parts(x), _parts(y)]
@@ -233,7 +238,7 @@ def relative_motion(m, theta2: float, omega2: float = 1.0, alpha2: float = 0.0) 
             sliding(e.point, e.pivot, e.through)
         elif k in ("on_ray", "coupler_point"):
             rigid(e.point, e.origin, e.through, known=True)
-    return RelativeMotion(float(theta2), float(omega2), float(alpha2), tuple(eqs))
+    return RelativeMotion(theta2, omega2, alpha2, tuple(eqs))
 
 
 def _jet(v):

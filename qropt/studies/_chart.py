@@ -18,6 +18,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from qropt import validate
 from qropt.errors import ChartError, QroptError
 from qropt.io.paths import picture_path
 from qropt.synthesis import criteria
@@ -340,10 +341,9 @@ class Chart:
         (ChartError naming the file and what is wrong)."""
         _path(path, "JSON")
         try:
-            with open(path) as fh:
-                d = json.load(fh)
-        except (OSError, UnicodeDecodeError, ValueError) as e:
-            raise ChartError(f"{path}: not a qropt chart file ({type(e).__name__}: {e})") from None
+            d = validate.json_document(validate.read_text(path, "chart file"), str(path), "chart")
+        except QroptError as e:
+            raise ChartError(f"{path}: not a qropt chart file ({e})") from None
         try:
             return cls._from_dict(d)
         except QroptError as e:

@@ -22,11 +22,12 @@ from dataclasses import dataclass, field
 from qropt import units as units_
 from qropt.errors import ProblemError, QroptError
 from qropt.mechanisms import mechanism_type
-from qropt.mechanisms.base import MAGNITUDE, REQUIRED
+from qropt.mechanisms.base import REQUIRED
 from qropt.studies import _workers
 from qropt.synthesis import criteria
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import SOLUTION_PRESENT, Result, json_safe
+from qropt.validate import MAGNITUDE
 
 # type name -> (mechanism kind, free lengths, free offsets, fixed values, free angles)
 TYPES = {
@@ -239,6 +240,64 @@ class Comparison:
         save(comparison_figure(self), path)
 
 
+def task_problems(
+    time_ratio: float,
+    stroke: float,
+    *,
+    objective: str = "max_gamma_min",
+    types=None,
+    bounds=None,
+    conditions=None,
+    omega2: float = 1.0,
+    size: str = "footprint",
+    units: str = units_.DEFAULT,
+    masses=None,
+    loads=None,
+) -> dict:
+    """Row name -> the Problem ``design`` solves for it, every argument checked (ProblemError naming the first
+    that is wrong); what ``design`` and the web application's design jobs check before any solve."""
+    try:
+        units = units_.length_unit(units)
+    except QroptError as e:
+        raise ProblemError(f"design: {e}") from None
+    if bounds is not None and not isinstance(bounds, Mapping):
+        raise ProblemError(f"bounds is a dict name -> (lower, upper), got {bounds!r}")
+    chosen = _types(list(TYPES) if types is None else types)  # row name -> the type as given
+    types = list(chosen)
+    if not (criteria.finite(time_ratio) and time_ratio >= 1):
+        raise ProblemError(f"time_ratio is slow/fast >= 1, got {time_ratio!r}")
+    if not (criteria.finite(stroke) and stroke > 0):
+        raise ProblemError(f"stroke must be a positive number, got {stroke!r}")
+    if not 20 / MAGNITUDE <= stroke <= MAGNITUDE / 5:  # the default bounds [s/20, 5 s] within the magnitude range
+        raise ProblemError(f"stroke {stroke:g} {units} is out of range [2e-99, 2e99] (its bounds reach s/20 and 5 s)")
+    if conditions is not None and not isinstance(conditions, Mapping):
+        raise ProblemError(f"conditions is a dict name -> bound (e.g. {{'gamma_min': 0.7}}), got {conditions!r}")
+    known = set()
+    for t in types:
+        mech, lengths, offsets, _, _ = type_row(chosen[t])[1]
+        angles = [k for k, kind in mechanism_type(mech).kinds().items() if kind == "angle"]
+        known |= {*lengths, *offsets, *angles}
+    unknown = sorted(set(bounds or {}) - known, key=str)
+    if unknown:
+        raise ProblemError(f"bounds name {unknown}, which no type of {types} has (they have {sorted(known)})")
+    return {
+        kind: type_problem(
+            chosen[kind],
+            time_ratio,
+            stroke,
+            objective=objective,
+            bounds=bounds,
+            conditions=conditions,
+            omega2=omega2,
+            size=size,
+            units=units,
+            masses=masses,
+            loads=loads,
+        )
+        for kind in types
+    }
+
+
 def design(
     time_ratio: float,
     stroke: float,
@@ -278,46 +337,20 @@ def design(
     if workers is not None:
         _workers.check_workers(workers)
     solver = solver or DEFAULT
-    try:
-        units = units_.length_unit(units)
-    except QroptError as e:
-        raise ProblemError(f"design: {e}") from None
-    if bounds is not None and not isinstance(bounds, Mapping):
-        raise ProblemError(f"bounds is a dict name -> (lower, upper), got {bounds!r}")
-    chosen = _types(list(TYPES) if types is None else types)  # row name -> the type as given
-    types = list(chosen)
-    if not (criteria.finite(time_ratio) and time_ratio >= 1):
-        raise ProblemError(f"time_ratio is slow/fast >= 1, got {time_ratio!r}")
-    if not (criteria.finite(stroke) and stroke > 0):
-        raise ProblemError(f"stroke must be a positive number, got {stroke!r}")
-    if not 20 / MAGNITUDE <= stroke <= MAGNITUDE / 5:  # the default bounds [s/20, 5 s] within the magnitude range
-        raise ProblemError(f"stroke {stroke:g} {units} is out of range [2e-99, 2e99] (its bounds reach s/20 and 5 s)")
-    if conditions is not None and not isinstance(conditions, Mapping):
-        raise ProblemError(f"conditions is a dict name -> bound (e.g. {{'gamma_min': 0.7}}), got {conditions!r}")
-    known = set()
-    for t in types:
-        mech, lengths, offsets, _, _ = type_row(chosen[t])[1]
-        angles = [k for k, kind in mechanism_type(mech).kinds().items() if kind == "angle"]
-        known |= {*lengths, *offsets, *angles}
-    unknown = sorted(set(bounds or {}) - known, key=str)
-    if unknown:
-        raise ProblemError(f"bounds name {unknown}, which no type of {types} has (they have {sorted(known)})")
-    problems = {
-        kind: type_problem(
-            chosen[kind],
-            time_ratio,
-            stroke,
-            objective=objective,
-            bounds=bounds,
-            conditions=conditions,
-            omega2=omega2,
-            size=size,
-            units=units,
-            masses=masses,
-            loads=loads,
-        )
-        for kind in types
-    }
+    problems = task_problems(
+        time_ratio,
+        stroke,
+        objective=objective,
+        types=types,
+        bounds=bounds,
+        conditions=conditions,
+        omega2=omega2,
+        size=size,
+        units=units,
+        masses=masses,
+        loads=loads,
+    )
+    units = units_.length_unit(units)
     if pareto is not None:
         from qropt.studies._pareto import _check
 

@@ -14,7 +14,7 @@ from scipy.optimize import brentq, minimize_scalar
 from qropt.errors import InvalidParameter, QroptError
 from qropt.kinematics.ops import NUMPY
 from qropt.mechanisms import Mechanism
-from qropt.mechanisms.base import MAGNITUDE
+from qropt.validate import MAGNITUDE
 
 SPAN = 1000.0  # given bounds may span at most this many times the mechanism's largest other parameter
 

@@ -22,13 +22,13 @@ from qropt import units as units_
 from qropt.dynamics.model import Loads, Masses
 from qropt.errors import ProblemError, QroptError
 from qropt.mechanisms import Mechanism, mechanism_type, type_reference
-from qropt.mechanisms.base import MAGNITUDE, REQUIRED
+from qropt.mechanisms.base import REQUIRED
 from qropt.synthesis import criteria
 from qropt.synthesis.criteria import SIZES, finite
+from qropt.validate import MAGNITUDE, MAX_NESTING, nesting
 
 MAX_OMEGA2 = 1e6  # rad/s: omega2^2 times a length up to MAGNITUDE stays finite (1e112); no machine turns faster
 MAX_TIME_RATIO = 1e6  # slow/fast: beyond it the fast stroke takes under 2 pi / 1e6 rad and TR has no meaning
-MAX_NESTING = 200  # levels of nested tables and lists in a problem file (a problem needs about 4)
 
 
 def _frozen(d):
@@ -343,7 +343,7 @@ class Problem:
     def _from_text(cls, text, loads, error, kind) -> Problem:
         if not isinstance(text, str):
             raise ProblemError(f"a {kind} problem is text (str), got {type(text).__name__}")
-        if _nesting(text) > MAX_NESTING:
+        if nesting(text) > MAX_NESTING:
             raise ProblemError(f"not a {kind} problem: nested deeper than {MAX_NESTING} levels")
         try:
             d = loads(text)
@@ -393,16 +393,3 @@ class Problem:
         """The mechanism (in the problem's unit) with the free parameters at ``values`` on ``branch`` (may raise
         QroptError)."""
         return self.mechanism(**self.fixed, **values, **branch, units=self.units)
-
-
-def _nesting(text: str) -> int:
-    """An upper bound on the nesting depth of JSON or TOML text: brackets and braces open at once (counting those
-    inside strings too, which only overestimates)."""
-    depth = most = 0
-    for ch in text:
-        if ch in "[{":
-            depth += 1
-            most = max(most, depth)
-        elif ch in "]}":
-            depth = max(depth - 1, 0)
-    return most
