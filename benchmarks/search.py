@@ -43,7 +43,7 @@ from qropt.kinematics.closures import RIGHT_ANGLE, transmission_angle
 from qropt.kinematics.ops import NUMPY
 from qropt.mechanisms import REQUIRED
 from qropt.studies._design import TYPES, design, type_problem
-from qropt.synthesis import criteria, evolution
+from qropt.synthesis import criteria, descents, evolution
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.criteria import sense
 from qropt.synthesis.result import SOLUTION_PRESENT
@@ -187,7 +187,7 @@ def reference(
             d for s in range(EVOLVE_SEEDS) for d in evolution.evolve(problem, evolve_generations, seed + s, EVOLVE_KEEP)
         ]
         # each design descended on the targets; for a peak over the turn the SQP from it and its end too, as a solve's
-        ends = evolution.descents(problem, kept, DESCENT_EVALS, sqp=True)
+        ends = descents.descents(problem, kept, DESCENT_EVALS, sqp=True)
         solved = solver.solve(problem, starts_n=0, use_analytic=False, extra_starts=kept, diagnose=False)
         solves.append(("evolution", solved))
         exact = (ends[0].value, ends[0].design) if ends else None

@@ -1,7 +1,8 @@
 """qropt: optimisation-based dimensional synthesis of quick-return mechanisms.
 
-The public names only; the flow of data is kinematics -> mechanisms -> synthesis -> studies -> convex -> io
-(see docs/architecture.md).
+The public names only; the layers, from the bottom: kinematics -> dynamics -> mechanisms -> synthesis ->
+studies | convex -> io (see docs/architecture.md). Importing it attaches every object's pictures and notebook
+view (``qropt.io.views``).
 """
 
 from qropt.convex.servo import SpeedProfile, speed_profile
@@ -17,6 +18,7 @@ from qropt.errors import (
     ProblemError,
     QroptError,
 )
+from qropt.io import views  # noqa: F401 - attaches every object's plot() and notebook view
 from qropt.mechanisms import (
     CouplerSlider,
     CrankRockerSlider,

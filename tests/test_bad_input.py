@@ -19,10 +19,10 @@ from qropt.app.defaults import SHIPPED
 from qropt.errors import ChartError, InvalidParameter, ProblemError
 from qropt.examples import paper_mechanism
 from qropt.io.export import load_design, read_design
-from qropt.io.paths import picture_path
 from qropt.mechanisms import REQUIRED, Mechanism, mechanism_type
 from qropt.mechanisms.builder import Linkage, LinkageError
 from qropt.studies import Chart
+from qropt.validate import picture_path
 
 ROOT = Path(__file__).resolve().parent.parent
 NAN, INF = math.nan, math.inf

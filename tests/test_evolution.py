@@ -12,7 +12,7 @@ import pytest
 from benchmarks.tasks import LOADS, MASSES, OMEGA2
 from qropt import solve
 from qropt.studies._design import type_problem
-from qropt.synthesis import evolution
+from qropt.synthesis import descents, evolution
 from qropt.synthesis.criteria import objective_of
 
 KW = {"objective": "min_peak_torque", "masses": MASSES, "loads": LOADS, "omega2": OMEGA2}
@@ -149,7 +149,7 @@ def test_more_evolutions_add_their_ends_to_the_first_ones(monkeypatch):
     assert one.status == r.status == "feasible", (one.message, r.message)
     assert "2 differential evolutions (seeds 0-1) of 20 generations" in r.certificate.global_claim
     assert r.objective <= one.objective * (1 + 1e-12)
-    second = evolution.descended(problem, 20, 1)
+    second = descents.descended(problem, 20, 1)
     assert r.objective <= second[0].value * (1 + 1e-12)
 
 
@@ -188,7 +188,7 @@ def test_a_descents_end_stands_only_where_it_beats_every_certified_design():
     s = Solver()
     r = s.solve(problem)
     assert r.status == "optimal"
-    ends = evolution.descended(problem, 20, seed=3, keep=2, evals=300)
+    ends = descents.descended(problem, 20, seed=3, keep=2, evals=300)
     assert ends and ends[0].value >= r.objective * (1 - 1e-9)
     assert s.descended(problem, r, ends, "") is r
     worse = dataclasses.replace(r, objective=r.objective * 1.2, local_optima=())

@@ -17,7 +17,7 @@ import pytest
 import qropt
 from benchmarks.tasks import LOADS, MASSES, OMEGA2
 from qropt.studies._design import type_problem
-from qropt.synthesis import evolution, minimax, starts
+from qropt.synthesis import descents, evolution, minimax, starts
 from qropt.synthesis.dynamic import _cycle
 from tests import brute
 
@@ -122,7 +122,7 @@ def test_the_solver_descends_the_descents_ends_again_by_the_sqp_and_counts_them(
     (``feasible``, the claim counting both kinds of end), it meets the TR and stroke (brute force) and its peak is
     exact (a dense Newton-Euler grid). Without a peak over the turn nothing is added."""
     problem = type_problem("crank-rocker-slider", 2.017, 1.9568, **KW)
-    ends = evolution.descended(problem, 20, seed=0, keep=2, evals=300)
+    ends = descents.descended(problem, 20, seed=0, keep=2, evals=300)
     s = qropt.Solver()
     more, sqp = s.polished(problem, None, ends)
     added = sqp["sqp_ends"]

@@ -426,8 +426,8 @@ def _current_figure(p: Project):
 
 def _solution(p: Project) -> str:
     from qropt.io import plots
+    from qropt.io.plots import polygon_figure
     from qropt.io.report import _png, _table
-    from qropt.mechanisms.relative_motion import polygon_figure
 
     spec, u, r, m = p.spec, p.units, p.result, p.mechanism
     g = m.gamma_min()

@@ -130,8 +130,8 @@ MIN_STEP = math.radians(0.01)  # the finest full-cycle table: 36,000 rows
 
 
 def picture_path(path: str) -> str:
-    """A path for a picture, checked before any work (``qropt.io.paths.picture_path``), or CliError saying why."""
-    from qropt.io.paths import picture_path as check
+    """A path for a picture, checked before any work (``qropt.validate.picture_path``), or CliError saying why."""
+    from qropt.validate import picture_path as check
 
     try:
         check(path)

@@ -36,7 +36,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _targets(args) -> list[tuple[int, Path]]:
     """(seed, path) of every page, every path checked before anything is computed."""
     from qropt.cli import CliError
-    from qropt.io.paths import output_path
+    from qropt.validate import output_path
 
     def report_path(p):
         return output_path(p, (".html", ".htm"), "project page")

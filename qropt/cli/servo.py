@@ -11,8 +11,8 @@ import sys
 import numpy as np
 
 from qropt.convex.servo import OBJECTIVES, speed_profile
-from qropt.io.paths import picture_path
 from qropt.mechanisms import REGISTRY, type_reference
+from qropt.validate import picture_path
 
 COMMAND = "servo"
 HELP = "fastest crank-speed profile of a servo-driven crank within speed, acceleration and torque limits"

@@ -28,7 +28,6 @@ import numpy as np
 import scipy.sparse as sp
 
 from qropt.errors import InvalidParameter
-from qropt.io.paths import picture_path
 from qropt.mechanisms import Mechanism
 from qropt.units import to_metres
 from qropt.validate import MAGNITUDE, number
@@ -206,50 +205,6 @@ class SpeedProfile:
             inside = (k >= lo) & (k < hi)
             out["v_cut"] = float(np.abs(np.abs(s.v[inside]) / lim["v_cut"] - 1.0).max())
         return out
-
-    def plot(self, path) -> None:
-        """omega2, slider v and a (and the torque when given) against time, limits dashed, working stroke shaded.
-
-        path: a file ending .png, .pdf or .svg in an existing directory (InvalidParameter otherwise)."""
-        from qropt.io import plots
-
-        path = picture_path(path)  # checked before anything is drawn
-        s = self.motion()
-        rows = [
-            ("crank omega2 [rad/s]", s.omega, ["omega_max"]),
-            ("slider v [m/s]", s.v, ["v_max", "v_cut"]),
-            ("slider a [m/s^2]", s.a, ["a_max"]),
-        ]
-        if self.peak_torque is not None:
-            rows.append(("motor torque [N m]", s.torque, ["torque_max"]))
-        fig, axes = plots.plt.subplots(len(rows), 1, figsize=(8, 2.2 * len(rows) + 0.6), sharex=True)
-        tw = self.working_time
-        for ax, (label, y, names) in zip(axes, rows, strict=True):
-            ax.plot(s.t, y, color="tab:blue", lw=1.5)
-            ax.axvspan(0.0, tw, color="tab:orange", alpha=0.12, lw=0)
-            for name in names:
-                v = self.limits.get(name)
-                if v is not None:
-                    for i, sign in enumerate((1, -1) if name != "omega_max" else (1,)):
-                        ax.axhline(
-                            sign * v,
-                            color="tab:red" if name != "v_cut" else "tab:green",
-                            ls="--",
-                            lw=1,
-                            label=None if i else ("cutting speed" if name == "v_cut" else f"limit {name}"),
-                        )
-            if ax.get_legend_handles_labels()[0]:
-                ax.legend(loc="lower right", fontsize=7, framealpha=0.9)
-            ax.set_ylabel(label)
-            ax.grid(alpha=0.3)
-        axes[-1].set_xlabel("time [s]")
-        axes[0].set_title(
-            f"{type(self.mechanism).__name__} servo profile: cycle {self.cycle_time:.4g} s, "
-            f"time ratio {self.time_ratio:.3f} (working stroke shaded)",
-            fontsize=10,
-        )
-        fig.tight_layout()
-        plots.save(fig, path)
 
 
 def in_metres(m: Mechanism) -> Mechanism:

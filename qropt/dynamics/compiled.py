@@ -19,7 +19,8 @@ from __future__ import annotations
 import casadi
 import numpy as np
 
-from qropt.dynamics.rigid import body_motion
+from qropt.dynamics.elimination import Elimination, Parts
+from qropt.dynamics.rigid import body_motion, shaking
 from qropt.kinematics.kernel import CSE, Batched
 from qropt.kinematics.ops import CASADI
 
@@ -41,8 +42,6 @@ def kernel(m, s, superposed: bool = False) -> Batched:
 
 
 def _function(m, s, superposed: bool) -> casadi.Function:
-    from qropt.dynamics.inverse import Elimination, shaking
-
     names = list(m.params)
     t, w, al, g, k, load = (casadi.SX.sym(n) for n in ("t", "w", "al", "g", "k", "load"))
     P = casadi.SX.sym("p", len(names))
@@ -85,7 +84,7 @@ def _function(m, s, superposed: bool) -> casadi.Function:
 
 
 def parts(m, s, t, omega2, alpha2, g, k, known=None, superposed=False):
-    """``inverse._Parts`` from the structure's Function (``known``: the load that does not depend on the motion,
+    """``elimination.Parts`` from the structure's Function (``known``: the load that does not depend on the motion,
     (n,) on the load's row, or None), or None where a row is not finite (a singular angle, which the numpy route
     reports)."""
     n = t.size
@@ -106,8 +105,6 @@ def _body(bm) -> tuple:
 
 
 def _unpack(out, s, superposed):
-    from qropt.dynamics.inverse import _Parts
-
     K = s.n
     cols = out.T
     x0, u = out[:, :K], (out[:, K : 2 * K] if superposed else None)
@@ -122,7 +119,7 @@ def _unpack(out, s, superposed):
         if c.kind == "slot":
             normals[c.joint] = (cols[i], cols[i + 1])
             i += 2
-    return _Parts(solve, x_out, v_out, normals, (sfx, sfy, sm))
+    return Parts(solve, x_out, v_out, normals, (sfx, sfy, sm))
 
 
 __all__ = ["kernel", "parts"]

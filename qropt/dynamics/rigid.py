@@ -15,7 +15,7 @@ import numpy as np
 NO_TURN = (1.0, 0.0, 0.0, 0.0)
 
 
-def _zero(v) -> bool:
+def is_zero(v) -> bool:
     return isinstance(v, (int, float)) and v == 0
 
 
@@ -54,14 +54,27 @@ def body_motion(body, com, pts) -> tuple:
     an (x, y) pair. v_G = o' + phi' J R c, a_G = o'' + phi'' J R c - phi'^2 R c."""
     (ox, oy), rot = frame(body, pts)
     cx, cy = com
-    if _zero(cx) and _zero(cy):
+    if is_zero(cx) and is_zero(cy):
         return (ox[0], oy[0]), (ox[1], oy[1]), (ox[2], oy[2]), rot
     c, sn, w, al = rot
-    rx, ry = (c * cx, sn * cx) if _zero(cy) else (c * cx - sn * cy, sn * cx + c * cy)
+    rx, ry = (c * cx, sn * cx) if is_zero(cy) else (c * cx - sn * cy, sn * cx + c * cy)
     w2 = w * w
     v = (ox[1] - w * ry, oy[1] + w * rx)
     a = (ox[2] - al * ry - w2 * rx, oy[2] + al * rx - w2 * ry)
     return (ox[0] + rx, oy[0] + ry), v, a, rot
 
 
-__all__ = ["body_motion", "frame", "rotation"]
+def shaking(kin) -> tuple:
+    """(fx, fy, moment about O2) of the shaking: -sum(m a_G), -sum(r_G x m a_G + I alpha) (kin: body -> (G, a_G,
+    alpha, mass, inertia), numbers, arrays or expressions alike)."""
+    sfx, sfy, sm = 0.0, 0.0, 0.0
+    for (gx, gy), (ax, ay), alpha, mass, inertia in kin.values():
+        if not is_zero(mass):
+            sfx, sfy = sfx - mass * ax, sfy - mass * ay
+            sm = sm - mass * (gx * ay - gy * ax)
+        if not is_zero(inertia):
+            sm = sm - inertia * alpha
+    return sfx, sfy, sm
+
+
+__all__ = ["body_motion", "frame", "rotation", "shaking", "is_zero"]

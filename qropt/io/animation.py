@@ -8,8 +8,8 @@ import numpy as np
 
 from qropt.errors import InvalidParameter
 from qropt.io import drawing
-from qropt.io.paths import output_path
 from qropt.mechanisms import Mechanism
+from qropt.validate import output_path
 
 MAX_FPS = 100  # a GIF frame lasts a whole number of hundredths of a second
 

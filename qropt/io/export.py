@@ -18,8 +18,8 @@ from qropt import units as units_
 from qropt import validate
 from qropt.errors import InvalidParameter, QroptError
 from qropt.io import drawing
-from qropt.io.paths import output_path
 from qropt.mechanisms import Mechanism, mechanism_type, type_reference
+from qropt.validate import output_path
 
 LAYERS = drawing.LAYERS  # name -> DXF colour
 RESERVED = ("type", "params", "units")  # the design file's own fields

@@ -564,11 +564,9 @@ def front_html(f) -> str:
 def chart_html(ch) -> str:
     """A design chart: the objective over the grid as a heat map (gamma_min in degrees; grey: no design) and a
     compact table of its first cells."""
-    from qropt.studies._chart import _panel, _shown
-
-    values, label = _panel(ch, "objective")
-    xs, xlabel = _shown(ch.x, ch.problem)
-    ys, ylabel = _shown(ch.y, ch.problem) if ch.y is not None else (np.zeros(1), "")
+    values, label = ch.panel("objective")
+    xs, xlabel = ch.x.shown(ch.problem)
+    ys, ylabel = ch.y.shown(ch.problem) if ch.y is not None else (np.zeros(1), "")
     ny, nx = values.shape
     step = max(1, math.ceil(math.sqrt(nx * ny / MAX_CELLS)))
     ii, jj = np.arange(0, nx, step), np.arange(0, ny, step)

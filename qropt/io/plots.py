@@ -14,8 +14,9 @@ from matplotlib.patches import Polygon  # noqa: E402
 
 from qropt.errors import InvalidParameter  # noqa: E402
 from qropt.io import drawing  # noqa: E402
-from qropt.io.paths import picture_path  # noqa: E402
 from qropt.mechanisms import Mechanism  # noqa: E402
+from qropt.synthesis import criteria  # noqa: E402
+from qropt.validate import picture_path  # noqa: E402
 
 
 def draw_shapes(ax, shapes, color="k", alpha=1.0, labels=True, joint_color=None) -> list:
@@ -440,3 +441,186 @@ def _drawn_at(m) -> float:
     """A crank angle that shows a design's links apart: 30% into its working stroke (rad)."""
     start, length = m.working_arc()
     return start + 0.3 * length
+
+
+def chart_figure(ch):
+    """The chart's figure (matplotlib): one panel for the objective, one per free parameter, one for how each
+    cell was solved; with a fixed parameter on y, the best y of each x is drawn as a dashed ridge."""
+    names = ["objective", *ch.problem.free]
+    xs, xlabel = ch.x.shown(ch.problem)
+    note = ", ".join(
+        [
+            f"{k} = {v:g}"
+            for k, v in ch.problem.fixed.items()
+            if k != getattr(ch.y, "name", "") and k in ch.problem.mechanism.LENGTHS and k != ch.x.name
+        ]
+        + [
+            f"{k} = {v:g}"
+            for k, v in ch.problem.targets.items()
+            if k not in (ch.x.name, getattr(ch.y, "name", "")) and k != "swing"
+        ]
+    )
+    title = f"{ch.problem.name or ch.problem.mechanism.__name__}: {ch.problem.mechanism.KIND}" + (
+        f", {note}" if note else ""
+    )
+    s = ch.stats
+    how = (
+        f"{s['cells']} cells: {s['continued']} continued, {s['full']} full solves ({s['needed']} needed), "
+        f"{s['no_design']} without a design, {s['jumps'] + s['switched']} branch changes"
+    )
+    if ch.y is None:
+        fig, axes = plt.subplots(len(names), 1, figsize=(7, 2.2 * len(names)), sharex=True, squeeze=False)
+        for ax, name in zip(axes[:, 0], names, strict=True):
+            z, label = ch.panel(name)
+            ax.plot(xs, z[0], "o-", ms=3)
+            ax.plot(xs[ch.mask("infeasible")[0]], np.zeros(ch.mask("infeasible").sum()), "x", color="0.5")
+            ax.set_ylabel(label, fontsize=8)
+            ax.grid(alpha=0.3)
+        axes[-1, 0].set_xlabel(xlabel)
+        fig.suptitle(f"{title}\n{how}", fontsize=9)
+        fig.tight_layout()
+        return fig
+    ys, ylabel = ch.y.shown(ch.problem)
+    n = len(names) + 1
+    cols = 3 if n > 4 else 2
+    rows = -(-n // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(5.2 * cols, 3.9 * rows), squeeze=False)
+    bad, change = ch.mask("infeasible"), ch.mask("jump") | ch.mask("switched")
+    gx, gy = np.meshgrid(xs, ys)
+    ridge = None
+    if ch.y.kind == "fixed":  # a design choice on y: its best value for each x
+        z = ch.panel("objective")[0]
+        sign = criteria.sense(ch.problem.objective)
+        cols_ok = np.isfinite(z).any(axis=0)
+        ridge = (xs[cols_ok], ys[np.nanargmax(sign * np.where(np.isfinite(z), z, -np.inf * sign), axis=0)][cols_ok])
+    for ax, name in zip(axes.flat, names, strict=False):
+        z, label = ch.panel(name)
+        zm = np.ma.masked_invalid(z)
+        if name == "objective":
+            filled = ax.contourf(gx, gy, zm, levels=12, cmap="viridis")
+            fig.colorbar(filled, ax=ax, shrink=0.9)
+            lines = ax.contour(gx, gy, zm, levels=filled.levels[::2], colors="k", linewidths=0.6)
+        else:
+            lines = ax.contour(gx, gy, zm, levels=10, cmap="copper", linewidths=1.0)
+        ax.clabel(lines, fontsize=7, fmt="%.3g")
+        ax.set_title(label, fontsize=10)
+    how_ax = axes.flat[len(names)]
+    how_ax.set_title("how each cell was solved", fontsize=10)
+    code = np.select([bad, ch.mask("needed"), ch.mask("full")], [3, 2, 1], 0)
+    colours = matplotlib.colors.ListedColormap(["#dfe9f5", "#4c72b0", "#dd8452", "0.55"])
+    how_ax.pcolormesh(gx, gy, code, cmap=colours, vmin=-0.5, vmax=3.5, shading="nearest")
+    how_ax.set_xlim(xs.min(), xs.max())
+    how_ax.set_ylim(ys.min(), ys.max())
+    labels = ["continued", "full solve (tile start, check, closed form)", "full solve needed", "no design"]
+    handles = [matplotlib.patches.Patch(color=colours(k), label=t) for k, t in enumerate(labels)]
+    how_ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
+    for ax in axes.flat[:n]:
+        ax.plot(gx[bad], gy[bad], "x", color="0.35", ms=4, mew=0.8, ls="none")
+        ax.plot(gx[change], gy[change], "o", mfc="none", mec="red", ms=6, mew=1.0, ls="none")
+        if ridge is not None:
+            ax.plot(*ridge, "--", color="crimson", lw=1.2)
+        ax.set_xlabel(xlabel, fontsize=8)
+        ax.set_ylabel(ylabel, fontsize=8)
+        ax.tick_params(labelsize=7)
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    fig.suptitle(
+        f"{title}\n{how}\nx: no design, red ring: branch change"
+        + ("; dashed: best " + ch.y.name + " for each " + ch.x.name if ridge is not None else ""),
+        fontsize=9,
+    )
+    fig.tight_layout()
+    return fig
+
+
+def polygon_figure(rm, units: str = "m"):
+    """The velocity and acceleration polygons drawn to scale: each equation's terms head to tail from the pole o
+    (a vector already drawn is not drawn again), the joint's exact vector dashed from o."""
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.6))
+    colours = {
+        "absolute": "k",
+        "relative": "tab:blue",
+        "normal": "tab:green",
+        "tangential": "tab:orange",
+        "sliding": "tab:purple",
+        "coriolis": "tab:red",
+    }
+    for ax, quantity, unit in ((axes[0], "velocity", f"{units}/s"), (axes[1], "acceleration", f"{units}/s^2")):
+        drawn = set()
+        eqs = [e for e in rm.equations if e.quantity == quantity]
+        gap = 0.025 * max([float(np.hypot(*t.vector)) for e in eqs for t in e.terms] + [1e-300])
+        segments: set = set()
+        for e in eqs:
+            head = np.zeros(2)
+            for t in e.terms:
+                tip = head + t.vector
+                seg = tuple(np.round(np.r_[head, tip] / gap, 3))  # a vector drawn already (a known absolute term)
+                if t.magnitude > 0 and seg not in segments:
+                    segments.add(seg)
+                    style = {"arrowstyle": "->", "color": colours[t.kind], "lw": 1.4}
+                    ax.annotate("", xy=tip, xytext=head, arrowprops=style)
+                    ax.plot([head[0], tip[0]], [head[1], tip[1]], alpha=0.0)  # (arrows do not set the limits)
+                    normal = np.array([-t.vector[1], t.vector[0]]) / t.magnitude  # labels on the left of a term
+                    mid = head + 0.5 * t.vector + gap * normal
+                    ha = "right" if normal[0] < -0.3 else "left" if normal[0] > 0.3 else "center"
+                    ax.text(*mid, t.name, fontsize=7, color=colours[t.kind], ha=ha, va="center")
+                head = tip
+            if e.joint not in drawn:  # the joint's exact vector from the pole, once
+                ax.plot([0, e.exact[0]], [0, e.exact[1]], ls="--", color="0.5", lw=0.8)
+                ax.text(*e.exact, f" {e.joint}", fontsize=8, color="0.3")
+                drawn.add(e.joint)
+        ax.plot(0, 0, "ko", ms=4)
+        ax.text(0, 0, " o", fontsize=9)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_xlabel(f"x [{unit}]")
+        ax.set_ylabel(f"y [{unit}]")
+        ax.set_title(f"{quantity} polygon")
+        ax.grid(alpha=0.3)
+    for kind, c in colours.items():
+        axes[1].plot([], [], color=c, label=kind)
+    axes[1].legend(fontsize=7, loc="best")
+    title = f"theta2 = {math.degrees(rm.theta2):.1f} deg, omega2 = {rm.omega2:g} rad/s, alpha2 = {rm.alpha2:g} rad/s^2"
+    fig.suptitle(title + "; dashed: each joint's exact vector from the pole o")
+    fig.tight_layout()
+    return fig
+
+
+def servo_figure(profile):
+    """A servo speed profile's figure: omega2, slider v and a (and the torque when given) against time, limits
+    dashed, working stroke shaded."""
+    s = profile.motion()
+    rows = [
+        ("crank omega2 [rad/s]", s.omega, ["omega_max"]),
+        ("slider v [m/s]", s.v, ["v_max", "v_cut"]),
+        ("slider a [m/s^2]", s.a, ["a_max"]),
+    ]
+    if profile.peak_torque is not None:
+        rows.append(("motor torque [N m]", s.torque, ["torque_max"]))
+    fig, axes = plt.subplots(len(rows), 1, figsize=(8, 2.2 * len(rows) + 0.6), sharex=True)
+    tw = profile.working_time
+    for ax, (label, y, names) in zip(axes, rows, strict=True):
+        ax.plot(s.t, y, color="tab:blue", lw=1.5)
+        ax.axvspan(0.0, tw, color="tab:orange", alpha=0.12, lw=0)
+        for name in names:
+            v = profile.limits.get(name)
+            if v is not None:
+                for i, sign in enumerate((1, -1) if name != "omega_max" else (1,)):
+                    ax.axhline(
+                        sign * v,
+                        color="tab:red" if name != "v_cut" else "tab:green",
+                        ls="--",
+                        lw=1,
+                        label=None if i else ("cutting speed" if name == "v_cut" else f"limit {name}"),
+                    )
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="lower right", fontsize=7, framealpha=0.9)
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    axes[-1].set_xlabel("time [s]")
+    axes[0].set_title(
+        f"{type(profile.mechanism).__name__} servo profile: cycle {profile.cycle_time:.4g} s, "
+        f"time ratio {profile.time_ratio:.3f} (working stroke shaded)",
+        fontsize=10,
+    )
+    fig.tight_layout()
+    return fig

@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from qropt.errors import InvalidParameter
-from qropt.io.paths import output_path
 from qropt.synthesis import analytic
+from qropt.validate import output_path
 
 # The paper's printed values (its claims, shown beside the exact ones). Table 5: theta2 = 60 deg, omega2 = 10 rad/s.
 TABLE5 = {
@@ -286,7 +286,7 @@ def _forces(m) -> str:
 def _polygons(m) -> str:
     """Analysis 1 by relative motion: the paper's Tables 2-3 beside qropt's polygons, the polygons drawn, and
     every term."""
-    from qropt.mechanisms.relative_motion import polygon_figure
+    from qropt.io.plots import polygon_figure
 
     rm = m.relative_motion(math.radians(60), 10.0, 0.0)
     terms = rm.terms()
@@ -343,7 +343,7 @@ def design_page(m, theta2: float = 0.0, omega2: float = 1.0) -> str:
     its forces under the report's assumed masses and load (``FORCES``)."""
     from qropt.errors import QroptError
     from qropt.io import plots
-    from qropt.mechanisms.relative_motion import polygon_figure
+    from qropt.io.plots import polygon_figure
 
     u, kinds = m.units, m.kinds()
     g, d = m.gamma_min(), m.dead_centres()

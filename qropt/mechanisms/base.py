@@ -451,12 +451,6 @@ class Mechanism:
         # cached properties write to __dict__ directly, so only user assignments arrive here
         raise AttributeError(f"{type(self).__name__} is immutable")
 
-    def _repr_html_(self) -> str:
-        """The mechanism in a notebook: its picture and key numbers (self-contained HTML)."""
-        from qropt.io.notebook import mechanism_html
-
-        return mechanism_html(self)
-
     def __repr__(self):
         given = [f"{k}={v:g}" for k, v in self.params.items()]
         given += [f"units={self.units!r}"] if self.units != units_.DEFAULT else []

@@ -65,12 +65,6 @@ class RelativeMotion:
     alpha2: float
     equations: tuple
 
-    def plot(self, path, units: str = "m") -> None:
-        """The polygons drawn to scale (``polygon_figure``), PNG, PDF or SVG by the path's suffix."""
-        from qropt.io import plots
-
-        plots.save(polygon_figure(self, units), path)
-
     def terms(self) -> dict:
         """Term name -> Term (each equation's terms, velocities first)."""
         return {t.name: t for e in self.equations for t in e.terms}
@@ -90,60 +84,6 @@ class RelativeMotion:
             for e in self.equations
             for t in e.terms
         ]
-
-
-def polygon_figure(rm: RelativeMotion, units: str = "m"):
-    """The velocity and acceleration polygons drawn to scale: each equation's terms head to tail from the pole o
-    (a vector already drawn is not drawn again), the joint's exact vector dashed from o."""
-    from qropt.io import plots
-
-    fig, axes = plots.plt.subplots(1, 2, figsize=(12, 5.6))
-    colours = {
-        "absolute": "k",
-        "relative": "tab:blue",
-        "normal": "tab:green",
-        "tangential": "tab:orange",
-        "sliding": "tab:purple",
-        "coriolis": "tab:red",
-    }
-    for ax, quantity, unit in ((axes[0], "velocity", f"{units}/s"), (axes[1], "acceleration", f"{units}/s^2")):
-        drawn = set()
-        eqs = [e for e in rm.equations if e.quantity == quantity]
-        gap = 0.025 * max([float(np.hypot(*t.vector)) for e in eqs for t in e.terms] + [1e-300])
-        segments: set = set()
-        for e in eqs:
-            head = np.zeros(2)
-            for t in e.terms:
-                tip = head + t.vector
-                seg = tuple(np.round(np.r_[head, tip] / gap, 3))  # a vector drawn already (a known absolute term)
-                if t.magnitude > 0 and seg not in segments:
-                    segments.add(seg)
-                    style = {"arrowstyle": "->", "color": colours[t.kind], "lw": 1.4}
-                    ax.annotate("", xy=tip, xytext=head, arrowprops=style)
-                    ax.plot([head[0], tip[0]], [head[1], tip[1]], alpha=0.0)  # (arrows do not set the limits)
-                    normal = np.array([-t.vector[1], t.vector[0]]) / t.magnitude  # labels on the left of a term
-                    mid = head + 0.5 * t.vector + gap * normal
-                    ha = "right" if normal[0] < -0.3 else "left" if normal[0] > 0.3 else "center"
-                    ax.text(*mid, t.name, fontsize=7, color=colours[t.kind], ha=ha, va="center")
-                head = tip
-            if e.joint not in drawn:  # the joint's exact vector from the pole, once
-                ax.plot([0, e.exact[0]], [0, e.exact[1]], ls="--", color="0.5", lw=0.8)
-                ax.text(*e.exact, f" {e.joint}", fontsize=8, color="0.3")
-                drawn.add(e.joint)
-        ax.plot(0, 0, "ko", ms=4)
-        ax.text(0, 0, " o", fontsize=9)
-        ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel(f"x [{unit}]")
-        ax.set_ylabel(f"y [{unit}]")
-        ax.set_title(f"{quantity} polygon")
-        ax.grid(alpha=0.3)
-    for kind, c in colours.items():
-        axes[1].plot([], [], color=c, label=kind)
-    axes[1].legend(fontsize=7, loc="best")
-    title = f"theta2 = {math.degrees(rm.theta2):.1f} deg, omega2 = {rm.omega2:g} rad/s, alpha2 = {rm.alpha2:g} rad/s^2"
-    fig.suptitle(title + "; dashed: each joint's exact vector from the pole o")
-    fig.tight_layout()
-    return fig
 
 
 def relative_motion(m, theta2: float, omega2: float = 1.0, alpha2: float = 0.0) -> RelativeMotion:
@@ -251,4 +191,4 @@ def _parts(v):
     return [float(v), 0.0, 0.0]
 
 
-__all__ = ["relative_motion", "RelativeMotion", "Equation", "Term", "polygon_figure"]
+__all__ = ["relative_motion", "RelativeMotion", "Equation", "Term"]

@@ -20,9 +20,8 @@ import numpy as np
 
 from qropt import validate
 from qropt.errors import ChartError, QroptError
-from qropt.io.paths import picture_path
 from qropt.synthesis import criteria
-from qropt.synthesis.criteria import maximises, sense
+from qropt.synthesis.criteria import maximises
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import STATUSES, Result
 from qropt.units import named
@@ -50,6 +49,15 @@ class Axis(NamedTuple):
     name: str
     values: tuple
     kind: str  # 'target' or 'fixed'
+
+    def shown(self, problem=None) -> tuple:
+        """Display values and label: swing in degrees, a length (the stroke, a parameter) in the problem's unit."""
+        if self.name == "swing":
+            return np.degrees(self.values), "swing [deg]"
+        label = self.name.replace("_", " ")
+        if problem is not None and (self.name == "stroke" or self.name in problem.mechanism.PARAMS):
+            label += f" [{problem.units}]"
+        return np.asarray(self.values), label
 
 
 @dataclass(frozen=True, eq=False, repr=False)
@@ -254,6 +262,18 @@ class Chart:
                 out[k] = v
         return out.reshape(self.shape)
 
+    def panel(self, name: str = "objective") -> tuple:
+        """(values, title) of one panel of the chart's pictures: the objective (gamma_min in degrees, with its unit)
+        or a free parameter, in the problem's unit."""
+        if name != "objective":
+            return self.grid(name), f"optimal {name} [{self.problem.units}]"
+        if maximises(self.problem.objective):  # gamma_min, the one maximised criterion
+            return np.degrees(self.grid()), "best gamma_min [deg]"
+        if not self.problem.objective:
+            return self.grid(), "feasible: objective"
+        unit = named(criteria.of_problem(self.problem).unit, self.problem.units)
+        return self.grid(), f"{self.problem.objective}: objective [{unit}]"
+
     FLAGS = ("certified", "infeasible", "continued", "full", "needed", "jump", "switched")
 
     def mask(self, flag: str) -> np.ndarray:
@@ -281,12 +301,6 @@ class Chart:
             f"{s['full']} full ({s['needed']} needed), {s['jumps']} jumps, {s['switched']} switched; "
             f"{s['seconds']:.3g} s, {s['scheduler']})"
         )
-
-    def _repr_html_(self) -> str:
-        """The chart in a notebook: a heat map of the objective and a table of cells (HTML)."""
-        from qropt.io.notebook import chart_html
-
-        return chart_html(self)
 
     # ---- files ------------------------------------------------------------------------------------------
     def rows(self) -> list[dict]:
@@ -377,22 +391,6 @@ class Chart:
             if (c.i, c.j) != (k % nx, k // nx):
                 raise ChartError(f"cell {k} is ({c.i}, {c.j}), not ({k % nx}, {k // nx}): cells are in row order")
         return cls(problem, x, y, cells, dict(d["stats"]))
-
-    def plot(self, path, dpi: int = 90) -> None:
-        """Contour charts of the objective and the optimal free parameters beside how each cell was solved;
-        cells without a design are crossed, branch changes ringed (PNG, PDF or SVG by the path's suffix)."""
-        import matplotlib.pyplot as plt
-
-        picture_path(path)
-        if isinstance(dpi, bool) or not isinstance(dpi, (int, float, np.integer, np.floating)) or not 10 <= dpi <= 1200:
-            raise ChartError(f"dpi must be a number from 10 to 1200, got {dpi!r}")
-        fig = chart_figure(self)
-        try:
-            fig.savefig(path, dpi=dpi)
-        except OSError as e:
-            raise ChartError(f"cannot write the chart picture {path}: {e.strerror or e}") from None
-        finally:
-            plt.close(fig)
 
 
 def _path(path, what):
@@ -510,122 +508,4 @@ def _index(axis: Axis, v) -> int:
 
 
 # ---- the picture ---------------------------------------------------------------------------------------------
-def _shown(axis: Axis, problem=None) -> tuple:
-    """Display values and label of an axis: swing in degrees, a length (the stroke, a parameter) in the problem's
-    unit."""
-    if axis.name == "swing":
-        return np.degrees(axis.values), "swing [deg]"
-    label = axis.name.replace("_", " ")
-    if problem is not None and (axis.name == "stroke" or axis.name in problem.mechanism.PARAMS):
-        label += f" [{problem.units}]"
-    return np.asarray(axis.values), label
-
-
-def _panel(ch: Chart, name: str) -> tuple:
-    """Values and title of one panel: the objective (gamma_min in degrees) or a parameter."""
-    if name != "objective":
-        return ch.grid(name), f"optimal {name} [{ch.problem.units}]"
-    if maximises(ch.problem.objective):  # gamma_min, the one maximised criterion
-        return np.degrees(ch.grid()), "best gamma_min [deg]"
-    if not ch.problem.objective:
-        return ch.grid(), "feasible: objective"
-    unit = named(criteria.of_problem(ch.problem).unit, ch.problem.units)
-    return ch.grid(), f"{ch.problem.objective}: objective [{unit}]"
-
-
-def chart_figure(ch: Chart):
-    """The chart's figure (matplotlib): one panel for the objective, one per free parameter, one for how each
-    cell was solved; with a fixed parameter on y, the best y of each x is drawn as a dashed ridge."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    names = ["objective", *ch.problem.free]
-    xs, xlabel = _shown(ch.x, ch.problem)
-    note = ", ".join(
-        [
-            f"{k} = {v:g}"
-            for k, v in ch.problem.fixed.items()
-            if k != getattr(ch.y, "name", "") and k in ch.problem.mechanism.LENGTHS and k != ch.x.name
-        ]
-        + [
-            f"{k} = {v:g}"
-            for k, v in ch.problem.targets.items()
-            if k not in (ch.x.name, getattr(ch.y, "name", "")) and k != "swing"
-        ]
-    )
-    title = f"{ch.problem.name or ch.problem.mechanism.__name__}: {ch.problem.mechanism.KIND}" + (
-        f", {note}" if note else ""
-    )
-    s = ch.stats
-    how = (
-        f"{s['cells']} cells: {s['continued']} continued, {s['full']} full solves ({s['needed']} needed), "
-        f"{s['no_design']} without a design, {s['jumps'] + s['switched']} branch changes"
-    )
-    if ch.y is None:
-        fig, axes = plt.subplots(len(names), 1, figsize=(7, 2.2 * len(names)), sharex=True, squeeze=False)
-        for ax, name in zip(axes[:, 0], names, strict=True):
-            z, label = _panel(ch, name)
-            ax.plot(xs, z[0], "o-", ms=3)
-            ax.plot(xs[ch.mask("infeasible")[0]], np.zeros(ch.mask("infeasible").sum()), "x", color="0.5")
-            ax.set_ylabel(label, fontsize=8)
-            ax.grid(alpha=0.3)
-        axes[-1, 0].set_xlabel(xlabel)
-        fig.suptitle(f"{title}\n{how}", fontsize=9)
-        fig.tight_layout()
-        return fig
-    ys, ylabel = _shown(ch.y, ch.problem)
-    n = len(names) + 1
-    cols = 3 if n > 4 else 2
-    rows = -(-n // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(5.2 * cols, 3.9 * rows), squeeze=False)
-    bad, change = ch.mask("infeasible"), ch.mask("jump") | ch.mask("switched")
-    gx, gy = np.meshgrid(xs, ys)
-    ridge = None
-    if ch.y.kind == "fixed":  # a design choice on y: its best value for each x
-        z = _panel(ch, "objective")[0]
-        sign = sense(ch.problem.objective)
-        cols_ok = np.isfinite(z).any(axis=0)
-        ridge = (xs[cols_ok], ys[np.nanargmax(sign * np.where(np.isfinite(z), z, -np.inf * sign), axis=0)][cols_ok])
-    for ax, name in zip(axes.flat, names, strict=False):
-        z, label = _panel(ch, name)
-        zm = np.ma.masked_invalid(z)
-        if name == "objective":
-            filled = ax.contourf(gx, gy, zm, levels=12, cmap="viridis")
-            fig.colorbar(filled, ax=ax, shrink=0.9)
-            lines = ax.contour(gx, gy, zm, levels=filled.levels[::2], colors="k", linewidths=0.6)
-        else:
-            lines = ax.contour(gx, gy, zm, levels=10, cmap="copper", linewidths=1.0)
-        ax.clabel(lines, fontsize=7, fmt="%.3g")
-        ax.set_title(label, fontsize=10)
-    how_ax = axes.flat[len(names)]
-    how_ax.set_title("how each cell was solved", fontsize=10)
-    code = np.select([bad, ch.mask("needed"), ch.mask("full")], [3, 2, 1], 0)
-    colours = matplotlib.colors.ListedColormap(["#dfe9f5", "#4c72b0", "#dd8452", "0.55"])
-    how_ax.pcolormesh(gx, gy, code, cmap=colours, vmin=-0.5, vmax=3.5, shading="nearest")
-    how_ax.set_xlim(xs.min(), xs.max())
-    how_ax.set_ylim(ys.min(), ys.max())
-    labels = ["continued", "full solve (tile start, check, closed form)", "full solve needed", "no design"]
-    handles = [matplotlib.patches.Patch(color=colours(k), label=t) for k, t in enumerate(labels)]
-    how_ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
-    for ax in axes.flat[:n]:
-        ax.plot(gx[bad], gy[bad], "x", color="0.35", ms=4, mew=0.8, ls="none")
-        ax.plot(gx[change], gy[change], "o", mfc="none", mec="red", ms=6, mew=1.0, ls="none")
-        if ridge is not None:
-            ax.plot(*ridge, "--", color="crimson", lw=1.2)
-        ax.set_xlabel(xlabel, fontsize=8)
-        ax.set_ylabel(ylabel, fontsize=8)
-        ax.tick_params(labelsize=7)
-    for ax in axes.flat[n:]:
-        ax.set_visible(False)
-    fig.suptitle(
-        f"{title}\n{how}\nx: no design, red ring: branch change"
-        + ("; dashed: best " + ch.y.name + " for each " + ch.x.name if ridge is not None else ""),
-        fontsize=9,
-    )
-    fig.tight_layout()
-    return fig
-
-
-__all__ = ["Chart", "Cell", "Axis", "ChartError", "axis_kind", "problem_at", "chart_figure"]
+__all__ = ["Chart", "Cell", "Axis", "ChartError", "axis_kind", "problem_at"]

@@ -166,12 +166,6 @@ class Comparison:
                 lines.append(f"  {r.type:20s} no design: {r.reason}")
         return "\n".join(lines)
 
-    def _repr_html_(self) -> str:
-        """The comparison in a notebook: the ranked table and each design's picture (HTML)."""
-        from qropt.io.notebook import comparison_html
-
-        return comparison_html(self)
-
     def markdown(self) -> str:
         """The comparison as a Markdown table, best first: gamma_min in degrees, each criterion in its unit to four
         significant digits, the chosen parameters (lengths in the unit, angles in degrees)."""
@@ -232,12 +226,6 @@ class Comparison:
                         self.units,
                     ]
                 )
-
-    def plot(self, path) -> None:
-        """The designs side by side at one scale, each with its numbers (and the fronts, if computed)."""
-        from qropt.io.plots import comparison_figure, save
-
-        save(comparison_figure(self), path)
 
 
 def task_problems(

@@ -75,12 +75,6 @@ class Family:
     folds: list
     stats: dict
 
-    def _repr_html_(self) -> str:
-        """The family in a notebook: its curve in two free parameters and a table of points (HTML)."""
-        from qropt.io.notebook import family_html
-
-        return family_html(self)
-
     def points(self):
         return [p for b in self.branches for p in b]
 

@@ -48,12 +48,6 @@ class Front:
             lines.append("  ...")
         return "\n".join(lines)
 
-    def _repr_html_(self) -> str:
-        """The front in a notebook: a scatter of its two criteria and a table (HTML)."""
-        from qropt.io.notebook import front_html
-
-        return front_html(self)
-
     def table(self) -> list[dict]:
         a, b = self.criteria
         return [
@@ -68,12 +62,6 @@ class Front:
             w.writerow(names)
             for r in rows:
                 w.writerow([f"{r[k]:.12g}" if isinstance(r[k], float) else r[k] for k in names])
-
-    def plot(self, path) -> None:
-        """The front in the two criteria, with the designs drawn at a few points."""
-        from qropt.io.plots import front_figure, save
-
-        save(front_figure(self), path)
 
 
 def pareto(

@@ -414,8 +414,12 @@ def working_fractions(m, extremes, above) -> list:
 CRITERIA: dict[str, Criterion] = {}
 
 
-def register(criterion: Criterion) -> Criterion:
-    """Add a criterion (an instance); its name, objective and bound must be new."""
+BUILT_IN: list[str] = []  # the shipped criteria's names (registered with built_in=True; they cannot be removed)
+
+
+def register(criterion: Criterion, *, built_in: bool = False) -> Criterion:
+    """Add a criterion (an instance); its name, objective and bound must be new. ``built_in``: one of qropt's own
+    (here and in ``qropt.synthesis.dynamic``)."""
     if not isinstance(criterion, Criterion):
         raise ProblemError(f"register takes a Criterion instance, got {criterion!r}")
     for other in CRITERIA.values():
@@ -423,6 +427,8 @@ def register(criterion: Criterion) -> Criterion:
         if clash or (criterion.objective == other.objective and not (criterion.size and other.size)):
             raise ProblemError(f"criterion {criterion.name!r} clashes with {other.name!r}")
     CRITERIA[criterion.name] = criterion
+    if built_in:
+        BUILT_IN.append(criterion.name)
     return criterion
 
 
@@ -434,10 +440,7 @@ def unregister(name: str) -> None:
 
 
 for _c in (GammaMin(), SizeSum(), SizeLongest(), Footprint(), PeakAcceleration(), PeakVelocity()):
-    register(_c)
-from qropt.synthesis import dynamic  # noqa: E402,F401 - registers the dynamic criteria (it imports this module)
-
-BUILT_IN = tuple(CRITERIA)
+    register(_c, built_in=True)
 
 
 def objectives() -> tuple:

@@ -210,7 +210,8 @@ class _Symbolic:
         ram's row (``friction_load``; 0 without friction). The cutting force on (``working`` True), off (False)
         or by the ram's velocity (None); the friction against the ram's velocity, or its stroke's direction where
         ``working`` is given; ``lengths`` as ``mass_model``."""
-        from qropt.dynamics.inverse import Elimination, friction_load
+        from qropt.dynamics.elimination import Elimination
+        from qropt.dynamics.inverse import friction_load
 
         self.no_lock()
         f, s = self.f, self.system()
@@ -253,7 +254,7 @@ class _Symbolic:
     def no_lock(self):
         """Rows that keep the slide from locking (mu |dN/dF| <= NO_LOCK, where ``friction_load`` holds) at every
         sample, once per formulation, from the first expression that needs them; none without friction."""
-        from qropt.dynamics.inverse import Elimination
+        from qropt.dynamics.elimination import Elimination
 
         col = self.guide()
         if col is None or getattr(self, "_no_lock", False):
@@ -571,6 +572,6 @@ class PeakBearingForce(_Squared):
 
 
 for _c in (PeakTorque(), RmsTorque(), ShakingForce(), PeakBearingForce()):
-    register(_c)
+    register(_c, built_in=True)
 
 __all__ = ["PeakTorque", "RmsTorque", "ShakingForce", "PeakBearingForce"]

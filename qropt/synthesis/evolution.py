@@ -187,14 +187,14 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
     found.sort(key=lambda f: f[0])
     chosen: list[dict] = []
     for _, d in found:
-        if all(_apart(problem, d, c) for c in chosen):
+        if all(apart(problem, d, c) for c in chosen):
             chosen.append(d)
             if len(chosen) == keep:
                 break
     return chosen
 
 
-def _apart(problem, a: dict, b: dict) -> bool:
+def apart(problem, a: dict, b: dict) -> bool:
     """Whether two designs differ by DISTINCT in some free parameter (in log for lengths, of its range else)."""
     kinds = problem.mechanism.kinds()
     for k, (lo, hi) in problem.free.items():
@@ -287,39 +287,6 @@ def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dic
     return best[0]
 
 
-def descended(
-    problem, generations: int, seed: int, keep: int = KEEP, evals: int | None = None, sqp: bool = False
-) -> list[End]:
-    """The ``descents`` of an evolution's designs (``evolve``: ``generations`` from ``seed``, ``keep`` of them)."""
-    return descents(problem, evolve(problem, generations, seed, keep), evals, sqp)
-
-
-def descents(problem, designs: list[dict], evals: int | None = None, sqp: bool = False) -> list[End]:
-    """The designs, each put on the targets and descended by Nelder-Mead (``descend``, ``evals`` evaluations); with
-    ``sqp``, where the objective is a peak over the turn, the SQP on its exact extremes (``minimax.polish``) runs
-    from the design and from Nelder-Mead's end too (the two often reach different minima; the ends then kept where
-    they differ, ``_apart``). The ends, best first."""
-    from qropt.synthesis import minimax  # it builds on this module
-
-    ends: list[End] = []
-    sqp = sqp and minimax.applies(problem)
-    for d in designs:
-        on = on_targets(problem, d)
-        if on is None:
-            continue
-        got = descend(problem, on, evals)
-        for x in ([on] + ([got[1]] if got is not None else [])) if sqp else []:
-            if (p := minimax.polish(problem, x)) is not None:
-                ends.append(End(p.value, p.design, p.local))  # first: at a tie its end says what holds
-        if got is not None:
-            ends.append(End(got[0], got[1], DESCENT_LOCAL))
-    distinct: list[End] = []
-    for e in sorted(ends, key=lambda e: e.value):
-        if not sqp or all(_apart(problem, e.design, x.design) for x in distinct):
-            distinct.append(e)
-    return distinct
-
-
 __all__ = [
     "End",
     "applies",
@@ -327,8 +294,7 @@ __all__ = [
     "evolve",
     "on_targets",
     "descend",
-    "descended",
-    "descents",
+    "apart",
     "outside",
     "value",
     "CRANK",

@@ -17,7 +17,7 @@ import numpy as np
 
 from qropt.errors import QroptError
 from qropt.synthesis import atlas as atlas_
-from qropt.synthesis import criteria, evolution
+from qropt.synthesis import criteria, descents, evolution
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.certificate import Designs
 from qropt.synthesis.local import Candidate, LocalSolve, nlp_value
@@ -158,7 +158,7 @@ class MultiStart:
             return [], "", []
         if not evolution.applies(problem):
             return [], "", []
-        each = [evolution.descended(problem, EVOLUTION_GENERATIONS, seed + i, sqp=sqp) for i in range(count)]
+        each = [descents.descended(problem, EVOLUTION_GENERATIONS, seed + i, sqp=sqp) for i in range(count)]
         runs = [("evolution", e.design) for ends in each for e in ends[: evolution.KEEP]]  # the best distinct ends
         out = self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
         which = (

@@ -160,12 +160,6 @@ class Result:
         lines.append(f"  max_violation: {self.max_violation:.1e}, time {self.stats.get('t_total') or 0.0:.3g} s")
         return "\n".join(lines)
 
-    def _repr_html_(self) -> str:
-        """The result in a notebook: status, design, quantities, certificate and picture (HTML)."""
-        from qropt.io.notebook import result_html
-
-        return result_html(self)
-
     def summary(self) -> str:
         """A few readable lines: status, design, quantities (gamma_min in degrees), certificate."""
         lines = [f"status: {self.status} - {self.message}"]
