@@ -19,8 +19,7 @@ from qropt.examples import paper_mechanism
 from qropt.io import drawing, export, plots
 from qropt.io.animation import animate
 from qropt.kinematics.closures import rod_lines, rod_to_line
-from qropt.mechanisms import TYPES, Mechanism
-from qropt.mechanisms.base import REQUIRED, Body, Loop, Rule
+from qropt.mechanisms import REQUIRED, TYPES, Body, Loop, Mechanism, Rule
 
 SVG = "{http://www.w3.org/2000/svg}"
 

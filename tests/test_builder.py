@@ -25,7 +25,7 @@ from qropt.kinematics.closures import (
     transmission_cos,
 )
 from qropt.kinematics.ops import CASADI, JET, NUMPY, Jet
-from qropt.mechanisms.base import Body, Loop
+from qropt.mechanisms import Body, Loop
 from qropt.mechanisms.builder import Linkage, LinkageError
 from qropt.mechanisms.four_bar import four_bar as four_bar_closure  # the four-bar the hand-written loops used
 from tests import randmech

@@ -2,7 +2,7 @@
 
 Nothing here knows a type: the bodies (``Mechanism.bodies()``), the ground pivots (``GROUND``) and the output
 joint (``output_joint()``) are the type's declarations, checked against the joints of its loop before anything is
-drawn (``BodyError`` naming the joint). How each kind of body is drawn is in ``qropt.mechanisms.base.Body``. Sizes
+drawn (``BodyError`` naming the joint). How each kind of body is drawn is in ``qropt.mechanisms.values.Body``. Sizes
 of blocks and joint circles follow the size of the whole mechanism over a turn; lengths in the mechanism's unit.
 """
 
@@ -17,7 +17,7 @@ import numpy as np
 from qropt.errors import AssemblyError, BodyError, InvalidParameter
 from qropt.kinematics.ops import NUMPY
 from qropt.mechanisms import Mechanism
-from qropt.mechanisms.base import BODY_KINDS, Body
+from qropt.mechanisms.values import BODY_KINDS, Body
 
 LAYERS = {"LINKS": 7, "PIVOTS": 1, "JOINTS": 5, "SLIDE_LINE": 8, "SLIDER_PATH": 4, "BLOCKS": 3}  # name -> DXF colour
 JOINTS = {"bar": (2, None), "plate": (3, None), "slot-lever": (2, None), "block": (2, 2), "ram": (1, 1), "yoke": (1, 1)}

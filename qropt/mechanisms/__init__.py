@@ -14,28 +14,16 @@ import importlib
 import warnings
 
 from qropt.mechanisms import closures
-from qropt.mechanisms.base import (
-    PARAMETER_KINDS,
-    REGISTRY,
-    REQUIRED,
-    Body,
-    DeadCentres,
-    GammaMin,
-    Loop,
-    Mechanism,
-    Motion,
-    Positions,
-    RegistryError,
-    Rule,
-    register,
-)
+from qropt.mechanisms.base import PARAMETER_KINDS, REQUIRED, Loop, Mechanism
 from qropt.mechanisms.coupler_slider import CouplerSlider
 from qropt.mechanisms.crank_rocker_slider import CrankRockerSlider
 from qropt.mechanisms.crank_shaper import CrankShaper
 from qropt.mechanisms.drag_link_slider import DragLinkSlider
 from qropt.mechanisms.four_bar import FourBar, FourBarSlider, Grashof, four_bar, grashof, grashof_rules
+from qropt.mechanisms.registry import REGISTRY, RegistryError, register
 from qropt.mechanisms.slider_crank import SliderCrank
 from qropt.mechanisms.slot_ram_shaper import SlotRamShaper
+from qropt.mechanisms.values import Body, DeadCentres, GammaMin, Motion, Positions, Rule
 from qropt.mechanisms.whitworth import Whitworth
 
 TYPES = (SliderCrank, CrankShaper, Whitworth, CrankRockerSlider, DragLinkSlider, FourBar, CouplerSlider, SlotRamShaper)

@@ -5,16 +5,17 @@ its ``LENGTHS`` (positive) and ``loop(xp, theta2, p) -> Loop`` written once over
 math namespace. Everything else (positions, rates, dead centres, time ratio,
 stroke, transmission angles, gamma_min, the assembly check) is derived here.
 Angles are radians; lengths are numbers in the mechanism's stated unit (``units="mm"``, a keyword that is not a
-parameter; metres by default, see ``qropt.units``); theta2 counter-clockwise from +x.
+parameter; metres by default, see ``qropt.units``); theta2 counter-clockwise from +x. The values it answers with
+are in ``qropt.mechanisms.values``, the registry of types in ``qropt.mechanisms.registry`` and the exact
+sensitivities in ``qropt.mechanisms.sensitivity``.
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
 from types import MappingProxyType
-from typing import Any, ClassVar, NamedTuple
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -24,28 +25,26 @@ from qropt.kinematics import cycle
 from qropt.kinematics.closures import Loop, transmission_angle
 from qropt.kinematics.kernel import kernel, resolved_spectrum, spectral_derivative, spectrum
 from qropt.kinematics.ops import NUMPY
+from qropt.mechanisms.registry import register
+from qropt.mechanisms.values import (
+    AccelerationExtremes,
+    Body,
+    BoundingBox,
+    DeadCentres,
+    GammaMin,
+    Motion,
+    PeakAcceleration,
+    PeakVelocity,
+    Positions,
+    Rule,
+    Sensitivity,
+    cached_property,
+)
 from qropt.validate import MAGNITUDE, branch_sign, number
 
 REQUIRED = object()  # a PARAMS default: the parameter has none and must be given
-REGISTRY: dict[str, type[Mechanism]] = {}  # KIND -> the type (shipped types and every user type with a KIND)
 PARAMETER_KINDS = ("length", "offset", "angle", "branch")  # what ``Mechanism.kinds()`` says of each parameter
 MAX_ANGLES = 10_000_000  # crank angles evaluated in one call
-
-
-class cached_property:  # noqa: N801 - functools.cached_property without its lock (Python 3.11 takes one per read)
-    """A value computed on first read and kept in the instance's ``__dict__`` (later reads do not come here)."""
-
-    def __init__(self, func):
-        self.func, self.name, self.__doc__ = func, func.__name__, func.__doc__
-
-    def __set_name__(self, owner, name):
-        self.name = name
-
-    def __get__(self, obj, cls=None):
-        if obj is None:
-            return self
-        value = obj.__dict__[self.name] = self.func(obj)
-        return value
 
 
 @functools.cache
@@ -76,190 +75,8 @@ def crank_angles(theta2) -> np.ndarray:
     return t
 
 
-class RegistryError(InvalidParameter):
-    """A mechanism type cannot be registered (its KIND or class name is another class's) or found (an unknown
-    name, a ``"module:Class"`` reference whose module does not import, that has no such class, or that names
-    something that is not a Mechanism)."""
-
-
-def _identity(cls) -> str:
-    """module + qualname: the same class re-imported (a module reload) has the same identity."""
-    return f"{cls.__module__}.{cls.__qualname__}"
-
-
-def register(cls) -> None:
-    """Register a type by its own KIND (``Mechanism.__init_subclass__`` calls it). A KIND or class name (either
-    compared without case, '_' as '-') already held by another class is refused with RegistryError naming both;
-    the same class again (same module and qualname, e.g. a reloaded module) replaces itself."""
-    kind = cls.__dict__.get("KIND")
-    if not kind:
-        return
-    if not isinstance(kind, str):
-        raise RegistryError(f"{_identity(cls)}: KIND is a string (e.g. 'my-slider'), got {kind!r}")
-    key, name = kind.lower().replace("_", "-"), cls.__name__.lower()
-    for other in list(REGISTRY.values()):
-        if _identity(other) == _identity(cls):
-            continue
-        if other.KIND.lower().replace("_", "-") == key:
-            raise RegistryError(
-                f"mechanism KIND {kind!r} of {_identity(cls)} is already taken by {_identity(other)}; "
-                "give the new type its own KIND"
-            )
-        if other.__name__.lower() == name:
-            raise RegistryError(
-                f"mechanism class name {cls.__name__!r} of {_identity(cls)} is already taken by {_identity(other)} "
-                f"(KIND {other.KIND!r}); give the new type its own class name"
-            )
-    for k in [k for k, v in REGISTRY.items() if _identity(v) == _identity(cls)]:
-        del REGISTRY[k]  # a reloaded class (and its earlier KIND, if it changed)
-    REGISTRY[kind] = cls
-
-
-class Rule(NamedTuple):
-    """A feasibility rule of a type, written once over a math namespace: it holds where ``value >= 0``.
-
-    Construction checks it on numbers, the NLP states it as a row, ``reachable`` reads the interval it leaves
-    a parameter (the rules are linear in each length)."""
-
-    name: str
-    value: Any
-
-
-@dataclass(frozen=True)
-class Positions:
-    """Joint coordinates (arrays of shape (n, 2)) and link angles (rad) at the crank angles theta2."""
-
-    theta2: np.ndarray
-    points: dict
-    angles: dict
-    x: np.ndarray
-
-
-class Motion:
-    """Output position x, velocity v, acceleration a and every link's angle, omega, alpha (dicts by angle name,
-    computed on first use).
-
-    Units: length, length/s, length/s^2, rad, rad/s, rad/s^2 (for FourBar x is theta4 in rad).
-    """
-
-    def __init__(self, theta2: np.ndarray, x: np.ndarray, v: np.ndarray, a: np.ndarray, links):
-        self.theta2, self.x, self.v, self.a = theta2, x, v, a
-        self._links = links  # () -> (angles, omega, alpha)
-
-    @cached_property
-    def _rates(self) -> tuple[dict, dict, dict]:
-        return self._links()
-
-    @property
-    def angles(self) -> dict:
-        return self._rates[0]
-
-    @property
-    def omega(self) -> dict:
-        return self._rates[1]
-
-    @property
-    def alpha(self) -> dict:
-        return self._rates[2]
-
-    def __reduce__(self):  # pickled with its link rates computed (the closure that makes them is not data)
-        rates = self._rates
-        return (_motion_of, (self.theta2, self.x, self.v, self.a, rates))
-
-    def __repr__(self):
-        return f"Motion({self.theta2.size} crank angles: x, v, a, and {', '.join(self.angles)})"
-
-
-def _motion_of(theta2, x, v, a, rates) -> Motion:
-    return Motion(theta2, x, v, a, lambda: rates)
-
-
 def _rebuilt(cls, params: dict, units: str) -> Mechanism:
     return cls(**params, units=units)
-
-
-class DeadCentres(NamedTuple):
-    """Crank angles (rad, in [0, 2pi)) of the largest and smallest output, and those outputs.
-
-    ``reversals`` counts the output's local maxima over a turn: 1 for a proper
-    quick-return; more means the slider reverses inside a stroke and TR is ill-posed.
-    """
-
-    theta_max: float
-    theta_min: float
-    x_max: float
-    x_min: float
-    reversals: int = 1
-
-
-class PeakAcceleration(NamedTuple):
-    """Largest |slider acceleration| (length/s^2) at a constant omega2 and the crank angle (rad) where it occurs."""
-
-    value: float
-    theta2: float
-
-
-class PeakVelocity(NamedTuple):
-    """Largest |slider velocity| (length/s) over the working stroke at a constant omega2, the crank angle (rad)
-    where it occurs, and the peak crank torque per newton of a constant cutting force (length: N m per N)."""
-
-    value: float
-    theta2: float
-    torque_per_newton: float
-
-
-class AccelerationExtremes(NamedTuple):
-    """Local maxima and minima of d2x/dtheta2 over a turn: each (theta2 array in rad, value array)."""
-
-    maxima: tuple
-    minima: tuple
-
-
-class BoundingBox(NamedTuple):
-    """Extremes of every joint's path over a turn (length), the crank angles (rad) where they occur and the
-    coordinates that reach them (index into the loop's points, two per joint: x then y), each in the order
-    x_min, x_max, y_min, y_max."""
-
-    x_min: float
-    x_max: float
-    y_min: float
-    y_max: float
-    angles: tuple
-    coords: tuple = ()
-
-
-class GammaMin(NamedTuple):
-    """Smallest transmission angle over a full turn and every joint: value (rad), theta2 (rad), joint."""
-
-    value: float
-    theta2: float
-    joint: str
-
-
-BODY_KINDS = ("bar", "plate", "slot-lever", "block", "ram", "yoke")
-
-
-class Body(NamedTuple):
-    """A moving body of a type, declared once on the type (``Mechanism.BODIES``) for its pictures and mass model.
-
-    name: what it is ('crank', 'coupler', 'lever', 'rod', 'ram', ...); joints: the joints it carries, its frame's
-    origin first (the body's x axis points from it towards the second joint, or along the ray through it);
-    kind, one of BODY_KINDS:
-
-    - 'bar': a rigid straight link, a binary link or a lever carrying collinear joints (the four-bar sliders'
-      follower O4, B, C); drawn from its first joint to the farthest of the others;
-    - 'plate': a rigid link over three or more joints that are not collinear (a coupler carrying a coupler
-      point); drawn as a filled polygon over its joints in order;
-    - 'slot-lever': a lever about its first joint (a ground pivot) along the ray through its second, which slides
-      in the lever's slot; drawn from the pivot to the farthest its joints reach over a turn, with the slot;
-    - 'block': a block on a pin sliding in a slot: (the pin, a second point on the slot's line);
-    - 'ram': the slider on the slide line (along +x): (its pin,);
-    - 'yoke': a ram driven by a pin sliding in a slot normal to the slide line: (the pin,).
-    """
-
-    name: str
-    joints: tuple[str, ...]
-    kind: str
 
 
 def _check_declaration(cls) -> None:
@@ -850,152 +667,24 @@ class Mechanism:
             return tuple((what, lo, hi) for lo, hi in found)
         return ()
 
-    # ---- exact sensitivities, many nearby mechanisms at once, the crank angle of an output position -------
-    TIE: ClassVar[float] = 1e-9  # rad (relative for accelerations): stationary values this close share the extreme
-    NEARBY_GRID: ClassVar[int] = 180  # crank angles on which every tracked nearby mechanism is checked
-    ACCEL_CHECK: ClassVar[float] = 0.02  # a tracked peak |x''| must reach the grid's second differences within this
-
+    # ---- exact sensitivities, many nearby mechanisms at once (qropt.mechanisms.sensitivity) ---------------
     def sensitivity(self, quantity: str, omega2: float | None = None) -> Sensitivity:
         """Exact derivatives of 'time_ratio', 'stroke', 'gamma_min' (rad) or 'peak_acceleration' (over the turn,
-        length/s^2 at omega2 rad/s) with respect to every parameter but the branch signs, in ``params`` order.
+        length/s^2 at omega2 rad/s) with respect to every parameter but the branch signs, in ``params`` order
+        (``qropt.mechanisms.sensitivity.sensitivity``)."""
+        from qropt.mechanisms import sensitivity
 
-        A dead centre solves x'(theta*; p) = 0, so d theta*/dp = -(dx'/dp) / x'' (implicit function theorem); the
-        stroke, gamma_min and the peak acceleration are values at stationary points, so their derivatives are
-        partial derivatives at the fixed crank angle (envelope theorem), all by AD of the type's loop. Where the
-        quantity is the larger or least of equal pieces it has a kink (TR = 1 where both strokes take pi; a
-        transmission minimum or an acceleration peak reached at two crank angles): ``branches`` then holds every
-        piece's gradient, ``left`` and ``right`` the one-sided derivatives and ``kink`` says why."""
-        if quantity not in SENSITIVE:
-            raise InvalidParameter(f"sensitivity: unknown quantity {quantity!r}; one of {list(SENSITIVE)}")
-        if quantity == "peak_acceleration" and (omega2 is None or number("omega2", omega2) == 0.0):
-            raise InvalidParameter(f"the peak acceleration's sensitivity needs a nonzero omega2 (rad/s), got {omega2}")
-        self._require_full_turn()
-        k, p = self._kernel, self._vector
-        n = p.size
-        names = tuple(q for q in self.params if q not in self.BRANCHES)
-        cols = [list(self.params).index(q) for q in names]
-        combine, kink = "max", ""
-        if quantity in ("time_ratio", "stroke"):
-            d = self.dead_centres()
-            r = k.parametric("x")(np.column_stack([[d.theta_max, d.theta_min], np.broadcast_to(p, (2, n))]))
-            x2, dx, dv = r[:, 2], r[:, 3 : 3 + n], r[:, 3 + n : 3 + 2 * n]
-            if quantity == "stroke":
-                rows = [dx[0] - dx[1]]
-            else:
-                if x2[0] == 0.0 or x2[1] == 0.0:
-                    raise DegenerateMechanism(f"{self!r}: a dead centre has x'' = 0; its time ratio is not smooth")
-                a, b = self.stroke_angles()
-                da = dv[0] / x2[0] - dv[1] / x2[1]  # a = theta_min - theta_max
-                slow_a, slow_b = 2 * math.pi / b**2 * da, -2 * math.pi / a**2 * da  # TR = a / b, or b / a
-                if abs(a - b) <= self.TIE:
-                    rows = [slow_a, slow_b]
-                    kink = "both strokes take pi (TR = 1, its least): TR - 1 grows as |dTR| either way"
-                else:
-                    rows = [slow_a if a >= b else slow_b]
-        elif quantity == "gamma_min":
-            combine, least = "min", self.gamma_min().value
-            minima = self.transmission_minima_by_joint()
-            tied = []
-            for j in k.joints:
-                ts, vs = minima.get(j, ((), ()))
-                tied += [(j, t) for t, v in zip(ts, vs, strict=True) if v <= least + self.TIE]
-            rows = [k.parametric(j)(np.append(t, p)[None, :])[0, 1:] for j, t in tied] or [np.zeros(n)]
-            if len(rows) > 1:
-                kink = f"gamma_min is reached at {len(rows)} crank angles: it falls either way from a ridge"
-        else:
-            ex = self.acceleration_extremes()
-            ts, vs = np.concatenate([ex.maxima[0], ex.minima[0]]), np.concatenate([ex.maxima[1], ex.minima[1]])
-            if not ts.size:
-                raise DegenerateMechanism(f"{self!r}: the slider acceleration has no regular extremes")
-            tied = np.abs(vs) >= np.abs(vs).max() * (1 - self.TIE)
-            r = k.parametric("x")(np.column_stack([ts[tied], np.broadcast_to(p, (int(tied.sum()), n))]))
-            w2 = float(omega2) ** 2
-            rows = list(np.sign(vs[tied])[:, None] * w2 * r[:, 3 + 2 * n :])
-            if len(rows) > 1:
-                kink = f"the peak |acceleration| is reached at {len(rows)} crank angles"
-        return Sensitivity(quantity, names, np.array(rows)[:, cols], combine, kink)
+        return sensitivity.sensitivity(self, quantity, omega2)
 
     def nearby(self, P, quantities=("time_ratio", "stroke"), omega2: float | None = None) -> np.ndarray:
-        """Exact 'time_ratio', 'stroke', 'gamma_min' and 'peak_acceleration' (over the turn, at omega2) of many
-        mechanisms of this type near this one, all at once: P holds one parameter set per row, (K, len(params)) in
-        ``params`` order (branch signs included). Returns (len(quantities), K); nan where one cannot be analysed.
+        """Exact 'time_ratio', 'stroke', 'gamma_min' and 'peak_acceleration' of many mechanisms of this type near
+        this one, all at once: P holds one parameter set per row, (K, len(params)) in ``params`` order; returns
+        (len(quantities), K), nan where one cannot be analysed (``qropt.mechanisms.sensitivity.nearby``)."""
+        from qropt.mechanisms import sensitivity
 
-        Every stationary point (dead centres, transmission minima, acceleration extremes) is followed from this
-        mechanism's by exact Newton steps, one compiled call per point; each must converge and hold the global
-        extreme of a NEARBY_GRID-point grid (the peak acceleration within ACCEL_CHECK of the grid's second
-        differences), else that mechanism is analysed on its own through this API."""
-        qs = [quantities] if isinstance(quantities, str) else list(quantities)
-        if not qs or any(q not in SENSITIVE for q in qs):
-            raise InvalidParameter(f"nearby: quantities are among {list(SENSITIVE)}, got {quantities!r}")
-        if "peak_acceleration" in qs:
-            if omega2 is None or number("omega2", omega2) == 0.0:
-                raise InvalidParameter("nearby: the peak acceleration needs a nonzero omega2 (rad/s)")
-            omega2 = float(omega2)
-        P = np.asarray(P)
-        if P.dtype.kind not in "iuf" or P.ndim != 2 or P.shape[1] != len(self.params) or not np.isfinite(P).all():
-            raise InvalidParameter(f"nearby: P must be finite numbers, one row of {list(self.params)} per mechanism")
-        P = P.astype(float)
-        self._require_full_turn()
-        k, N = self._kernel, P.shape[0]
-        d = self.dead_centres()
-        tmax, xmax, ok = k.track("cycle", 0, d.theta_max, P, 1.0)
-        tmin, xmin, conv = k.track("cycle", 0, d.theta_min, P, -1.0)
-        ok &= conv
-        xg, gammas, margins = k.grid_many(P, self.NEARBY_GRID, "gamma_min" in qs)
-        with np.errstate(invalid="ignore"):
-            slack = 1e-12 * (np.abs(xg).max(axis=0) + 1.0)
-            ok &= (xmax >= xg.max(axis=0) - slack) & (xmin <= xg.min(axis=0) + slack)
-            for m in margins:
-                ok &= np.all(m >= -cycle.MARGIN_TOL, axis=0)
-        out = np.full((len(qs), N), np.nan)
-        for i, q in enumerate(qs):
-            if q == "stroke":
-                out[i] = xmax - xmin
-            elif q == "time_ratio":
-                s = np.mod(tmin - tmax, cycle.TWO_PI)
-                out[i] = np.maximum(s, cycle.TWO_PI - s) / np.minimum(s, cycle.TWO_PI - s)
-            elif q == "gamma_min":
-                best, on_grid = np.full(N, math.pi / 2), np.full(N, math.pi / 2)
-                minima = self.transmission_minima_by_joint()
-                for j, g in zip(k.joints, gammas, strict=True):
-                    on_grid = np.minimum(on_grid, g.min(axis=0))
-                    for t0 in minima.get(j, ((),))[0]:
-                        _, v, conv = k.track("cycle", 1 + k.joints.index(j), t0, P, 1.0)
-                        ok &= conv
-                        best = np.minimum(best, v)
-                with np.errstate(invalid="ignore"):
-                    ok &= best <= on_grid + 1e-12
-                out[i] = best
-            else:
-                peak, ex = np.zeros(N), self.acceleration_extremes()
-                for sign, (ts, _) in ((1.0, ex.maxima), (-1.0, ex.minima)):
-                    for t0 in ts:
-                        _, v, conv = k.track("accel", 0, t0, P, sign)
-                        ok &= conv
-                        peak = np.maximum(peak, np.abs(v))
-                x2 = (np.roll(xg, 1, axis=0) - 2 * xg + np.roll(xg, -1, axis=0)) / (cycle.TWO_PI / xg.shape[0]) ** 2
-                with np.errstate(invalid="ignore"):
-                    ok &= peak >= np.abs(x2).max(axis=0) * (1 - self.ACCEL_CHECK)
-                out[i] = peak * omega2 * omega2
-        for j in np.flatnonzero(~ok):  # one at a time through the API
-            out[:, j] = self._nearby_one(P[j], qs, omega2)
-        return out
+        return sensitivity.nearby(self, P, quantities, omega2)
 
-    def _nearby_one(self, row, qs, omega2) -> np.ndarray:
-        from qropt.errors import QroptError
-
-        try:
-            m = type(self)(**dict(zip(self.params, row.tolist(), strict=True)), units=self.units)
-            vals = {
-                "time_ratio": m.time_ratio,
-                "stroke": m.stroke,
-                "gamma_min": lambda: m.gamma_min().value,
-                "peak_acceleration": lambda: m.peak_acceleration(omega2).value,
-            }
-            return np.array([vals[q]() for q in qs])
-        except QroptError:
-            return np.full(len(qs), np.nan)
-
+    # ---- the crank angle of an output position --------------------------------------------------------------
     def working_angle_at(self, x) -> np.ndarray:
         """Crank angles (rad, from ``working_arc()``'s start to its end, not reduced mod 2 pi) at which the output
         passes the positions x (length; rad for FourBar) on the working stroke, exact: Newton on the exact x and
@@ -1028,43 +717,3 @@ class Mechanism:
             if done.all():
                 break
         return t
-
-
-SENSITIVE = ("time_ratio", "stroke", "gamma_min", "peak_acceleration")  # quantities with exact sensitivities
-
-
-class Sensitivity(NamedTuple):
-    """Exact derivatives of a cycle quantity Q with respect to the parameters ``names``.
-
-    ``branches`` (J, len(names)): the gradients of the smooth pieces of which Q is, near these parameters, the
-    largest (``combine`` 'max') or least ('min'); J = 1 and ``kink`` '' where Q is differentiable, else ``kink``
-    says why it is not (the one-sided derivatives ``left`` and ``right`` then differ)."""
-
-    quantity: str
-    names: tuple
-    branches: np.ndarray
-    combine: str = "max"
-    kink: str = ""
-
-    @property
-    def gradient(self) -> np.ndarray:
-        """Per parameter the one-sided derivative of larger magnitude: the derivative where Q is smooth, and a
-        slope whose magnitude bounds either side at a kink (a safe coefficient for a worst-case stack-up)."""
-        g = self.branches
-        return g[np.argmax(np.abs(g), axis=0), np.arange(g.shape[1])]
-
-    @property
-    def right(self) -> np.ndarray:
-        """dQ/dp_i from above (p_i increased)."""
-        return self.branches.max(axis=0) if self.combine == "max" else self.branches.min(axis=0)
-
-    @property
-    def left(self) -> np.ndarray:
-        """dQ/dp_i from below (p_i decreased)."""
-        return self.branches.min(axis=0) if self.combine == "max" else self.branches.max(axis=0)
-
-    def change(self, delta) -> np.ndarray:
-        """First-order change of Q for parameter changes delta (len(names),) or (len(names), K): the largest
-        (or least) of the pieces' linear changes, exact to second order even at a kink."""
-        lin = self.branches @ np.asarray(delta, float)
-        return lin.max(axis=0) if self.combine == "max" else lin.min(axis=0)

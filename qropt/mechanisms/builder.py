@@ -88,7 +88,8 @@ from typing import NamedTuple
 
 from qropt.errors import InvalidParameter
 from qropt.kinematics import closures as cl
-from qropt.mechanisms.base import Body, Loop
+from qropt.kinematics.closures import Loop
+from qropt.mechanisms.values import Body
 from qropt.validate import branch_sign, number
 
 __all__ = ["Linkage", "LinkageError", "Connection"]

@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 from qropt.errors import InvalidParameter
-from qropt.mechanisms.base import REQUIRED, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.builder import Linkage
+from qropt.mechanisms.values import Rule
 
 
 def slotted_lever(lever: str | None) -> Linkage:

@@ -9,8 +9,9 @@ from typing import ClassVar, NamedTuple
 
 from qropt.errors import GrashofError
 from qropt.kinematics.closures import circle_circle
-from qropt.mechanisms.base import REQUIRED, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.builder import Linkage
+from qropt.mechanisms.values import Rule
 
 LINKS = ("r1", "r2", "r3", "r4")
 

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from qropt.mechanisms.base import REQUIRED, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.builder import Linkage
+from qropt.mechanisms.values import Rule
 
 LINKAGE = Linkage()
 LINKAGE.ground("O2", (0, 0))

@@ -3,8 +3,9 @@ and on the slide line y = -r1 + h (no rod)."""
 
 from __future__ import annotations
 
-from qropt.mechanisms.base import REQUIRED, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.crank_shaper import slotted_lever
+from qropt.mechanisms.values import Rule
 
 # D rides in the lever's slot O4->A (lever length max(r1 + r2, h r1 / sqrt(r1^2 - r2^2))) and on y = -r1 + h; it is
 # on the ray (t > 0) wherever the rules hold

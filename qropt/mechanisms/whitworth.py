@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from qropt.mechanisms.base import REQUIRED, Mechanism, Rule
+from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.crank_shaper import slotted_lever
+from qropt.mechanisms.values import Rule
 
 # the lever O4-A-C turns fully (length max(r5, r1 + r2)); the rod CD drives the ram D on y = -r1 + h
 LINKAGE = slotted_lever("r5").rrp("D", ("C", "r6"), line_y="-r1 + h", sign="sigma_slider").output("D")
