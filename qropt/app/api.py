@@ -132,7 +132,7 @@ def analyze(payload) -> dict:
     """``POST /api/analyze``: ``{type, params, theta2, omega2}`` (rad, rad/s; optional ``alpha2``, ``units``,
     ``masses`` (``Masses.to_dict`` form), ``loads`` (``Loads.to_dict`` form), ``frames`` (crank angles of an
     animation, 0-360), ``polygons`` (bool, default true), ``extremes`` (bool, default true: the exact dynamic
-    extremes and flywheel, about 0.1 s; false while a slider moves)): the state at theta2, the cycle quantities,
+    extremes and flywheel, the costly part; false while a slider moves)): the state at theta2, the cycle quantities,
     x, v, a over the turn, the drawing at theta2, the polygons at theta2 and, with masses, the forces."""
     d = fields(
         payload,

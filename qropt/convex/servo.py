@@ -317,7 +317,7 @@ def _groups(g: _Grid, lim: dict, force: float, inertia: float, gen=None):
 
 def _solve(problem) -> str | None:
     """Solve with CLARABEL: the cvxpy status, or 'error: ...' if the solver raised."""
-    import cvxpy as cp  # imported on use: it takes a fraction of a second to import
+    import cvxpy as cp  # imported on use: it is slow to import
 
     try:
         with warnings.catch_warnings():
@@ -331,7 +331,7 @@ def _solve(problem) -> str | None:
 def _diagnose(groups, equal, n: int) -> tuple[tuple, str]:
     """Phase one: relax each limit by a relative slack, minimise their sum; the limits whose rows carry
     dual weight conflict, and the slacks say by how much relaxing them would do."""
-    import cvxpy as cp  # imported on use: it takes a fraction of a second to import
+    import cvxpy as cp  # imported on use: it is slow to import
 
     names = list(dict.fromkeys([name for name, _, _ in groups] + (["v_cut"] if equal is not None else [])))
     beta, s = cp.Variable(n, nonneg=True), cp.Variable(len(names), nonneg=True)
@@ -398,7 +398,7 @@ def speed_profile(
     stays out of the convex problem. Invalid input raises InvalidParameter; an infeasible set of limits
     returns status 'infeasible'.
     """
-    import cvxpy as cp  # imported on use: it takes a fraction of a second to import
+    import cvxpy as cp  # imported on use: it is slow to import
 
     if not isinstance(mechanism, Mechanism):
         raise InvalidParameter(f"speed_profile needs a qropt mechanism, got {mechanism!r}")

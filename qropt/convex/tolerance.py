@@ -222,7 +222,7 @@ def allocate(
     limits: {quantity: E > 0} over time_ratio, stroke (length), gamma_min (rad), peak_acceleration
     (length/s^2, needs omega2); params: the toleranced names (default: lengths and offsets); weights:
     {param: w > 0} (default 1); bounds: {param: (low, high)} on t."""
-    import cvxpy as cp  # imported on use: it takes a fraction of a second to import
+    import cvxpy as cp  # imported on use: it is slow to import
 
     names, omega2 = _names(mechanism, params), _omega2(omega2)
     if method not in METHODS:
@@ -301,7 +301,7 @@ def _weights(weights, names) -> np.ndarray:
 def _convex(a, w, lo, hi, method):
     """maximise w . log u s.t. each row's stack-up of a u <= 1, lo <= u <= hi, with cvxpy (CLARABEL), then
     polished on the KKT equations of the active set. Returns (u or None, 'polished' or the cvxpy status)."""
-    import cvxpy as cp  # imported on use: it takes a fraction of a second to import
+    import cvxpy as cp  # imported on use: it is slow to import
 
     u = cp.Variable(w.size, pos=True)
     cons = [(r @ u if method == "worst-case" else cp.norm(cp.multiply(r, u))) <= 1 for r in a] + [u >= lo]

@@ -4,8 +4,7 @@
 compiled to machine code once it is used often (``kinematics.kernel.Batched``), on CasADi's virtual machine until
 then and without a compiler: the same numbers to the last bit, so that a result does not depend on how often the
 process evaluated the structure before (the jets' numbers differ in the last bits, and a dynamic solve's path can
-follow them: the drag-link slider's least peak torque at TR 2.479, 0.2952 m was 126.013 N m in a fresh process and
-145.074 after two other tasks). Where a row is not finite (a singular angle) the jets and numpy
+follow them to a different design). Where a row is not finite (a singular angle) the jets and numpy
 (``inverse._numpy_parts``) compute it and report where.
 
 One function serves every design and mass model of a type: the parameters, the bodies' masses, centres and

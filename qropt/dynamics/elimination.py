@@ -160,8 +160,7 @@ class Elimination:
     def solve(self, rhs: dict) -> list:
         """x as K columns, each (n,) (or an expression), for the right-hand sides {row: number, (n,) array or
         expression} (absent rows zero). Columns rather than one (n, K) array: many small arrays keep the allocator
-        from returning memory to the system and faulting it in again at every call (measured 2.5x at 3,600
-        angles)."""
+        from returning memory to the system and faulting it in again at every call."""
         K, n = self.K, self.n
         if self.dense:
             if n is None:

@@ -499,7 +499,7 @@ def _turning(quantity: _Quantity, lo, hi, sign, p):
     """Brackets [a, b] in [lo, hi] where sign * dq/dtheta2 turns from >= 0 to <= 0 (a maximum of sign * q): the
     whole bracket where its ends turn, else the turn among TURN_SAMPLES sub-intervals nearest its middle (a
     second extreme, less than a grid step away, turns the slope back before the end: the crank shaper whose rod
-    nears its reach has two maxima 0.08 rad apart with a 5e-6 dip between). Returns (a, b, whether any turns)."""
+    nears its reach has two close maxima with a shallow dip between). Returns (a, b, whether any turns)."""
     ends = quantity.at(np.concatenate([lo, hi]), p)[1]
     d_lo, d_hi = sign * ends[: lo.size], sign * ends[lo.size :]
     turns = (d_lo >= 0) & (d_hi <= 0)

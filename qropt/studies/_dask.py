@@ -22,7 +22,7 @@ from qropt.studies._continuation import solve_tile
 
 CONNECT_TIMEOUT = 5  # s
 # Dask's workers return freed memory to the system at once (MALLOC_TRIM_THRESHOLD_=65536); a solve allocates
-# and frees many small arrays, and that setting makes a tile about 25% slower: the local cluster leaves glibc's
+# and frees many small arrays, and that setting slows a tile down: the local cluster leaves glibc's
 # own threshold (give a running cluster's workers MALLOC_TRIM_THRESHOLD_=1073741824 for the same)
 LOCAL_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
 

@@ -74,9 +74,8 @@ NEAR_MU = 1e-6  # the barrier's first value for a start at an optimum of a nearb
 NEAR = {"ipopt.mu_strategy": "monotone", "ipopt.mu_init": NEAR_MU}
 DERIVATIVES = {"grad_f": "grad_f", "jac_g": "jac_g", "hess_lag": "hess_l"}  # nlpsol's option -> nlp_<its function>
 # A formulation's derivatives are built by its first solver and given to the others (warm, near, patient, each
-# objective scale, every backend's): a solver that builds its own is 70-80 MB and 1 s for the coupler slider by
-# peak torque, one given them 5 MB and 0.05 s; the same functions, the same numbers (a process solving by peak
-# torque at 12 tasks held over 10 GB of solvers that built their own)
+# objective scale, every backend's): a solver that builds its own costs many times the memory and build time of one
+# given them, and a process holding many such solvers grows without need; the same functions, the same numbers
 _DERIVATIVES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 STALLED_KKT = 1e-9  # an IPOPT run stopped short of its tolerance is acceptable at a KKT point to this, relative
 
@@ -89,7 +88,7 @@ def _push(bound) -> np.ndarray:
 def objective_scale(form, w0, p) -> float:
     """1, or for a dynamic objective (newtons, newton-metres, their squares) the power of ten that brings its value
     at the start to order one: IPOPT's tolerance (1e-12) is absolute, below the rounding of a peak force of 1e3 N
-    (an N^2 epigraph of 1e6 went to the iteration limit in every run)."""
+    (an N^2 epigraph of 1e6 cannot meet it and runs to the iteration limit)."""
     c = form.objective
     if c is None or not c.needs_masses:
         return 1.0
@@ -125,9 +124,9 @@ class Ipopt:
         """The same backend with a barrier that starts at NEAR_MU and falls monotonically, for a run that starts at
         or near an optimum: an exchange loop's re-solve (the last round's optimum, a few samples added) and a start
         from the atlas or a neighbour's design. The adaptive barrier's first large steps move such a start off its
-        active constraints, often to another local optimum: from the coupler slider's best design at TR 2.056,
-        its re-solves ended at a design whose dead centres are local (no design), and the atlas's walk from TR
-        1.75 to 1.85 failed where this one keeps the branch. A barrier option the caller gave stays theirs."""
+        active constraints, often to another local optimum: a re-solve can end at a design whose dead centres are
+        local (no design), and a walk from one of the atlas's nodes to the next can leave the branch this one keeps.
+        A barrier option the caller gave stays theirs."""
         if self._near is None:
             self._near = Ipopt({**NEAR, **self.given})
         return self._near

@@ -58,8 +58,8 @@ class Diagnosis:
             if r.success:
                 return r
         # a complete enumeration that gives no design proves there is none; the ranges are sampled (designs and
-        # local solves): a target beyond them proves nothing (the all-free slider-crank reaches TR 2.479 at
-        # r2 = 0.1386, r3 = 0.1610, e = 0.0222 where its sampled range ended at 1.545), so the search goes on
+        # local solves): a target beyond them proves nothing (a type can reach targets well beyond its sampled
+        # range), so the search goes on
         proved = plan.kind == "enumeration" and not plan.analytic  # (every design it gives outside the bounds)
         reach = self.solver.target_ranges(
             problem, targets, list(targets), starts_n=n, seed=seed, solves=RANGE_SOLVES, toward=True
@@ -119,8 +119,7 @@ class Diagnosis:
                 )
                 return done("failed", msg, reachable=reach)
             # local runs prove nothing of the whole problem, wherever they end (a run that converges to a point
-            # the exact evaluation refuses, as the coupler slider's at TR 2.967 did where designs exist): no design
-            # was found, none was proved absent
+            # the exact evaluation refuses, even where designs exist): no design was found, none was proved absent
             return done("failed", msg + "; no design was found, none was proved absent", reachable=reach)
         reasons = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
         why = "; ".join(r for r in reasons[:3] if r)

@@ -458,8 +458,8 @@ class PeakTorque(_LiftedPeak):
     name, unit, label = "peak_torque", "N m", "peak crank torque"
     what, epigraph_name = "torque", "peak |crank torque|"
     quantity = staticmethod(_abs_torque)
-    # near a toggle the torque spikes between the NLP's samples and IPOPT's runs end at the iteration limit there
-    # (docs/benchmarks.md, "The dynamic rows"): the multi-start is run again with every transmission angle above this
+    # near a toggle the torque spikes between the NLP's samples and IPOPT's runs end at the iteration limit there:
+    # the multi-start is run again with every transmission angle above this
     guard = math.radians(10.0)
 
     def lifted(self, s, out):

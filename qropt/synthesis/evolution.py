@@ -49,9 +49,8 @@ MANY_FREE, MANY = 7, 4  # a problem with this many free parameters or more runs 
 
 def count(problem) -> int:
     """The evolutions a solve runs by default: MANY where the problem has MANY_FREE free parameters or more (the
-    four-bar-driven rows), else one. Measured by peak torque on the 36 four-bar-driven rows of the benchmark's 12
-    tasks: four evolutions made 8 rows better by 0.2-5.6 %, none worse, in 2.1-2.4 times a row's time; the rows of
-    three and five free parameters met the independent search with one (docs/benchmarks.md)."""
+    four-bar-driven types), else one: each evolution reaches its own basins at the cost of its own run, which
+    pays where the free parameters are many; with fewer, one evolution's basins already hold the best design."""
     return MANY if len(problem.free) >= MANY_FREE else 1
 
 

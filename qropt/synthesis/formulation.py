@@ -136,8 +136,8 @@ IPOPT = {
     "ipopt.tol": 1e-12,
     "ipopt.acceptable_tol": 1e-9,
     "ipopt.max_iter": 60,
-    "ipopt.max_refinement_steps": 3,  # IPOPT's default 10 (and 5): a near-singular KKT system's refinement
-    # overflowed, the barrier parameter became NaN and IPOPT never ended; after three it is found singular
+    "ipopt.max_refinement_steps": 3,  # IPOPT's default 10 (and 5): a near-singular KKT system's refinement can
+    # overflow, make the barrier parameter NaN and keep IPOPT from ending; after three it is found singular
     "ipopt.mu_strategy": "adaptive",
     "ipopt.bound_relax_factor": 0.0,
     "show_eval_warnings": False,

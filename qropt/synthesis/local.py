@@ -139,8 +139,8 @@ class LocalSolve:
         one."""
         max_rounds = self.max_rounds if max_rounds is None else max_rounds
         backend = self.backend.patient() if patient and hasattr(self.backend, "patient") else self.backend
-        # a re-solve starts at the last round's optimum: from the small barrier too (the slider-crank's
-        # min_peak_torque: 6 IPOPT runs of 250 iterations in all before, 2 of 71 with it; the same design)
+        # a re-solve starts at the last round's optimum: from the small barrier too (fewer IPOPT runs and
+        # iterations to the same design than from the default barrier)
         warm_backend = backend.near() if hasattr(backend, "near") else backend
         backend = warm_backend if near else backend
         designs = designs or Designs()
@@ -154,8 +154,8 @@ class LocalSolve:
             and not _meets(problem, values0, branch, targets, designs)
         ):
             # a dynamic objective from a design that meets the targets: its forces change fast where the loop nears
-            # a limit, and a start far from the targets leads IPOPT there (a feasibility solve first, measured:
-            # the crank-rocker slider's min_peak_torque went from no design in 23 starts to the optimum)
+            # a limit, and a start far from the targets leads IPOPT there (a feasibility solve first, so that the
+            # objective's run starts on the targets)
             pre = self.run(
                 self._feasibility(problem),
                 values0,
@@ -220,9 +220,8 @@ class LocalSolve:
                 continue
             # a dynamic objective's run that ran out of iterations far from a design: the torque's extremes move,
             # merge and appear as the design changes, and a lifted angle whose extreme merged cannot meet its
-            # stationarity row (violated by 30-320 N m/rad where the crank-rocker slider's runs at TR 1.423 stopped,
-            # from starts that met every row). Go on from there with each lifted angle at an extreme of the design
-            # it reached (``lifted_start``)
+            # stationarity row (even from a start that met every row). Go on from there with each lifted angle at an
+            # extreme of the design it reached (``lifted_start``)
             if (
                 run.status is Status.ITERATION_LIMIT
                 and relifts < RELIFTS
@@ -382,8 +381,8 @@ def _meets(problem, values, branch, targets, build, tol: float = 1e-9) -> bool:
 
 def _stuck(rounds) -> bool:
     """Whether the exchange loop's last STUCK rounds ended alike: the same verdict and reason, NLP values within
-    1e-9 (relative) and the same angles and fractions to add (to 1e-9): the loop goes round without moving (the
-    coupler slider at TR 2.61: 25 rounds at one design whose dead centres are local)."""
+    1e-9 (relative) and the same angles and fractions to add (to 1e-9): the loop goes round without moving (at a
+    design whose dead centres are local, say)."""
     if len(rounds) < STUCK:
         return False
     ok, why, f, add, frac = rounds[-1]

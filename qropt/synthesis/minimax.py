@@ -20,10 +20,6 @@ predicts a decrease below FIRST_ORDER within a step of CHECK.
 
 The solver runs it on its best certified designs and its descents' ends at the end of a solve
 (``Solver.polished``), and with ``Solver(sqp=True)`` on the evolution's designs as starts too.
-
-Measured on the benchmark's crank-rocker slider by peak torque (TR 2.004, 1.37 m): from the designs of a
-differential evolution to the independent search's design, 1,570.397 N m, where Nelder-Mead's descents from the
-same designs stopped at 1,591.0 and above (tests/test_minimax.py).
 """
 
 from __future__ import annotations
@@ -44,7 +40,7 @@ RHO_TAKE, RHO_GROW, RHO_SHRINK = 0.01, 0.75, 0.25  # actual / predicted decrease
 STATIONARY = 1e-8  # relative: a step's predicted decrease below this ends the SQP
 CHECK, FIRST_ORDER = 1e-3, 1e-5  # the end is stationary where its linear model predicts a decrease below
 # FIRST_ORDER (relative) within a step of CHECK: a slope below 1 % of the peak per unit of z (near a toggle an
-# extreme's own slope is 10-1,000 times the peak; the derivatives are differences)
+# extreme's own slope can be many times the peak; the derivatives are differences)
 STEPS = 150  # most SQP steps
 CLIP = 1e-6  # the Hessian's eigenvalues at least this times its largest (a convex QP)
 MARGIN = 1e-9  # the QP keeps the coordinates this far inside the box (its rows miss by higher-order terms)
@@ -232,8 +228,8 @@ def _curvatures(problem, c, xy: _Coordinates, d: dict, shifted: np.ndarray, base
 
 
 def _qp(F, f, G, C, c0, a, xy, B, delta):
-    """The step's QP (module docstring), scaled by F, solved by Clarabel (its rows stated directly: a QP of a
-    few dozen rows, where a modelling layer's canonicalisation took 13 times the solve): (s, the extremes'
+    """The step's QP (module docstring), scaled by F, solved by Clarabel (its rows stated directly: for a QP of a
+    few dozen rows a modelling layer's canonicalisation costs more than the solve): (s, the extremes'
     multipliers, the TR row's, predicted decrease) or None where Clarabel does not solve it."""
     import clarabel
     from scipy import sparse

@@ -29,21 +29,19 @@ WALK_GRID = 33  # points of a family walk's finer grid between two scan points, 
 WALK_XTOL = 1e-12  # a family walk's search tolerance relative to its parameter (SciPy's bounded Brent stops
 # within sqrt(machine epsilon) of it, relative, at the least: about 1e-16 of a smooth objective's optimum)
 MANY_STARTS = 6  # more closed-form points than this are scored exactly and only the best few refined
-WIDER = 4  # a wider multi-start runs this many times the starts (measured: the drag-link slider's least peak
-# acceleration at TR 2.479, stroke 0.2952 m and TR 2.004, 1.37 m needs 96 starts, not 24)
+WIDER = 4  # a wider multi-start runs this many times the starts (some optima lie in basins the default starts miss)
 FULL_TURN = 2 * math.pi * (1 - 1e-9)  # an angle's box this wide holds every angle: its edges are one (``wrapped``)
 WRAP_EDGE = 1e-6  # rad: a design's angle this near such an edge is at it
 EVOLUTION_GENERATIONS = 100  # an evolution's generations where the guard applies (``evolved``)
 THIN = 3  # a multi-start whose second pass (both TR orientations) certifies fewer designs than this is thin
 # evidence: the diagnosis's wider multi-start runs too (``Diagnosis.run``)
-GUARD_STEP = 0.7  # a guarded design is continued through transmission guards this much smaller each step: from
-# 10 deg straight to none the crank-rocker slider's best design at TR 1.66, 0.2997 m (84.56 N m, the guard binding)
-# ended at no design; through 7, 4.9, ... deg it ends at 82.52 N m, gamma_min 3.06 deg
+GUARD_STEP = 0.7  # a guarded design is continued through transmission guards this much smaller each step: a jump
+# from a binding guard straight to none can end at no design where gradual steps keep one
 GUARD_LEAST = math.radians(1.0)  # the smallest guard before none
 ATLAS_SHORT = 0.02  # where the atlas's starts end this much (relative) worse than their nodes' designs interpolated
-# to the TR, those without a design run again with a larger iteration limit (a jump of 0.05 in TR from an optimum
-# took up to 180 IPOPT iterations), and where they end this much worse than both nodes' designs, the multi-start runs
-# as well
+# to the TR, those without a design run again with a larger iteration limit (a jump in TR from an optimum can need
+# more IPOPT iterations than the default limit), and where they end this much worse than both nodes' designs, the
+# multi-start runs as well
 
 
 class MultiStart:
@@ -93,8 +91,8 @@ class MultiStart:
             if not extra:  # shapes best by the objective among many, on a grid
                 runs += [("shape", v) for v in starts_.shapes(problem, starts_.SHAPES_KEEP, seed)]
                 # and, for a dynamic objective, the atlas's optima of the same shape by the kinematic ones, from the
-                # default barrier (from the small one none of the 8 at the coupler slider's least peak torque at TR
-                # 2.479, 0.2952 m gave a design; from the default 2 gave 103.146 N m, which 36 starts had missed)
+                # default barrier (from the small one they can give no design where the default one finds optima
+                # that the other starts miss)
                 runs += [("related", v, b) for v, b in plan.related.designs]
             runs += [("multistart", v) for v in starts_.sobol(problem, starts_n, seed, designs)]
         cands += self.run(problem, runs, targets, max_rounds, designs, both_ways=False, hint=hint)
@@ -150,8 +148,8 @@ class MultiStart:
         (candidates, the claim's words, the descents' distinct ends, ``evolution.End``s best first, which the
         solver compares with the certified designs, ``Solver.descended``; [], '' and [] where it does not apply;
         the local solves start from the KEEP best of each evolution.) Run
-        whether or not the passes certify a design: of the 36 four-bar-driven rows of the benchmark's 12 tasks it
-        made 7 better and gave 1 its only design (docs/benchmarks.md)."""
+        whether or not the passes certify a design: the descents reach basins the passes miss, and can give a
+        problem its only design."""
         c = criteria.of_problem(problem)
         own = problem.conditions.get("gamma_min", 0.0)
         if c is None or c.guard is None or own >= c.guard or plan.kind not in ("none", "partial"):
@@ -175,8 +173,7 @@ class MultiStart:
     def wrapped(self, problem, cands, targets, max_rounds, designs) -> tuple[list, str]:
         """Each distinct certified design with an angle at an edge of a full-turn box (its width 2 pi), solved again
         from that angle taken across the edge (2 pi less or more: the same mechanism), where the box cut its descent.
-        The coupler slider's beta ended at pi with 1,155.33 N m at TR 2.004, 1.37 m; from -pi it goes on to
-        -2.761 rad and 1,127.31 N m. (candidates, the claim's words; '' where no design is at such an edge)."""
+        (candidates, the claim's words; '' where no design is at such an edge)."""
         kinds, runs = problem.mechanism.kinds(), []
         turns = [k for k, (lo, hi) in problem.free.items() if kinds[k] == "angle" and hi - lo >= FULL_TURN]
         for c in distinct([c for c in cands if c.ok]) if turns else []:
@@ -240,11 +237,9 @@ class MultiStart:
         """A local solve from every start; the incumbent's NLP value prunes starts that cannot beat it; patient:
         each run with the backend's larger iteration limit (``LocalSolve.run``). A start of a NEAR origin runs
         from the backend's small barrier; one from the atlas or a descent (AGAIN) that gives no design there runs
-        from its default barrier too (not in a patient rerun, where the default barrier took 1,000 iterations for
-        nothing at the coupler slider's TR 2.61). Measured on the 12 benchmark tasks, with the atlas refilled the
-        same way: 5 gamma_min and 20 peak-acceleration rows of 192 better, none worse; from the best descent's end
-        at the crank-rocker slider's TR 2.004, 1.37 m by peak torque the small barrier reached its iteration limit
-        in 5 rounds, the default one certified 1,570.40 N m (docs/benchmarks.md)."""
+        from its default barrier too (not in a patient rerun, where the default barrier can spend the larger
+        iteration limit for nothing): from such a start the small barrier can reach its iteration limit where the
+        default one certifies a design."""
         plans, count = [], {1: 0, -1: 0}
         for i, (origin, v, *br) in enumerate(runs):
             for b in br or starts_.branches(problem):
@@ -294,10 +289,9 @@ class MultiStart:
     def walked(self, problem, plan, run, failed, targets, designs) -> Candidate | None:
         """A family point's design by a bounded 1-D search (Brent) of the exact objective along the closed-form
         family (``plan.walk``) between the scan's points on either side of it, where IPOPT from it (``failed``)
-        ended without a design (near a toggle the NLP is too ill-conditioned to converge: the slider-crank's least
-        peak acceleration at TR 2.85, gamma_min 0.5 deg, failed in every start). Every design of the family meets
-        the targets, so the search's best is the best design between those points; it is certified by exact
-        evaluation like any design. None where the search finds no design."""
+        ended without a design (near a toggle the NLP can be too ill-conditioned to converge from any start). Every
+        design of the family meets the targets, so the search's best is the best design between those points; it
+        is certified by exact evaluation like any design. None where the search finds no design."""
         from scipy.optimize import minimize_scalar  # imported here: only this fallback needs it
 
         _, values, branch = run
@@ -324,9 +318,8 @@ class MultiStart:
             return np.inf if f is None else -sign * f
 
         # the objective between the scan's points can have several minima, and a narrow valley beyond the first
-        # (the slider-crank's peak torque at TR 1.235, 0.0871 m: 36.3295 N m at r2 0.00763 m, between the end of
-        # the family, 0.00726, and its first scan point, 0.00802): the search runs between the best of a finer
-        # grid's neighbours
+        # (between the end of the family and its first scan point, say): the search runs between the best of a
+        # finer grid's neighbours
         ts = np.linspace(lo, hi, WALK_GRID)
         k = int(np.argmin([cost(t) for t in ts]))
         lo, hi = ts[max(k - 1, 0)], ts[min(k + 1, WALK_GRID - 1)]

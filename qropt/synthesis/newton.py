@@ -8,7 +8,7 @@ verified a strict local minimum of the whole NLP: the KKT residuals to ``TOL``, 
 held row's multiplier of the sign that a bound holding it needs and away from zero (strict complementarity), and
 the Lagrangian's Hessian positive definite on the held rows' tangent space. Anything else (the active set changed,
 the point left the region where the loop closes, a singular system, an NLP too large for its exact Hessian to pay)
-returns None, and the backend runs from the neighbour's design as before.
+returns None, and the backend runs from the neighbour's design instead.
 """
 
 from __future__ import annotations
@@ -23,12 +23,12 @@ import numpy as np
 from qropt.kinematics.kernel import CSE, Batched
 from qropt.synthesis.backends import Run, Status
 
-ITERATIONS = 8  # Newton steps at most (a converging corrector needs 2-4 from a neighbour)
+ITERATIONS = 8  # Newton steps at most (a converging corrector needs a few from a neighbour)
 TOL = 1e-11  # KKT residuals relative to their terms' scale; rows and bounds met to this, relative, at least 1
 ACTIVE = 1e-7  # a multiplier counts (its row held) above this, relative to the largest
 NLP_LIMIT = 2_000  # NLPs (objective and rows) of at most this many instructions are continued by Newton: their
-# KKT function (exact Hessian) builds in under about 0.3 s (a chart's four-bar: 380, 0.09 s; a dynamic
-# objective's 4,000-11,000 took 1-7 s)
+# KKT function (exact Hessian) builds fast enough to pay; a larger NLP's (a dynamic objective's) costs more to
+# build than the corrector saves
 CURVED = 1e-10  # an eigenvalue of the KKT matrix counts as nonzero above this, relative to the largest
 
 
@@ -86,7 +86,7 @@ def _key(values: dict) -> tuple:
 
 class _Compiled(Batched):
     HOT = 256  # evaluations after which a KKT function runs as machine code: a chart's hundreds of cells pay for
-    # the compile (about a second, then cached on disk), a front's twenty points stay on CasADi's VM
+    # the compile (then cached on disk), a front's few points stay on CasADi's VM
 
 
 def _functions(form):

@@ -58,14 +58,14 @@ class Solver:
     backend (``qropt.synthesis.backends``; default IPOPT); atlas: start a problem whose shape is in the atlas
     (``qropt.synthesis.atlas``) from its designs first, and run the multi-start only where none certifies;
     evolution: where the objective names a transmission guard (the peak torque), descents on the exact objective
-    from a differential evolution too (``MultiStart.evolved``, ``Solver.descended``: minutes of a four-bar-driven
-    design row, and better designs at some; False leaves them out); evolutions: how many independent evolutions
-    (seeds seed, seed + 1, ...; each about 35 s of a four-bar-driven row with its SQP): the basins they reach
-    differ from seed to seed; None: four where the problem has seven free parameters or more, else one
-    (``evolution.count``, measured in docs/benchmarks.md); sqp: where the objective is a peak over the
+    from a differential evolution too (``MultiStart.evolved``, ``Solver.descended``: the costliest part of a
+    four-bar-driven solve, for better designs where the multi-start's basins miss them; False leaves them out);
+    evolutions: how many independent evolutions (seeds seed, seed + 1, ...; each with its SQP): the basins they
+    reach differ from seed to seed; None: four where the problem has seven free parameters or more, else one
+    (``evolution.count``); sqp: where the objective is a peak over the
     turn, each design of the evolution and each Nelder-Mead end descended again by the SQP on the exact peak
-    (``minimax.polish``: its ends first-order stationary; on the benchmark's 12 tasks it made 7 rows better and 10
-    worse, docs/benchmarks.md, so it is off unless asked). Whatever ``sqp`` says, the SQP descends the best
+    (``minimax.polish``: its ends are first-order stationary but not always better than the ends it starts
+    from, so it is off unless asked). Whatever ``sqp`` says, the SQP descends the best
     certified designs and every descent's end once more at the end of a solve (``polished``).
     Results do not depend on what the Solver solved before: formulations take every value as a parameter.
     """
@@ -332,8 +332,7 @@ class Solver:
         first) with the ends of the SQP on the exact peak (``minimax.polish``) from the POLISHED best certified
         designs (``r`` and its local optima) and from each of ``ends``, where it moves them; best first, and
         {'sqp_ends': how many were added, 't_sqp': the time taken, s}. A Nelder-Mead descent stalls where peaks
-        are equal, and a certified design can be a point the SQP leaves (the crank-rocker slider by peak torque at
-        TR 2.017, 1.9568 m: a descent's end, 3,588.27 N m, goes to 3,514.80, docs/benchmarks.md). Only ends: a
+        are equal, and a certified design can be a point the SQP leaves for a lower peak. Only ends: a
         design is not moved, so what the solve found stands (``descended`` takes the best)."""
         t0 = time.perf_counter()
         if not minimax.applies(problem):
@@ -408,9 +407,7 @@ class Solver:
     def refreshed(self, problem, r: Result, targets, seed, max_rounds) -> Result:
         """For a dynamic objective, the best design solved again from itself with a fresh NLP (its samples and
         lifted extremes placed anew), up to REFRESHES times while that improves it by more than TIE_TOL: the
-        exchange loop's samples can hold a design that a fresh start at it leaves for a better one nearby (the
-        Whitworth's least peak torque at TR 1.796, 1.5711 m once ended at 3578.882 N m and went to 3578.109 from
-        itself; its screened starts now reach 3578.109 directly, docs/benchmarks.md)."""
+        exchange loop's samples can hold a design that a fresh start at it leaves for a better one nearby."""
         c = criteria.of_problem(problem)
         if c is None or c.kinematic or r.status != "optimal":
             return r
@@ -452,7 +449,7 @@ class Solver:
             v = r.objective - k * tol if c.maximise else r.objective + k * tol
             return old if old is not None and c.better(old, v) else v
 
-        # the bound holds at the sub-solve's design to rounding (1e-13 at the Whitworth's): accepted within 2 tol
+        # the bound holds at the sub-solve's design to rounding only: accepted within 2 tol
         # of the optimum, so that a bit either way (a kernel compiled or not) does not decide
         accept = within(2)
         along = self._least_along(problem, r, ties, targets, c, accept, tol)

@@ -79,7 +79,7 @@ def rule_points(problem, n: int, seed: int, least: int = 1) -> list[dict]:
     with the points that break the type's rules (Grashof class, crank shorter than the centres and the like)
     dropped in one vectorised check; none is built. While fewer than ``least`` pass, four times as many more are
     drawn (RULE_DRAWS in all at most). If none passes, the first n points as they are."""
-    from scipy.stats import qmc  # imported here: scipy.stats takes a second to import
+    from scipy.stats import qmc  # imported here: scipy.stats is slow to import
 
     names = list(problem.free)
     sampler = qmc.Sobol(len(names), scramble=True, seed=seed)
