@@ -95,6 +95,14 @@ def test_plot_written(tmp_path, capsys):
     assert f.stat().st_size > 10_000 and f.read_bytes()[:4] == b"\x89PNG"
 
 
+def test_version_is_the_packages(capsys):
+    import qropt
+
+    with pytest.raises(SystemExit) as e:
+        cli.main(["--version"])
+    assert e.value.code == 0 and capsys.readouterr().out == f"qropt {qropt.__version__}\n"
+
+
 def test_angle_parsing():
     assert cli.angle("60") == pytest.approx(math.radians(60))
     assert cli.angle("60deg") == pytest.approx(math.radians(60))

@@ -402,7 +402,10 @@ def export(args, m, theta2: float = 0.0) -> list[str]:
 
 
 def parser() -> argparse.ArgumentParser:
+    from qropt import __version__
+
     p = _Parser(prog="qropt", description="Quick-return mechanism analysis and synthesis.")
+    p.add_argument("--version", action="version", version=f"qropt {__version__}")
     p.add_argument("--quiet", action="store_true", help="no progress bars on standard error")
     sub = p.add_subparsers(dest="command", required=True)
     a = sub.add_parser("analyze", help="exact TR, stroke, dead centres, gamma_min and slider state")

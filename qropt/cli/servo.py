@@ -16,7 +16,6 @@ from qropt.validate import picture_path
 
 COMMAND = "servo"
 HELP = "fastest crank-speed profile of a servo-driven crank within speed, acceleration and torque limits"
-PARAM_NAMES = ("r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider")
 LIMITS = ("omega_max", "alpha_max", "v_max", "a_max", "v_cut", "force", "inertia", "torque_max")
 UNITS = {
     "omega_max": "rad/s",
@@ -34,7 +33,7 @@ UNITS = {
 def add_mechanism_arguments(parser: argparse.ArgumentParser) -> None:
     """TYPE (default: the paper's drag-link mechanism) and its parameters --r1 ... --sigma-slider."""
     parser.add_argument("type", nargs="?", help="mechanism type: " + ", ".join(sorted(REGISTRY)))
-    from qropt.cli import param_argument
+    from qropt.cli import PARAM_NAMES, param_argument
 
     for k in PARAM_NAMES:
         parser.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
@@ -43,7 +42,7 @@ def add_mechanism_arguments(parser: argparse.ArgumentParser) -> None:
 
 def mechanism_from(args):
     """The mechanism named by args (InvalidParameter for an unknown type or bad parameters)."""
-    from qropt.cli import cli_type, flag_params, mechanism_params
+    from qropt.cli import PARAM_NAMES, cli_type, flag_params, mechanism_params
 
     given = {**flag_params(args, PARAM_NAMES), **dict(args.param)}
     if args.type is None and not given:

@@ -16,7 +16,6 @@ from qropt.mechanisms import REGISTRY, mechanism_type, type_reference
 
 COMMAND = "tolerance"
 HELP = "exact sensitivities and the largest tolerances keeping TR, stroke, gamma_min within limits"
-PARAM_NAMES = ("r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider")
 LENGTH_UNITS = {u: units_.LENGTH_UNITS[u] for u in ("um", "mm", "cm", "m")}  # a limit's suffixes, in metres
 ANGLE_UNITS = {"deg": math.pi / 180, "rad": 1.0}
 PAPER_UNIT = "m"  # the paper's mechanism (the default design) is given in metres
@@ -65,6 +64,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "and 'params' (as 'qropt synth --json' or 'qropt analyze --json' print); default: the "
         "paper's mechanism",
     )
+    from qropt.cli import PARAM_NAMES
+
     for k in PARAM_NAMES:
         parser.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
     parser.add_argument(
@@ -96,7 +97,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def design_from(args):
     """(the mechanism, its stated length unit or None): from TYPE and --r1 ... (stated by --units), from a JSON
     file (its "units", which --units may repeat but not contradict), or the paper's mechanism (in m)."""
-    from qropt.cli import CliError
+    from qropt.cli import PARAM_NAMES, CliError
 
     given = {k: getattr(args, k) for k in PARAM_NAMES if getattr(args, k) is not None}
     override = getattr(args, "units", None)
