@@ -613,7 +613,7 @@ def servo_figure(profile):
                         label=None if i else ("cutting speed" if name == "v_cut" else f"limit {name}"),
                     )
         if ax.get_legend_handles_labels()[0]:
-            ax.legend(loc="lower right", fontsize=7, framealpha=0.9)
+            ax.legend(loc="best", fontsize=7, framealpha=0.9)
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("time [s]")
