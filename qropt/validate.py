@@ -61,9 +61,11 @@ def flag(name: str, value, *, error: type[InvalidParameter] = InvalidParameter) 
     return value
 
 
-def read_text(path, what: str, *, max_bytes: int = MAX_FILE, error: type[InvalidParameter] = InvalidParameter) -> str:
-    """The UTF-8 text of the regular file at ``path``, at most ``max_bytes`` long; ``error`` naming ``what`` and
-    the path for a missing, non-regular (a device, a pipe, a folder), oversized or unreadable file."""
+def regular_file(
+    path, what: str, *, max_bytes: int = MAX_FILE, error: type[InvalidParameter] = InvalidParameter
+) -> Path:
+    """``path`` as a Path to a regular file of at most ``max_bytes`` bytes (looked at, not opened), or ``error``
+    naming ``what`` and the path for a missing, non-regular (a device, a pipe, a folder) or oversized file."""
     if isinstance(path, bytes) or not isinstance(path, (str, os.PathLike)):
         raise error(f"a {what} path is a str or path-like, got {path!r:.80}")
     p = Path(path)
@@ -77,6 +79,13 @@ def read_text(path, what: str, *, max_bytes: int = MAX_FILE, error: type[Invalid
         raise error(f"{path} is not a regular file: a {what} is a file")
     if st.st_size > max_bytes:
         raise error(f"{path} has {st.st_size:,} bytes: a {what} has at most {max_bytes:,}")
+    return p
+
+
+def read_text(path, what: str, *, max_bytes: int = MAX_FILE, error: type[InvalidParameter] = InvalidParameter) -> str:
+    """The UTF-8 text of the ``regular_file`` at ``path``, read up to ``max_bytes`` bytes; ``error`` naming
+    ``what`` and the path for a file that ``regular_file`` refuses, that cannot be read or is not UTF-8."""
+    p = regular_file(path, what, max_bytes=max_bytes, error=error)
     try:
         with open(p, "rb") as fh:
             data = fh.read(max_bytes + 1)
@@ -176,6 +185,7 @@ __all__ = [
     "within",
     "branch_sign",
     "flag",
+    "regular_file",
     "read_text",
     "nesting",
     "json_document",

@@ -24,19 +24,13 @@ from qropt import validate
 from qropt.app import api
 from qropt.app.defaults import remember
 from qropt.app.jobs import Busy, Jobs
+from qropt.cli import load_problem
 from qropt.dynamics.model import Loads, Masses
 from qropt.errors import QroptError
 from qropt.studies._design import task_problems
 
 MAX_BODY = 1 << 20  # bytes of a request body
 STATIC = {"": ("index.html", "text/html"), "app.js": ("app.js", "text/javascript"), "app.css": ("app.css", "text/css")}
-
-
-def load_file(path: str):
-    """The Problem of a problem file (its type registered by loading it), as ``qropt synth`` reads it."""
-    from qropt.cli import load_problem
-
-    return load_problem(path)
 
 
 def _problem(payload):
@@ -99,7 +93,7 @@ def create_app(files=(), workers: int = 1, queue_size: int = 8, time_limit: floa
 
     problems = {}
     for f in files:
-        problems[str(f)] = load_file(f)
+        problems[str(f)] = load_problem(f)
     jobs = Jobs(workers, queue_size, time_limit, files)
     startup = {name: jobs.submit("solve", p.to_dict()) for name, p in problems.items()}
     for name, job in startup.items():  # a user type opens with its problem's design

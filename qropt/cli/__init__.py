@@ -641,20 +641,21 @@ def load_problem(path: str):
 
     from qropt.errors import ProblemError
     from qropt.synthesis.problem import Problem
-    from qropt.validate import read_text
+    from qropt.validate import read_text, regular_file
 
     file = Path(path)
     if not file.exists():
         raise CliError(f"no problem file {path!r}")
     if file.suffix not in (".toml", ".json", ".py"):
         raise CliError(f"{path}: a problem file is .py (with build()), .toml or .json")
-    text = read_text(file, "problem file", error=ProblemError)
     if file.suffix in (".toml", ".json"):
+        text = read_text(file, "problem file", error=ProblemError)
         _importable(file)  # a type of one's own named "module:Class" may sit beside the file
         try:
             return Problem.from_toml(text) if file.suffix == ".toml" else Problem.from_json(text)
         except ProblemError as e:
             raise ProblemError(f"{path}: {e}") from None
+    regular_file(file, "problem file", error=ProblemError)  # before Python opens it
     _importable(file)
     name = _module_name(file)
     spec = importlib.util.spec_from_file_location(name, file)

@@ -129,8 +129,8 @@ class Mechanism:
         _check_declaration(cls)
         if "BRANCHES" not in cls.__dict__:
             cls.BRANCHES = tuple(k for k in cls.PARAMS if k.startswith("sigma"))
-        linkage = getattr(getattr(cls, "loop", None), "__self__", None)  # a loop of the linkage builder
-        if not isinstance(linkage, type) and callable(getattr(linkage, "check", None)):
+        linkage = Mechanism.linkage.__func__(cls, {})  # the linkage the type's own loop comes from, if any
+        if linkage is not None:
             try:
                 linkage.check(cls.PARAMS, cls.BRANCHES)
             except InvalidParameter as e:
@@ -170,7 +170,8 @@ class Mechanism:
     @classmethod
     def linkage(cls, params: dict):
         """The builder ``Linkage`` this type's loop comes from at these parameters (None for a hand-written loop)."""
-        return getattr(cls.loop, "__self__", None)
+        linkage = getattr(getattr(cls, "loop", None), "__self__", None)  # ``loop = staticmethod(L.loop)``
+        return linkage if callable(getattr(linkage, "elements", None)) and not isinstance(linkage, type) else None
 
     def dynamics(self, theta2, omega2: float = 1.0, alpha2: float = 0.0, *, masses=None, loads=None):
         """Exact inverse dynamics at crank angles theta2 (rad), SI: the crank torque, every joint force, the
