@@ -14,6 +14,7 @@ from qropt.studies._design import TYPES, type_problem
 from qropt.synthesis import atlas, criteria, starts
 from qropt.synthesis.certificate import Designs
 from qropt.synthesis.result import SOLUTION_PRESENT
+from qropt.synthesis.search import results
 from tests import brute
 
 DATA = json.loads(atlas.PATH.read_text())
@@ -147,7 +148,7 @@ def test_the_atlas_designs_of_its_shape_reach_the_peak_torque_that_the_multi_sta
     plan = starts.plan(p, True, solver.atlas)
     runs = [("related", v, b) for v, b in plan.related.designs]
     found = solver.multistart.run(p, runs, p.targets, solver.max_rounds, Designs(), False)
-    r = solver.best(p, found, "", plan, 0.0)
+    r = results.best(solver, p, found, "", plan, 0.0)
     assert r.status == "optimal", r.message
     assert "from 8 starts (8 the atlas's optima of this shape by kinematic objectives)" in r.certificate.global_claim
     assert r.objective <= FIRST_REFERENCE * (1 + 1e-9)

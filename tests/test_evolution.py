@@ -14,6 +14,10 @@ from qropt import solve
 from qropt.studies._design import type_problem
 from qropt.synthesis import descents, evolution
 from qropt.synthesis.criteria import objective_of
+from qropt.synthesis.search import Settings
+from qropt.synthesis.search.descended import descended
+
+SHORT = Settings(evolution_generations=20)  # a short evolution
 
 KW = {"objective": "min_peak_torque", "masses": MASSES, "loads": LOADS, "omega2": OMEGA2}
 
@@ -64,12 +68,10 @@ def test_a_solve_without_a_design_from_its_passes_starts_from_descents(monkeypat
     forms), the solve starts local runs from descents on the exact objective, certifies the design they reach and
     says so in its claim. Shortened (20 generations, 200 evaluations a descent)."""
     from qropt import Solver
-    from qropt.synthesis import multistart
 
-    monkeypatch.setattr(multistart, "EVOLUTION_GENERATIONS", 20)
     monkeypatch.setattr(evolution, "DESCENT_EVALS", 200)
     problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
-    r = Solver(starts_n=0).solve(problem, use_analytic=False, diagnose=False)
+    r = Solver(starts_n=0, settings=SHORT).solve(problem, use_analytic=False, diagnose=False)
     assert r.status in ("optimal", "acceptable"), r.message
     assert "differential evolution of 20 generations" in r.certificate.global_claim
     free = {k: r.params[k] for k in problem.free}
@@ -86,13 +88,12 @@ def test_a_descents_end_stands_as_a_feasible_design_where_no_start_certifies(mon
     (a Nelder-Mead end); with ``Solver(sqp=True)`` the SQP on the exact peak descends it further and its ``local``
     states first-order stationarity (tests/test_minimax.py checks such an end)."""
     from qropt import Result, Solver
-    from qropt.synthesis import multistart
     from tests import brute
 
-    monkeypatch.setattr(multistart, "EVOLUTION_GENERATIONS", 20)
     monkeypatch.setattr(evolution, "DESCENT_EVALS", 200)
     problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
-    r = Solver(starts_n=0, ipopt_options={"ipopt.max_iter": 0}).solve(problem, use_analytic=False, diagnose=False)
+    none = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": SHORT}
+    r = Solver(**none).solve(problem, use_analytic=False, diagnose=False)
     assert r.status == "feasible" and r.success, r.message
     assert "not certified" in r.message and r.certificate.local.startswith("none")
     assert "differential evolution of 20 generations, 0 certified" in r.certificate.global_claim
@@ -107,13 +108,13 @@ def test_a_descents_end_stands_as_a_feasible_design_where_no_start_certifies(mon
     assert torque.max() <= r.objective * (1 + 1e-9) and torque.max() == pytest.approx(r.objective, rel=1e-4)
     back = Result.from_dict(r.to_dict())
     assert back.status == "feasible" and back.objective == r.objective
-    sqp = Solver(starts_n=0, ipopt_options={"ipopt.max_iter": 0}, sqp=True)
+    sqp = Solver(**none, sqp=True)
     assert Solver(**sqp.options()).sqp is True
     polished = sqp.solve(problem, use_analytic=False, diagnose=False)
     assert polished.status == "feasible" and polished.objective <= r.objective * (1 + 1e-12)
     assert polished.certificate.local.startswith("first-order stationary"), polished.certificate.local
     # without the evolution (Solver(evolution=False)) the same solve has no design and says why
-    off = Solver(starts_n=0, ipopt_options={"ipopt.max_iter": 0}, evolution=False)
+    off = Solver(**none, evolution=False)
     assert Solver(**off.options()).evolution is False  # the options rebuild an equal Solver (a worker's)
     r = off.solve(problem, use_analytic=False, diagnose=False)
     assert r.status == "failed" and "evolution" not in r.message, r.message
@@ -136,12 +137,10 @@ def test_more_evolutions_add_their_ends_to_the_first_ones(monkeypatch):
     solve, so with no certified design (IPOPT gets no iteration) its best end is at least as good, and better
     where the second seed's basin is; the claim names both seeds. Shortened (20 generations, 200 evaluations)."""
     from qropt import Solver
-    from qropt.synthesis import multistart
 
-    monkeypatch.setattr(multistart, "EVOLUTION_GENERATIONS", 20)
     monkeypatch.setattr(evolution, "DESCENT_EVALS", 200)
     problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
-    kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}}
+    kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": SHORT}
     one = Solver(**kw).solve(problem, use_analytic=False, diagnose=False)
     two = Solver(**kw, evolutions=2)
     assert Solver(**two.options()).evolutions == 2  # the options rebuild an equal Solver (a worker's)
@@ -159,15 +158,14 @@ def test_the_four_bar_driven_rows_run_four_evolutions_by_default(monkeypatch):
     Shortened (5 generations, 50 evaluations a descent, IPOPT given no iteration, no SQP)."""
     from qropt import Solver
     from qropt.studies._design import TYPES
-    from qropt.synthesis import minimax, multistart
+    from qropt.synthesis import minimax
 
     counts = {k: evolution.count(type_problem(k, 1.6, 0.3, **KW)) for k in TYPES}
     assert counts == {k: 4 if k in ("crank-rocker-slider", "drag-link-slider", "coupler-slider") else 1 for k in TYPES}
-    monkeypatch.setattr(multistart, "EVOLUTION_GENERATIONS", 5)
     monkeypatch.setattr(evolution, "DESCENT_EVALS", 50)
     monkeypatch.setattr(minimax, "polish", lambda problem, design, steps=0: None)
     problem = type_problem("crank-rocker-slider", 1.6, 0.3, **KW)
-    kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}}
+    kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": Settings(evolution_generations=5)}
     assert Solver(**kw).evolutions is None and Solver(**kw).evolutions_of(problem) == 4
     assert Solver(**Solver(**kw).options()).evolutions is None  # a worker's Solver decides the same way
     r = Solver(**kw).solve(problem, use_analytic=False, diagnose=False)
@@ -190,9 +188,9 @@ def test_a_descents_end_stands_only_where_it_beats_every_certified_design():
     assert r.status == "optimal"
     ends = descents.descended(problem, 20, seed=3, keep=2, evals=300)
     assert ends and ends[0].value >= r.objective * (1 - 1e-9)
-    assert s.descended(problem, r, ends, "") is r
+    assert descended(s, problem, r, ends, "") is r
     worse = dataclasses.replace(r, objective=r.objective * 1.2, local_optima=())
-    stood = s.descended(problem, worse, ends, "")
+    stood = descended(s, problem, worse, ends, "")
     assert stood.status == "feasible" and stood.objective == pytest.approx(ends[0].value, rel=1e-12)
     assert [x.status for x in stood.local_optima] == ["local_optimum"]
     assert stood.local_optima[0].objective == worse.objective

@@ -19,6 +19,8 @@ from benchmarks.tasks import LOADS, MASSES, OMEGA2
 from qropt.studies._design import type_problem
 from qropt.synthesis import descents, evolution, minimax, starts
 from qropt.synthesis.dynamic import _cycle
+from qropt.synthesis.search.descended import descended
+from qropt.synthesis.search.sqp import polished
 from tests import brute
 
 KW = {"objective": "min_peak_torque", "masses": MASSES, "loads": LOADS, "omega2": OMEGA2}
@@ -117,20 +119,21 @@ def test_where_the_sqp_applies():
 
 
 def test_the_solver_descends_the_descents_ends_again_by_the_sqp_and_counts_them():
-    """``Solver.polished``: the Nelder-Mead ends of a short evolution (the crank-rocker slider by peak torque at the
-    benchmark's TR 2.017, 1.9568 m) stall; the SQP from them ends lower and stationary, its end is the result
-    (``feasible``, the claim counting both kinds of end), it meets the TR and stroke (brute force) and its peak is
-    exact (a dense Newton-Euler grid). Without a peak over the turn nothing is added."""
+    """The ``PeakSQP`` strategy (``search.sqp.polished``): the Nelder-Mead ends of a short evolution (the
+    crank-rocker slider by peak torque at the benchmark's TR 2.017, 1.9568 m) stall; the SQP from them ends lower
+    and stationary, its end is the result (``feasible``, the claim counting both kinds of end), it meets the TR and
+    stroke (brute force) and its peak is exact (a dense Newton-Euler grid). Without a peak over the turn nothing is
+    added."""
     problem = type_problem("crank-rocker-slider", 2.017, 1.9568, **KW)
     ends = descents.descended(problem, 20, seed=0, keep=2, evals=300)
     s = qropt.Solver()
-    more, sqp = s.polished(problem, None, ends)
+    more, sqp = polished(problem, None, ends, s.settings.polished)
     added = sqp["sqp_ends"]
     assert added >= 1 and len(more) == len(ends) + added
     assert [e.value for e in more] == sorted(e.value for e in more)
     assert more[0].value < ends[0].value * (1 - 1e-3), (more[0].value, ends[0].value)
     assert more[0].local.startswith("first-order stationary")
-    r = s.descended(problem, None, more, "how", {}, polished=added)
+    r = descended(s, problem, None, more, "how", {}, polished=added)
     assert r.status == "feasible" and r.objective == pytest.approx(more[0].value, rel=1e-12)
     words = f"the best of {len(ends)} descents' ends and {added} ends of the SQP on the exact peak"
     assert r.certificate.global_claim.startswith(words), r.certificate.global_claim
@@ -142,7 +145,7 @@ def test_the_solver_descends_the_descents_ends_again_by_the_sqp_and_counts_them(
     grid = np.abs(r.mechanism.dynamics(np.linspace(0, 2 * np.pi, 40_001), OMEGA2, masses=MASSES, loads=LOADS).torque)
     assert grid.max() <= r.objective * (1 + 1e-12) and grid.max() == pytest.approx(r.objective, rel=1e-6)
     kinematic = type_problem("crank-rocker-slider", 2.017, 1.9568, objective="min_peak_accel")
-    same, none = s.polished(kinematic, None, ends)
+    same, none = polished(kinematic, None, ends, s.settings.polished)
     assert same == ends and none["sqp_ends"] == 0
 
 

@@ -23,7 +23,7 @@ from pathlib import Path
 from qropt.synthesis import criteria, scaling
 
 PATH = Path(__file__).with_name("atlas.json")
-SHAPE_CONDITIONS = ("grashof", "gamma_min")  # conditions that do not change with the scale
+SHAPE_CONDITIONS = ("grashof", criteria.GammaMin.name)  # conditions that do not change with the scale
 SAME = 0.02  # a node's designs this close in every parameter (strokes for lengths and offsets, rad for angles) are
 # one start: a solve from the second ends where the first's does
 SAME_SHAPE = ("mechanism", "fixed", "free", "branches")  # what a problem shares with the atlas entries ``related``

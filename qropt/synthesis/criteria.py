@@ -31,6 +31,8 @@ from typing import ClassVar, NamedTuple
 import numpy as np
 
 from qropt.errors import ProblemError
+from qropt.kinematics.closures import transmission_angle
+from qropt.kinematics.ops import NUMPY
 
 TWO_PI = 2.0 * math.pi
 SIZES = ("sum", "longest", "footprint")
@@ -55,6 +57,10 @@ class Exchange(NamedTuple):
     fractions: list
 
 
+SIZE_OBJECTIVE = "min_size"  # the objective of every size measure (the measure is the problem's ``size``)
+SIZE = "size"  # the quantities key of the problem's size measure
+
+
 class Criterion:
     """Base of every criterion. Subclasses set the class attributes and implement ``value``; a criterion that
     needs samples over the turn also implements the NLP hooks (see GammaMin, PeakAcceleration)."""
@@ -67,16 +73,25 @@ class Criterion:
     size: ClassVar[str | None] = None  # a size measure: the objective is min_size with problem.size = this
     kinematic: ClassVar[bool] = True  # depends on the motion alone (not on the size or on masses)
     needs_masses: ClassVar[bool] = False  # a dynamic criterion: the problem's masses and loads, at its omega2
+    # ---- capabilities the search reads (``qropt.synthesis.search``) ---------------------------------------
     guard: ClassVar[float | None] = None  # rad: a transmission angle below which the NLP does not see the criterion
-    # well; a multi-start without closed forms is run again with gamma_min >= guard and its designs continued to
-    # the problem (``MultiStart.guarded``)
+    # well, so its landscape needs a global search: the guarded multi-start (gamma_min >= guard, its designs
+    # continued to the problem) and, on a problem with free scale and crank, the differential evolution
+    quantity = None  # a peak over the turn: the quantity of the cycle's dynamics whose peak it is (the SQP on the
+    # exact peak descends it, ``minimax``); None for any other criterion
+
+    def grid_value(self, problem, loop, x, scale):
+        """Its value for each design (row) of a grid screen, or None where it has none: ``loop`` the type's loop
+        evaluated on the designs (``starts.grid_loops``), ``x`` the output at uniform crank angles (designs, angles),
+        ``scale`` each design's factor to the stroke target. A screen's value chooses starts, never a result."""
+        return None
 
     # ---- names -------------------------------------------------------------------------------------
     @property
     def objective(self) -> str:
         """The objective that optimises it."""
         if self.size:
-            return "min_size"
+            return SIZE_OBJECTIVE
         return ("max_" if self.maximise else "min_") + self.name
 
     @property
@@ -193,6 +208,14 @@ class GammaMin(Criterion):
     def violation(self, problem, m, bound):
         return max(0.0, bound - self.value(problem, m))
 
+    def grid_value(self, problem, loop, x, scale):
+        value = -np.full(x.shape[0], np.pi / 2)
+        for lines in loop.transmission.values():
+            if lines is not None:
+                g = np.broadcast_to(transmission_angle(NUMPY, lines), x.shape).min(axis=1)
+                value = np.maximum(value, -g)
+        return value
+
     def epigraph(self, f):
         exprs = []
         if not f.exact_joints and not f.sampled_joints:  # every joint at a right angle (cos 0)
@@ -234,6 +257,9 @@ class GammaMin(Criterion):
         return [m.gamma_min().theta2], []
 
 
+GUARDED = GammaMin.name  # the condition a transmission guard sets: a lower bound on the transmission angle
+
+
 class SizeSum(Criterion):
     """The sum of the link lengths, ground included (length)."""
 
@@ -267,6 +293,11 @@ class Footprint(Criterion):
     def value(self, problem, m):
         return m.size("footprint")
 
+    def grid_value(self, problem, loop, x, scale):
+        xs = np.concatenate([np.broadcast_to(q[0], x.shape) for q in loop.points.values()], axis=1)
+        ys = np.concatenate([np.broadcast_to(q[1], x.shape) for q in loop.points.values()], axis=1)
+        return np.ptp(xs, axis=1) * np.ptp(ys, axis=1) * scale**2
+
     def epigraph(self, f):
         groups = {s: [] for s in self.SIDES}
         for out in f.sampled + f.exact + f.dead:
@@ -299,6 +330,11 @@ class PeakAcceleration(Criterion):
 
     def value(self, problem, m):
         return m.peak_acceleration(problem.omega2, problem.accel_over).value
+
+    def grid_value(self, problem, loop, x, scale):  # over the whole turn, by the grid's spectral derivative
+        wave = np.fft.rfftfreq(x.shape[1], 1.0 / x.shape[1]) ** 2
+        d2 = np.fft.irfft(-wave * np.fft.rfft(x, axis=1), n=x.shape[1], axis=1)
+        return np.abs(d2).max(axis=1) * scale * problem.omega2**2
 
     def to_nlp(self, v, omega2):
         return v / omega2**2
@@ -466,6 +502,12 @@ def of(objective: str, size: str = "sum") -> Criterion:
 def of_problem(problem) -> Criterion | None:
     """The problem's objective criterion, or None."""
     return of(problem.objective, problem.size) if problem.objective else None
+
+
+def grid_criterion(problem) -> Criterion | None:
+    """The problem's objective criterion where a grid screen can value it (``Criterion.grid_value``), else None."""
+    c = of_problem(problem)
+    return c if c is not None and type(c).grid_value is not Criterion.grid_value else None
 
 
 def maximises(objective: str | None) -> bool:

@@ -407,7 +407,7 @@ class _Squared(_Dynamic):
         return math.sqrt(max(y, 0.0))
 
 
-class _LiftedPeak(_Dynamic):
+class PeakOverTurn(_Dynamic):
     """A peak over the turn (of ``quantity`` of the cycle's dynamics) whose largest extremes the NLP lifts
     (stationary in theta2) and whose exchange adds every extreme above the NLP's value; ``lifted`` gives the
     NLP's expression of it at one crank angle and the terms it bounds."""
@@ -452,7 +452,7 @@ class _LiftedPeak(_Dynamic):
         return [_cycle(problem, m).peak(self.quantity).theta2], []
 
 
-class PeakTorque(_LiftedPeak):
+class PeakTorque(PeakOverTurn):
     """The largest |crank torque| over the turn at constant omega2 (N m)."""
 
     name, unit, label = "peak_torque", "N m", "peak crank torque"
@@ -502,7 +502,7 @@ class RmsTorque(_Squared):
         return Exchange(nlp, exact, gap, [], [])
 
 
-class ShakingForce(_Squared, _LiftedPeak):
+class ShakingForce(_Squared, PeakOverTurn):
     """The largest shaking force |sum(m a_G)| over the turn at constant omega2 (N); the NLP bounds its square."""
 
     name, unit, label = "shaking_force", "N", "peak shaking force"

@@ -262,7 +262,7 @@ class Formulation:
         PSI, SEL = casadi.SX.sym("psi", n_box), casadi.SX.sym("sel", n_box * self.n_coords)
         for s in range(n_box):
             out, pick = self.at(PSI[s]), SEL[s * self.n_coords : (s + 1) * self.n_coords]
-            zi = self._z_of["footprint"][s]
+            zi = self._z_of[criteria.Footprint.name][s]
             self.row(
                 f"lifted box side {self.z_names[zi]}: stationary", casadi.dot(pick, out.dcoords), 0.0, 0.0, RowKind.LIFT
             )

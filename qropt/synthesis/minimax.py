@@ -78,7 +78,7 @@ def applies(problem) -> bool:
     puts on its targets (``evolution.applies``), without a free counterweight (its moments are the NLP's)."""
     c = criteria.of_problem(problem)
     balancing = problem.masses is not None and problem.masses.balancing
-    return evolution.applies(problem) and hasattr(c, "quantity") and not balancing
+    return evolution.applies(problem) and c is not None and c.quantity is not None and not balancing
 
 
 class _Coordinates:

@@ -1,205 +1,38 @@
-"""The multi-start: a plan of starts -> local solves -> the distinct certified designs, best first.
-
-Closed forms first: a complete enumeration is polished point by point (no multi-start), a closed-form family is
-scanned by exact evaluation and only its best points refined; otherwise the atlas's designs of the problem's
-shape (``atlas``), and only where none of them certifies, the closed-form points and a scrambled Sobol design.
-Each start is solved in its own TR orientation (both where it has none); the space-filling starts also try the
-other orientation until each has at least MIN_WAY of them. A criterion with a transmission guard (the peak
-torque's) has its starts run again under it, each design they certify continued back to the problem (``guarded``).
-"""
+"""Local solves from many starts: a list of starts -> local solves (each in its TR orientation, the incumbent
+pruning starts that cannot beat it), a guarded design continued back to its problem, a closed-form family's best
+points and its walk; and the helpers the search's strategies share (``score``, ``distinct``, ``expected``). Which
+starts run, in which order, is the search pipeline's (``qropt.synthesis.search``)."""
 
 from __future__ import annotations
-
-import dataclasses
-import math
 
 import numpy as np
 
 from qropt.errors import QroptError
-from qropt.synthesis import atlas as atlas_
-from qropt.synthesis import criteria, descents, evolution
+from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
-from qropt.synthesis.certificate import Designs
 from qropt.synthesis.local import Candidate, LocalSolve, nlp_value
 
 NEAR = ("atlas", "given", "evolution")  # starts at or near optima: run from a small barrier (``Ipopt.near``)
 AGAIN = ("atlas", "evolution")  # such starts that give no design there run from the default barrier too (``run``)
-MIN_WAY = 3  # space-filling starts tried in each way of meeting the TR equality, at least
-WALK_GRID = 33  # points of a family walk's finer grid between two scan points, before its bounded search
-WALK_XTOL = 1e-12  # a family walk's search tolerance relative to its parameter (SciPy's bounded Brent stops
-# within sqrt(machine epsilon) of it, relative, at the least: about 1e-16 of a smooth objective's optimum)
-MANY_STARTS = 6  # more closed-form points than this are scored exactly and only the best few refined
-WIDER = 4  # a wider multi-start runs this many times the starts (some optima lie in basins the default starts miss)
-FULL_TURN = 2 * math.pi * (1 - 1e-9)  # an angle's box this wide holds every angle: its edges are one (``wrapped``)
-WRAP_EDGE = 1e-6  # rad: a design's angle this near such an edge is at it
-EVOLUTION_GENERATIONS = 100  # an evolution's generations where the guard applies (``evolved``)
-THIN = 3  # a multi-start whose second pass (both TR orientations) certifies fewer designs than this is thin
-# evidence: the diagnosis's wider multi-start runs too (``Diagnosis.run``)
-GUARD_STEP = 0.7  # a guarded design is continued through transmission guards this much smaller each step: a jump
-# from a binding guard straight to none can end at no design where gradual steps keep one
-GUARD_LEAST = math.radians(1.0)  # the smallest guard before none
-ATLAS_SHORT = 0.02  # where the atlas's starts end this much (relative) worse than their nodes' designs interpolated
-# to the TR, those without a design run again with a larger iteration limit (a jump in TR from an optimum can need
-# more IPOPT iterations than the default limit), and where they end this much worse than both nodes' designs, the
-# multi-start runs as well
 
 
 class MultiStart:
-    """Runs a plan of starts through a LocalSolve; ``claim`` says what the best of them rests on."""
+    """Runs starts through a LocalSolve, with the search's ``Settings``."""
 
-    def __init__(self, local: LocalSolve):
-        self.local = local
-
-    def candidates(self, problem, plan, extra, targets, starts_n, seed, max_rounds, designs, retry=True, hint=None):
-        """(candidates, claim, the retry): where no space-filling start gives a certified design, the retry runs
-        each of them in both TR orientations; with ``retry`` it is run here (and None is returned), otherwise it
-        is returned as a callable (None where there is nothing to retry). ``hint``: a nearby problem's optimum
-        (``newton.Hint``) that a given start continues where it is that optimum's design."""
-        runs = [("given", v) for v in extra]
-        cands: list[Candidate] = []
-        claim = ""
-        if plan.kind == "enumeration" and not extra:
-            for v in plan.analytic:
-                for br in starts_.branches(problem):
-                    cands.append(self.local.polish(problem, v, br, targets, designs))
-            claim = f"by enumeration: {plan.how}"
-        elif plan.kind == "family" and not extra:
-            runs += self.family_starts(problem, plan, designs)
-            claim = (
-                f"best along a closed-form family that holds every solution ({plan.how}; {len(plan.analytic)} points)"
-            )
-        else:
-            if plan.atlas.designs and not extra:  # the atlas's designs first: the multi-start only where none certifies
-                first = [("atlas", v, b) for v, b in plan.atlas.designs]
-                cands += self.run(problem, first, targets, max_rounds, designs, both_ways=False)
-                between, floor = expected(problem, plan.atlas, designs)
-                how = plan.atlas.how
-                done = {c.start for c in cands if c.ok}
-                if short(problem, cands, between) and len(done) < len(first):
-                    # again, each start without a design, with a larger iteration limit
-                    again = [r for i, r in enumerate(first) if i not in done]
-                    cands += self.run(problem, again, targets, max_rounds, designs, both_ways=False, patient=True)
-                    how += ", those without a design run again with a larger iteration limit"
-                falls_short = short(problem, cands, floor)
-                if any(c.ok for c in cands) and not falls_short:
-                    return cands, f"best of {how}", None
-                # none certified, or still short: the multi-start as well (the atlas's candidates kept, counted)
-            if len(plan.analytic) > MANY_STARTS and not extra:  # a sweep of closed-form points: the best few
-                runs += [("analytic", v, *b) for _, v, *b in self.family_starts(problem, plan, designs)]
-            else:
-                runs += [("analytic", v) for v in plan.analytic]
-            if not extra:  # shapes best by the objective among many, on a grid
-                runs += [("shape", v) for v in starts_.shapes(problem, starts_.SHAPES_KEEP, seed)]
-                # and, for a dynamic objective, the atlas's optima of the same shape by the kinematic ones, from the
-                # default barrier (from the small one they can give no design where the default one finds optima
-                # that the other starts miss)
-                runs += [("related", v, b) for v, b in plan.related.designs]
-            runs += [("multistart", v) for v in starts_.sobol(problem, starts_n, seed, designs)]
-        cands += self.run(problem, runs, targets, max_rounds, designs, both_ways=False, hint=hint)
-        if plan.kind == "family" and plan.walk is not None and not extra and problem.objective:
-            failed = [(runs[c.start], c) for c in cands if c.origin == "family" and not c.ok and not c.pruned]
-            walked = [w for run, c in failed if (w := self.walked(problem, plan, run, c, targets, designs))]
-            if any(c.ok for c in walked):
-                claim += (
-                    f"; from {sum(c.ok for c in walked)} point(s) where IPOPT ended without a design, a bounded 1-D "
-                    f"search of the exact objective along the family's {plan.walk.name} instead"
-                )
-            cands += walked
-        spread = [r for r in runs if r[0] == "multistart"]
-        if not spread or any(c.ok for c in cands):
-            return cands, claim, None
-
-        def again():  # the other way of meeting the TR equality
-            return self.run(problem, spread, targets, max_rounds, designs, both_ways=True)
-
-        if retry:
-            return cands + again(), claim, None
-        return cands, claim, again
-
-    def guarded(self, problem, plan, targets, starts_n, seed, max_rounds, designs) -> tuple[list, str, list]:
-        """Where the objective's criterion names a transmission guard (``Criterion.guard``) above the problem's own
-        gamma_min bound and no closed form enumerates or walks the designs: the same starts on the problem with
-        gamma_min >= guard, and each distinct design they certify continued to this problem (``continued``).
-        (candidates of this problem, the claim's words for them, the guarded problem's candidates; [], '' and []
-        where no guard applies)."""
-        c = criteria.of_problem(problem)
-        own = problem.conditions.get("gamma_min", 0.0)
-        if c is None or c.guard is None or own >= c.guard or plan.kind not in ("none", "partial"):
-            return [], "", []
-        found, _, _ = self.candidates(_under(problem, c.guard), plan, [], targets, starts_n, seed, max_rounds, designs)
-        good = distinct([x for x in found if x.ok])
-        out = [x for x in (self.continued(problem, x, c.guard, targets, max_rounds, designs) for x in good) if x]
-        for x in out:
-            x.origin = "guard"
-        to = "the problem's bound" if own > 0 else "none"
-        kept = f"{len(good)} distinct design{'s' * (len(good) != 1)}"
-        how = (
-            f"{kept} of {len(found)} starts under a transmission guard (gamma_min >= {math.degrees(c.guard):g} "
-            f"deg) continued to {to}, {len(out)} certified"
-        )
-        return out, how, found
-
-    def evolved(
-        self, problem, plan, targets, seed, max_rounds, designs, sqp=False, count: int = 1
-    ) -> tuple[list, str, list]:
-        """Where the guard applies (``guarded``): local solves from the ends of descents on the exact objective
-        from ``count`` evolutions' designs (``evolution.descended``: EVOLUTION_GENERATIONS generations each, from
-        seeds ``seed``, ``seed + 1``, ...; sqp: the SQP on the exact peak too).
-        (candidates, the claim's words, the descents' distinct ends, ``evolution.End``s best first, which the
-        solver compares with the certified designs, ``Solver.descended``; [], '' and [] where it does not apply;
-        the local solves start from the KEEP best of each evolution.) Run
-        whether or not the passes certify a design: the descents reach basins the passes miss, and can give a
-        problem its only design."""
-        c = criteria.of_problem(problem)
-        own = problem.conditions.get("gamma_min", 0.0)
-        if c is None or c.guard is None or own >= c.guard or plan.kind not in ("none", "partial"):
-            return [], "", []
-        if not evolution.applies(problem):
-            return [], "", []
-        each = [descents.descended(problem, EVOLUTION_GENERATIONS, seed + i, sqp=sqp) for i in range(count)]
-        runs = [("evolution", e.design) for ends in each for e in ends[: evolution.KEEP]]  # the best distinct ends
-        out = self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
-        which = (
-            "a differential evolution"
-            if count == 1
-            else f"{count} differential evolutions (seeds {seed}-{seed + count - 1})"
-        )
-        how = (
-            f"{len(runs)} starts from descents on the exact objective after {which} of "
-            f"{EVOLUTION_GENERATIONS} generations, {sum(x.ok for x in out)} certified"
-        )
-        return out, how, sorted((e for ends in each for e in ends), key=lambda e: e.value)
-
-    def wrapped(self, problem, cands, targets, max_rounds, designs) -> tuple[list, str]:
-        """Each distinct certified design with an angle at an edge of a full-turn box (its width 2 pi), solved again
-        from that angle taken across the edge (2 pi less or more: the same mechanism), where the box cut its descent.
-        (candidates, the claim's words; '' where no design is at such an edge)."""
-        kinds, runs = problem.mechanism.kinds(), []
-        turns = [k for k, (lo, hi) in problem.free.items() if kinds[k] == "angle" and hi - lo >= FULL_TURN]
-        for c in distinct([c for c in cands if c.ok]) if turns else []:
-            for k in turns:
-                lo, hi = problem.free[k]
-                x = c.values[k]
-                if min(x - lo, hi - x) <= WRAP_EDGE:
-                    across = x - 2 * math.pi if hi - x <= WRAP_EDGE else x + 2 * math.pi
-                    runs.append(("wrapped", {**c.values, k: min(max(across, lo), hi)}, c.branch))
-        if not runs:
-            return [], ""
-        out = self.run(problem, runs, targets, max_rounds, designs, both_ways=False)
-        n = len(runs)
-        how = f"{n} design{'s' * (n != 1)} at an edge of a full-turn angle's box solved again from across it, "
-        return out, how + f"{sum(c.ok for c in out)} certified"
+    def __init__(self, local: LocalSolve, settings):
+        self.local, self.settings = local, settings
 
     def continued(self, problem, start: Candidate, guard: float, targets, max_rounds, designs) -> Candidate | None:
-        """A design certified under a transmission guard, solved again under guards GUARD_STEP times smaller in turn
-        (down to GUARD_LEAST, or the problem's own bound) and then on the problem itself, each from the last design
-        certified, from the backend's small barrier; once the guard does not bind, the problem itself next. The
-        problem's candidate, or None where its last solve certifies nothing."""
-        own = problem.conditions.get("gamma_min", 0.0)
-        steps, g = [], guard * GUARD_STEP
-        while g > max(GUARD_LEAST, own):
+        """A design certified under a transmission guard, solved again under guards ``guard_step`` times smaller in
+        turn (down to ``guard_least``, or the problem's own bound) and then on the problem itself, each from the last
+        design certified, from the backend's small barrier; once the guard does not bind, the problem itself next.
+        The problem's candidate, or None where its last solve certifies nothing."""
+        own = problem.conditions.get(criteria.GUARDED, 0.0)
+        step, least = self.settings.guard_step, self.settings.guard_least
+        steps, g = [], guard * step
+        while g > max(least, own):
             steps.append(g)
-            g *= GUARD_STEP
+            g *= step
         values, way, gamma = start.values, start.orientation, start.mechanism.gamma_min().value
         t_ipopt, iterations = 0.0, 0
 
@@ -214,7 +47,7 @@ class MultiStart:
         for g in [*steps, None]:
             if g is not None and g >= gamma:
                 continue
-            x = run(problem if g is None else _under(problem, g))
+            x = run(problem if g is None else under(problem, g))
             if x.ok and g is not None:
                 values, way, gamma = x.values, x.orientation, x.mechanism.gamma_min().value
                 if gamma > g * (1 + 1e-6):  # the guard does not bind: the problem itself from here
@@ -223,15 +56,6 @@ class MultiStart:
                 x.t_ipopt, x.iterations = t_ipopt, iterations
                 return x
         return None
-
-    def wider(self, problem, plan, targets, starts_n, seed, max_rounds):
-        """(candidates, claim, plan) of one more multi-start of WIDER times ``starts_n`` space-filling starts
-        (already grown with the free parameters), from seed + 1, without the closed-form points and the atlas."""
-        wide = dataclasses.replace(plan, atlas=atlas_.Starts()) if plan.kind == "none" else starts_.plan(problem, False)
-        more, how, _ = self.candidates(
-            problem, wide, [], targets, WIDER * starts_n, seed + 1, max_rounds, Designs(), retry=False
-        )
-        return more, how, wide
 
     def run(self, problem, runs, targets, max_rounds, designs, both_ways, patient=False, hint=None):
         """A local solve from every start; the incumbent's NLP value prunes starts that cannot beat it; patient:
@@ -253,7 +77,7 @@ class MultiStart:
                     for way in ways:
                         count[way] += 1
         for _, origin, _, _, ways in plans:
-            if origin == "multistart" and len(ways) == 1 and count[-ways[0]] < MIN_WAY:
+            if origin == "multistart" and len(ways) == 1 and count[-ways[0]] < self.settings.min_way:
                 ways.append(-ways[0])
                 count[-ways[0]] += 1
         out, bound = [], None
@@ -320,11 +144,12 @@ class MultiStart:
         # the objective between the scan's points can have several minima, and a narrow valley beyond the first
         # (between the end of the family and its first scan point, say): the search runs between the best of a
         # finer grid's neighbours
-        ts = np.linspace(lo, hi, WALK_GRID)
+        grid, xtol = self.settings.walk_grid, self.settings.walk_xtol
+        ts = np.linspace(lo, hi, grid)
         k = int(np.argmin([cost(t) for t in ts]))
-        lo, hi = ts[max(k - 1, 0)], ts[min(k + 1, WALK_GRID - 1)]
+        lo, hi = ts[max(k - 1, 0)], ts[min(k + 1, grid - 1)]
         found = minimize_scalar(
-            cost, bounds=(lo, hi), method="bounded", options={"xatol": WALK_XTOL * max(abs(lo), abs(hi))}
+            cost, bounds=(lo, hi), method="bounded", options={"xatol": xtol * max(abs(lo), abs(hi))}
         )
         v = design(found.x) if np.isfinite(found.fun) else None
         if v is None:
@@ -335,9 +160,9 @@ class MultiStart:
         return c
 
 
-def _under(problem, guard: float):
+def under(problem, guard: float):
     """The problem with every transmission angle at least ``guard`` (rad) instead of its own gamma_min bound."""
-    return problem.replace(conditions={**problem.conditions, "gamma_min": guard})
+    return problem.replace(conditions={**problem.conditions, criteria.GUARDED: guard})
 
 
 def expected(problem, found, designs) -> tuple[float | None, float | None]:
@@ -360,13 +185,13 @@ def expected(problem, found, designs) -> tuple[float | None, float | None]:
     return at_nodes[0] + u * (at_nodes[1] - at_nodes[0]), min(at_nodes.values())
 
 
-def short(problem, cands, floor: float | None) -> bool:
-    """Whether the best certified candidate (or none) falls ATLAS_SHORT (relative) below ``expected``'s value."""
+def short(problem, cands, floor: float | None, tol: float) -> bool:
+    """Whether the best certified candidate (or none) falls ``tol`` (relative) below ``expected``'s value."""
     if floor is None:
         return False
     sign = criteria.sense(problem.objective)
     best = max((sign * criteria.objective_of(problem, c.mechanism) for c in cands if c.ok), default=-np.inf)
-    return bool(best < floor - ATLAS_SHORT * abs(floor))
+    return bool(best < floor - tol * abs(floor))
 
 
 def score(problem, values, branch, build):
@@ -399,16 +224,4 @@ def distinct(cands):
     return out
 
 
-__all__ = [
-    "MultiStart",
-    "score",
-    "distinct",
-    "MIN_WAY",
-    "MANY_STARTS",
-    "WIDER",
-    "THIN",
-    "GUARD_STEP",
-    "GUARD_LEAST",
-    "EVOLUTION_GENERATIONS",
-    "AGAIN",
-]
+__all__ = ["MultiStart", "score", "distinct", "expected", "short", "under", "NEAR", "AGAIN"]

@@ -13,9 +13,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from qropt.errors import QroptError
-from qropt.kinematics.closures import transmission_angle
 from qropt.kinematics.ops import NUMPY
-from qropt.synthesis import analytic
+from qropt.synthesis import analytic, criteria
 from qropt.synthesis import atlas as atlas_
 from qropt.synthesis.formulation import slow_interval
 
@@ -255,18 +254,15 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
     footprint). [] where scaling is not free or the objective has no grid value here. Grid values choose starts;
     results come from the local solves."""
     scalable = list(problem.mechanism.scalable())
-    grid_objective = {"max_gamma_min": 0, "min_peak_accel": 1}.get(problem.objective)
-    if problem.objective == "min_size" and problem.size == "footprint":
-        grid_objective = 2
+    c = criteria.grid_criterion(problem)
     target = problem.targets.get("stroke")
-    if grid_objective is None or target is None or "time_ratio" not in problem.targets or n <= 0:
+    if c is None or target is None or "time_ratio" not in problem.targets or n <= 0:
         return []
     if any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable):
         return []
     names = list(problem.free)
     pts = rule_points(problem, SHAPES, seed, least=SHAPES // 8)
     theta = np.linspace(0.0, 2 * np.pi, SHAPES_GRID, endpoint=False)
-    wave = np.fft.rfftfreq(SHAPES_GRID, 1.0 / SHAPES_GRID) ** 2
     tr_target, found = problem.targets["time_ratio"], []
     chunks = grid_loops(problem, _columns(problem, pts), theta)
     with np.errstate(all="ignore"):
@@ -278,7 +274,6 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
             if chunk is None:
                 break
             _, cols, loop, x = chunk
-            rows = x.shape[0]
             ok = turns(loop, x)
             tr, stroke = refined_cycle(x)
             scale = target / stroke
@@ -289,19 +284,7 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
                 ok &= (v >= lo) & (v <= hi)
             if not ok.any():
                 continue
-            if grid_objective == 0:
-                value = -np.full(rows, np.pi / 2)
-                for lines in loop.transmission.values():
-                    if lines is not None:
-                        g = np.broadcast_to(transmission_angle(NUMPY, lines), x.shape).min(axis=1)
-                        value = np.maximum(value, -g)
-            elif grid_objective == 1:
-                d2 = np.fft.irfft(-wave * np.fft.rfft(x, axis=1), n=theta.size, axis=1)
-                value = np.abs(d2).max(axis=1) * scale * problem.omega2**2
-            else:
-                xs = np.concatenate([np.broadcast_to(q[0], x.shape) for q in loop.points.values()], axis=1)
-                ys = np.concatenate([np.broadcast_to(q[1], x.shape) for q in loop.points.values()], axis=1)
-                value = np.ptp(xs, axis=1) * np.ptp(ys, axis=1) * scale**2
+            value = c.grid_value(problem, loop, x, scale)
             ok &= np.isfinite(value)
             for j in np.flatnonzero(ok).tolist():
                 v = {k: float(cols[k][j] * (scale[j] if k in scalable else 1.0)) for k in names}

@@ -1,0 +1,179 @@
+"""The search's parts: the Strategy protocol, the Pool a solve's strategies share, the Context of one solve, and
+the runner that walks a pipeline once.
+
+A strategy says whether it applies to a problem and its plan of starts (``accepts``: what the problem and its
+criterion declare, never a criterion's name) and then acts on the pool (``run``): it adds starts, runs local
+solves, adds candidates and descent ends, or makes the Result. A strategy returns ``STOP`` to end the pipeline (or
+the phase) it runs in. Each candidate keeps its provenance as data (``Candidate.origin``, ``parent`` and its cost);
+the claim of the certificate is rendered from the pool's words when the Result is made.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Protocol, runtime_checkable
+
+from qropt.errors import ProblemError
+from qropt.synthesis.certificate import Designs
+
+STOP = "stop"  # a strategy's run returns this to end the pipeline (or the phase) it runs in
+
+
+@runtime_checkable
+class Strategy(Protocol):
+    """One stage of a solve. ``name``: a few words for claims and tables."""
+
+    name: ClassVar[str]
+
+    def accepts(self, problem, plan) -> bool:
+        """Whether it applies to ``problem`` with this plan of starts (``starts.Plan``; None before one is made)."""
+
+    def run(self, problem, pool: Pool, context: Context) -> str | None:
+        """Act on the pool; ``STOP`` ends the pipeline (or phase) it runs in."""
+
+
+class Stage:
+    """A convenient base for strategies: accepts every problem."""
+
+    name: ClassVar[str] = ""
+
+    def accepts(self, problem, plan) -> bool:
+        return True
+
+    def __repr__(self):
+        return f"<strategy {self.name}>"
+
+
+@dataclass
+class Pool:
+    """What a solve's strategies share: the plan of starts, the queue of starts and the candidates they gave, the
+    descent ends, the claim's words, the time each strategy spent, and the Result once one is made."""
+
+    plan: Any = None  # starts.Plan
+    designs: Designs = field(default_factory=Designs)  # every mechanism this solve builds, built once
+    runs: list = field(default_factory=list)  # queued starts: (origin, values[, branch, ...])
+    candidates: list = field(default_factory=list)  # local.Candidate, every one kept
+    more: list = field(default_factory=list)  # candidates of the global strategies, merged after the second pass
+    ends: list = field(default_factory=list)  # evolution.End, best first
+    claim: str = ""  # what the best design rests on (a closed form's words, the atlas's)
+    notes: list = field(default_factory=list)  # the global strategies' words: "with ..." in the claim
+    retry: Any = None  # the multi-start's second pass, deferred (a callable) where the diagnosis may run it
+    spent: dict = field(default_factory=dict)  # statistics the strategies add to the Result's
+    ran: list = field(default_factory=list)  # (strategy name, seconds) in the order they ran
+    result: Any = None  # the Result, once made
+
+    @property
+    def good(self) -> list:
+        """The certified candidates."""
+        return [c for c in self.candidates if c.ok]
+
+    @property
+    def guard(self) -> str:
+        """The global strategies' words, joined as the claim shows them."""
+        return "; ".join(self.notes)
+
+
+@dataclass
+class Context:
+    """One solve's options and the Solver's parts. given: starts given (free-parameter dicts), tried first;
+    asked: whether ``starts_n`` was named (else grown with the free parameters); hint: a nearby optimum to
+    continue (``newton.Hint``); t0: when the solve began (perf_counter s)."""
+
+    solver: Any
+    targets: dict
+    starts_n: int
+    seed: int
+    max_rounds: int
+    given: list = field(default_factory=list)
+    use_analytic: bool = True
+    diagnose: bool = True
+    asked: bool = False
+    hint: Any = None
+    t0: float = field(default_factory=time.perf_counter)
+
+    @property
+    def settings(self):
+        return self.solver.settings
+
+    def options(self, **changed) -> dict:
+        """This solve's options as ``run`` takes them, some changed."""
+        out = {
+            "targets": self.targets,
+            "starts_n": self.starts_n,
+            "seed": self.seed,
+            "max_rounds": self.max_rounds,
+            "given": self.given,
+            "use_analytic": self.use_analytic,
+            "diagnose": self.diagnose,
+            "asked": self.asked,
+            "hint": self.hint,
+        }
+        out.update(changed)
+        return out
+
+    def sub(self, problem, **changed):
+        """The Result of another problem (a scaled copy, a bound's own optimum, a tie-break) by the Solver's
+        pipeline: this solve's starts_n (as named, not grown again), seed, rounds and diagnosis, its own targets,
+        the closed forms, no given starts, with these options changed (given starts and no diagnosis keep it
+        short)."""
+        base = {"targets": dict(problem.targets), "given": [], "use_analytic": True, "asked": True, "hint": None}
+        opts = self.options(**{**base, **changed})
+        return solve(self.solver.pipeline, problem, Context(self.solver, **opts))
+
+    def multistart(self, problem, plan, starts_n, seed, designs=None, *, retry=True, max_rounds=None):
+        """The Solver's starts phase on ``problem`` with ``plan`` and no given starts: (candidates, claim, the
+        deferred second pass or None). retry: run the second pass here where it applies."""
+        pool = Pool(plan=plan, designs=designs if designs is not None else Designs())
+        rounds = self.max_rounds if max_rounds is None else max_rounds
+        changed = {"starts_n": starts_n, "seed": seed, "given": [], "diagnose": not retry, "hint": None}
+        ctx = Context(self.solver, **self.options(max_rounds=rounds, **changed))
+        run(self.solver.starts, problem, pool, ctx)
+        return pool.candidates, pool.claim, pool.retry
+
+
+def spread(pool: Pool, context: Context) -> bool:
+    """Whether the space-filling starts run: no closed form enumerates or walks every design, or starts are given."""
+    return bool(context.given) or pool.plan.kind not in ("enumeration", "family")
+
+
+def run(stages, problem, pool: Pool, context: Context) -> str | None:
+    """Each strategy of ``stages`` that accepts the problem, in order, until one returns STOP (returned)."""
+    for s in stages:
+        if not s.accepts(problem, pool.plan):
+            continue
+        t = time.perf_counter()
+        said = s.run(problem, pool, context)
+        pool.ran.append((s.name, time.perf_counter() - t))
+        if said == STOP:
+            return STOP
+    return None
+
+
+def solve(stages, problem, context: Context):
+    """The Result of one pass of ``stages`` over a fresh pool (a pipeline must make one); its stats name the
+    strategies that ran (``strategies``: those of the pass that made it, where another pass made it)."""
+    pool = Pool()
+    run(stages, problem, pool, context)
+    if pool.result is None:
+        names = [s.name for s in stages]
+        raise ProblemError(f"the pipeline {names} made no Result (it needs a strategy that makes one, as Failed does)")
+    if "strategies" in pool.result.stats:
+        return pool.result
+    ran = list(dict.fromkeys(name for name, _ in pool.ran))
+    return dataclasses.replace(pool.result, stats={**pool.result.stats, "strategies": ran})
+
+
+@dataclass(frozen=True)
+class Phase(Stage):
+    """A named list of strategies run as one (a STOP inside ends the phase only)."""
+
+    name: ClassVar[str] = "phase"
+    stages: tuple = ()
+
+    def run(self, problem, pool, context):
+        run(self.stages, problem, pool, context)
+
+
+__all__ = ["Strategy", "Stage", "Pool", "Context", "Phase", "run", "solve", "spread", "STOP"]

@@ -1,0 +1,248 @@
+"""The diagnosis of a solve without a certified design: why, within a stated budget.
+
+In order, each step only where the ones before said nothing:
+1. each bound condition against the best value of its criterion among designs that meet the targets (one solve
+   of that criterion, without diagnosis): a bound beyond it is 'infeasible', and that solve's designs that meet
+   every bound start one refinement of the problem;
+2. each target against its range (``Solver.target_range``: sampled designs and ``range_solves`` local solves): a
+   range is sampled, so a target outside it is said, not proved absent ('infeasible' only where a complete
+   closed form gives no design);
+3. a feasibility solve (no objective): a design meeting every target and condition found there starts one
+   refinement of the objective, and otherwise makes the answer 'failed' (the optimum was not reached), never
+   'infeasible';
+4. where the closed forms gave the starts, one space-filling search of ``starts_n`` starts (they may have missed);
+   where there are none or only starting points, one multi-start of ``wider`` times the starts (the spread starts may
+   have been too few); it runs too where the multi-start's second pass finds fewer than ``thin`` certified designs.
+Every other solve here runs the pipeline without diagnosis and with at most ``diagnosis_starts`` space-filling
+starts (``Settings``), so a diagnosis costs at most (bounds + 4) solves and ``range_solves`` local solves per target.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+from qropt.synthesis import atlas as atlas_
+from qropt.synthesis import criteria
+from qropt.synthesis import starts as starts_
+from qropt.synthesis.result import Result
+from qropt.synthesis.search import results
+from qropt.synthesis.search.base import STOP, Stage
+
+
+class Failed(Stage):
+    """Where no diagnosis is asked for: 'failed', with the backend's reasons."""
+
+    name = "failed"
+
+    def run(self, problem, pool, context):
+        if context.diagnose:
+            return None
+        cands = pool.candidates
+        stats = {**results.stats(context.solver, problem, cands, pool.plan), **pool.spent}
+        stats["t_total"] = time.perf_counter() - context.t0
+        why = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
+        pool.result = Result(
+            "failed",
+            f"no start gave a certified design ({'; '.join(w for w in why[:3] if w)}); not diagnosed",
+            stats=stats,
+            units=problem.units,
+        )
+        return STOP
+
+
+class Diagnose(Stage):
+    """No certified design: the Result that says why."""
+
+    name = "diagnosis"
+
+    def run(self, problem, pool, context):
+        pool.result = diagnose(context, problem, pool.plan, pool.candidates, pool.claim, pool.retry)
+        return STOP
+
+
+def _sub(context, problem, **kw):
+    """A solve of the diagnosis: the Solver's own rounds, no diagnosis."""
+    return context.sub(problem, max_rounds=context.solver.max_rounds, diagnose=False, **kw)
+
+
+def diagnose(context, problem, plan, cands, claim, retry) -> Result:
+    """No certified design among ``cands`` (from ``plan``; ``retry``: the multi-start's second pass, or None)."""
+    solver, targets, seed, t0 = context.solver, context.targets, context.seed, context.t0
+    s = context.settings
+    n = min(context.starts_n, s.diagnosis_starts)
+
+    def done(status, msg, **kw):
+        stats = results.stats(solver, problem, cands, plan)
+        stats["t_total"] = time.perf_counter() - t0
+        return Result(status, msg, stats=stats, units=problem.units, **kw)
+
+    beyond, found = bound_out_of_reach(context, problem, n)
+    if beyond:
+        return done("infeasible", beyond[0], reachable=beyond[1])
+    if found:  # a design optimising a bounded criterion meets every bound: refine from it
+        r = _sub(context, problem, starts_n=0, given=found, use_analytic=False)
+        if r.success:
+            return r
+    # a complete enumeration that gives no design proves there is none; the ranges are sampled (designs and local
+    # solves): a target beyond them proves nothing (a type can reach targets well beyond its sampled range), so the
+    # search goes on
+    proved = plan.kind == "enumeration" and not plan.analytic  # (every design it gives outside the bounds)
+    reach = solver.target_ranges(
+        problem, targets, list(targets), starts_n=n, seed=seed, solves=s.range_solves, toward=True
+    )
+    msgs = [range_message(problem, k, targets[k], lo, hi, proved) for k, (lo, hi) in reach.items()]
+    outside = [  # a target beyond the designs found; none found proves nothing
+        m
+        for (k, (lo, hi)), m in zip(reach.items(), msgs, strict=True)
+        if math.isfinite(lo) and not inside(targets[k], lo, hi)
+    ]
+    if proved:
+        where = " inside the bounds" if plan.outside else ""
+        why = f"no design: the closed form that gives every design ({plan.how}) gives none{where} for these targets"
+        return done("infeasible", "; ".join([why, *msgs]), reachable=reach)
+    cands, claim, wide = searched(context, problem, plan, cands, claim, retry)
+    if any(c.ok for c in cands):
+        return results.best(solver, problem, cands, claim, wide, t0)
+    if problem.objective and not found:  # is there any design at all? (then the objective's solves failed)
+        r = _sub(context, problem.replace(objective=None), starts_n=n)
+        found = [{k: r.params[k] for k in problem.free}] if r.success else []
+        if found:
+            r = _sub(context, problem, starts_n=0, given=found, use_analytic=False)
+            if r.success:
+                return r
+    if plan.kind in ("family", "enumeration") and plan.analytic:  # the closed forms may have missed
+        # space-filling starts, each in its own TR orientation only (a second chance, not a second multi-start)
+        none = starts_.plan(problem, use_analytic=False)
+        more, how, _ = context.multistart(
+            problem, none, context.starts_n, seed, retry=False, max_rounds=solver.max_rounds
+        )
+        if any(c.ok for c in more):
+            return results.best(solver, problem, more, how, none, t0)
+    feas = solver.tolerances["feasibility"]
+    if all(max(c.residuals.values(), default=0.0) > feas or c.mechanism is None for c in cands):
+        ends: dict = {}
+        for c in cands:
+            k = c.statuses[-1] if c.statuses else "no run"
+            ends[k] = ends.get(k, 0) + 1
+        how = ", ".join(f"{n} {k}" for k, n in sorted(ends.items(), key=lambda kv: -kv[1]))
+        msg = f"none of {len(cands)} starts reaches a design meeting the targets and conditions together "
+        alone = "though each target alone can be met" if not outside else "and the designs sampled for the ranges"
+        msg += f"({solver.backend.name}: {how}), {alone} (" + "; ".join(msgs) + ")"
+        if found:  # a design meeting every target and condition exists: the objective's solves failed
+            shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
+            msg += (
+                f"; designs meeting every target and condition exist (one: {shown}), so the {problem.objective}"
+                " optimum was not reached (it may lie at a singular limit: a dead point, a link of zero "
+                "length or a bound)" + _dead_point_hint(problem)
+            )
+            return done("failed", msg, reachable=reach)
+        # local runs prove nothing of the whole problem, wherever they end (a run that converges to a point the
+        # exact evaluation refuses, even where designs exist): no design was found, none was proved absent
+        return done("failed", msg + "; no design was found, none was proved absent", reachable=reach)
+    reasons = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
+    why = "; ".join(r for r in reasons[:3] if r)
+    msg = f"no start converged to a certified design ({why}); " + "; ".join(msgs)
+    if found:
+        shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
+        msg += f"; a design meeting every target and condition: {shown}" + _dead_point_hint(problem)
+    return done("failed", msg, reachable=reach)
+
+
+def searched(context, problem, plan, cands, claim, retry):
+    """The searches a first pass without a certified design calls for: its second pass (``retry``, every
+    space-filling start both ways), and where that certifies fewer than ``thin`` designs and the closed forms give
+    starting points or none, one multi-start of ``wider`` times the starts, from seed + 1, without the closed-form
+    points and the atlas (the spread starts may have been too few). (candidates, claim, plan) to take the best of:
+    the passes' and, where it certifies any, the wider one's, every start counted."""
+    s = context.settings
+    if retry is not None:
+        cands = cands + retry()
+        if sum(c.ok for c in cands) >= s.thin:
+            return cands, claim, plan
+    if plan.kind in ("none", "partial") and context.starts_n > 0:
+        wide = dataclasses.replace(plan, atlas=atlas_.Starts()) if plan.kind == "none" else starts_.plan(problem, False)
+        more, how, _ = context.multistart(
+            problem,
+            wide,
+            s.wider * context.starts_n,
+            context.seed + 1,
+            retry=False,
+            max_rounds=context.solver.max_rounds,
+        )
+        if any(c.ok for c in more):
+            return cands + more, how, wide
+    return cands, claim, plan
+
+
+def bound_out_of_reach(context, problem, starts_n):
+    """((message, {quantity: (low, high)}) if a bound condition is beyond what any design meeting the targets and
+    the other conditions reaches (its best value, from a solve optimising it), else None; and the designs of those
+    solves that meet every bound, as starts)."""
+    found = []
+    tol = context.solver.tolerances["feasibility"]
+    for key, c in criteria.bounds().items():
+        bound = problem.conditions.get(key)
+        if bound is None:
+            continue
+        sub = problem.replace(
+            objective=c.objective,
+            size=c.size or problem.size,
+            conditions={k: v for k, v in problem.conditions.items() if k != key},
+        )
+        r = _sub(context, sub, starts_n=starts_n)
+        if r.status not in ("optimal", "acceptable"):
+            continue
+        found += [
+            {k: o.params[k] for k in problem.free}
+            for o in r.local_optima or (r,)
+            if max(criteria.violations(problem, o.mechanism).values(), default=0.0) <= tol
+        ]
+        best = r.objective
+        if c.better(bound, best):
+            span = (0.0, best) if c.maximise else (best, math.inf)
+            word = "largest" if c.maximise else "smallest"
+
+            def show(v, c=c):
+                deg = f" ({math.degrees(v):.2f} deg)" if c.unit == "rad" else ""
+                return f"{v:.6g} {c.unit}{deg}"
+
+            msg = (
+                f"{key} {show(bound)} is beyond reach: the {word} {c.name} of a design meeting the "
+                f"targets and the other conditions is {show(best)} ({r.certificate.global_claim})"
+            )
+            return (msg, {c.name: span}), []
+    return None, found
+
+
+def inside(v, lo, hi) -> bool:
+    """v within a found range, to 1e-6 relative: the range's ends are designs found, not proofs of an end."""
+    tol = 1e-6 * max(1.0, abs(v))
+    return lo - tol <= v <= hi + tol
+
+
+def range_message(problem, k, v, lo, hi, proved: bool = True):
+    """A target against its range: 'the reachable' range where a complete closed form proves it, else the range
+    of the designs sampled (which proves nothing beyond them)."""
+    bounds = ", ".join(f"{n} in [{a:g}, {b:g}]" for n, (a, b) in problem.free.items())
+    if not math.isfinite(lo):
+        return f"no sampled design turns fully and meets the conditions for {bounds}"
+    where = "inside" if inside(v, lo, hi) else "below" if v < lo else "above"
+    reach = "the reachable" if proved else "the sampled range"
+    return f"{k} {v:g} is {where} {reach} {lo:.6g}..{hi:.6g} for {bounds}"
+
+
+def _dead_point_hint(problem) -> str:
+    """For a dynamic objective without a transmission bound: why its optimum may sit at a dead point."""
+    c = criteria.of_problem(problem)
+    if c is None or c.kinematic or criteria.GUARDED in problem.conditions:
+        return ""
+    return (
+        f"; {problem.objective} may drive a design toward a dead point of a joint (a transmission angle of zero, "
+        "where the joint forces grow without bound but the torque and shaking stay finite): a gamma_min condition "
+        "keeps the designs away from it"
+    )
+
+
+__all__ = ["Diagnose", "Failed", "diagnose", "searched", "inside", "range_message"]

@@ -1,0 +1,43 @@
+"""Where the guard applies (``guard.guard_of``) and the evolution can put designs on the targets
+(``evolution.applies``): local solves from the ends of descents on the exact objective from differential
+evolutions' designs (``descents.descended``; ``Solver.evolutions_of`` of them, from seeds seed, seed + 1, ...). Run
+whether or not the passes certify a design: the descents reach basins the passes miss. Its ends go to the pool
+(``Pool.ends``), which the ``Descended`` strategy compares with the certified designs."""
+
+from __future__ import annotations
+
+import time
+
+from qropt.synthesis import descents
+from qropt.synthesis import evolution as evolution_
+from qropt.synthesis.search.base import Stage
+from qropt.synthesis.search.guard import guard_of
+
+
+class Evolution(Stage):
+    name = "differential evolution"
+
+    def accepts(self, problem, plan):
+        return guard_of(problem, plan) is not None and evolution_.applies(problem)
+
+    def run(self, problem, pool, context):
+        solver = context.solver
+        if context.given or not solver.evolution:
+            return
+        t0, seed = time.perf_counter(), context.seed
+        count, generations = solver.evolutions_of(problem), context.settings.evolution_generations
+        each = [descents.descended(problem, generations, seed + i, sqp=solver.sqp) for i in range(count)]
+        runs = [("evolution", e.design) for ends in each for e in ends[: evolution_.KEEP]]  # the best distinct ends
+        out = solver.multistart.run(problem, runs, context.targets, context.max_rounds, pool.designs, both_ways=False)
+        which = (
+            "a differential evolution"
+            if count == 1
+            else f"{count} differential evolutions (seeds {seed}-{seed + count - 1})"
+        )
+        pool.notes.append(
+            f"{len(runs)} starts from descents on the exact objective after {which} of "
+            f"{generations} generations, {sum(x.ok for x in out)} certified"
+        )
+        pool.more += out
+        pool.ends = sorted((e for ends in each for e in ends), key=lambda e: e.value)
+        pool.spent["t_evolution"] = time.perf_counter() - t0

@@ -1,0 +1,12 @@
+"""Given starts (``extra_starts``, a neighbour's optimum): queued first, in their own TR orientation."""
+
+from __future__ import annotations
+
+from qropt.synthesis.search.base import Stage
+
+
+class Given(Stage):
+    name = "given starts"
+
+    def run(self, problem, pool, context):
+        pool.runs += [("given", v) for v in context.given]

@@ -1,0 +1,150 @@
+"""The search as a declared pipeline (``qropt.synthesis.search``): a strategy and a dynamic criterion of one's own in
+one file each, a custom pipeline, results that do not depend on what ran before or on the order of the types, and
+the structural checks (the Solver never calls its own solve; generic search code names no criterion)."""
+
+from __future__ import annotations
+
+import ast
+import json
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+import qropt
+from benchmarks.tasks import LOADS, MASSES, OMEGA2
+from qropt import ProblemError, Solver
+from qropt.studies._design import TYPES, design, type_problem
+from qropt.synthesis import criteria, minimax, search, starts
+from qropt.synthesis.search import Settings
+from qropt.synthesis.search.local_solves import LocalSolves
+from tests.toy_strategy import GridStarts
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+SYNTHESIS = ROOT / "qropt" / "synthesis"
+KW = {"masses": MASSES, "loads": LOADS, "omega2": OMEGA2}
+
+
+def test_a_strategy_in_one_file_runs_in_a_custom_pipeline():
+    """``Solver(pipeline=...)``: the default pipeline with its starts phase replaced by the toy's grid starts and
+    the local solves. The solve is certified from the grid's starts alone (no closed forms, no atlas, no Sobol
+    points: the Result's stats name the strategies that ran) and reaches the default solve's optimum."""
+    problem = type_problem("slider-crank", 1.6, 0.3)
+    default = Solver().solve(problem)
+    phase = search.Phase((GridStarts(), LocalSolves()))
+    custom = [phase if isinstance(s, search.Phase) else s for s in search.DEFAULT]
+    r = Solver(pipeline=custom, atlas=False).solve(problem, use_analytic=False)
+    assert default.status == r.status == "optimal", r.message
+    assert r.stats["origin"] == "grid"
+    assert "grid starts" in r.stats["strategies"] and "Sobol multi-start" not in r.stats["strategies"]
+    assert r.objective == pytest.approx(default.objective, rel=1e-9)
+    m = r.mechanism
+    assert (m.time_ratio(), m.stroke()) == pytest.approx((1.6, 0.3), rel=1e-9)
+
+
+def test_a_pipeline_is_a_list_of_strategies_and_must_make_a_result():
+    with pytest.raises(ProblemError, match="pipeline is a list of strategies"):
+        Solver(pipeline="fast")
+    with pytest.raises(ProblemError, match="accepts"):
+        Solver(pipeline=[object()])
+    with pytest.raises(ProblemError, match="made no Result"):
+        Solver(pipeline=[GridStarts()]).solve(type_problem("crank-shaper", 1.6, 0.3))
+    with pytest.raises(ProblemError, match="positive int"):
+        Settings(evolution_generations=0)
+    with pytest.raises(ProblemError, match="Settings are"):
+        Solver(settings={"no_such": 1})
+    s = Solver(settings=Settings(thin=5))
+    assert Solver(**s.options()).settings == s.settings  # a worker's Solver has the same settings
+
+
+def _accepted(problem, plan) -> list[str]:
+    return [s.name for s in (*search.DEFAULT, *search.STARTS) if s.accepts(problem, plan)]
+
+
+def test_a_dynamic_criterion_in_one_file_gets_the_searches_the_shipped_ones_get():
+    """A user's copy of the peak torque (tests/toy_dynamic_criterion.py): every strategy that accepts the shipped
+    criterion's problem accepts its problem (the guarded multi-start, the evolution, the SQP on the exact peak among
+    them), and a solve by it (a shortened evolution) gives the shipped criterion's row to the last bit."""
+    from tests import toy_dynamic_criterion  # registers peak_drive_torque
+
+    shipped = type_problem("crank-shaper-rod", 1.6, 0.3, objective="min_peak_torque", **KW)
+    toy = type_problem("crank-shaper-rod", 1.6, 0.3, objective="min_" + toy_dynamic_criterion.DRIVE.name, **KW)
+    plan = starts.plan(shipped, True, True)
+    assert _accepted(toy, plan) == _accepted(shipped, plan)
+    assert {"transmission guard", "differential evolution"} <= set(_accepted(toy, plan))
+    assert minimax.applies(toy)
+    solver = Solver(settings=Settings(evolution_generations=20))
+    a, b = solver.solve(shipped), solver.solve(toy)
+    assert a.status == b.status and a.success, (a.message, b.message)
+    assert b.objective == a.objective and b.params == a.params
+    assert "transmission guard" in b.certificate.global_claim and "differential evolution" in b.message
+
+
+def _rows(cmp) -> dict:
+    return {r.type: [r.result.status, float(r.result.objective).hex(), dict(r.result.params)] for r in cmp.rows}
+
+
+def test_a_design_is_the_same_in_a_fresh_process_after_other_solves_and_in_another_order():
+    """``design(1.5, 0.3)``: the same rows, to the last bit, in a fresh process, in this one after other solves, and
+    with the types asked for in reverse order."""
+    code = (
+        "import json, qropt; c = qropt.design(1.5, 0.3); print(json.dumps({r.type: [r.result.status, "
+        "float(r.result.objective).hex(), dict(r.result.params)] for r in c.rows}))"
+    )
+    fresh = json.loads(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout)
+    qropt.design(2.0, 0.5)
+    qropt.design(1.2, 0.1, objective="min_peak_accel")
+    after = _rows(design(1.5, 0.3))
+    backwards = _rows(design(1.5, 0.3, types=list(reversed(TYPES))))
+    assert after == fresh
+    assert backwards == fresh
+
+
+def _functions(path):
+    return [n for n in ast.walk(ast.parse(path.read_text())) if isinstance(n, ast.FunctionDef)]
+
+
+def test_the_solver_never_calls_its_own_solve():
+    """No module of the synthesis calls a Solver's ``solve`` (``self.solve``, ``solver.solve``): a strategy that
+    needs another problem solved runs the pipeline through ``Context.sub``."""
+    calls = []
+    for path in SYNTHESIS.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "solve":
+                receiver = ast.unparse(node.func.value)
+                if receiver in ("self", "solver", "self.solver", "context.solver"):
+                    calls.append(f"{path.name}:{node.lineno} {receiver}.solve")
+    assert calls == []
+
+
+GENERIC = ["search", "solver.py", "multistart.py", "starts.py", "local.py", "formulation.py", "backends.py"]
+GENERIC += ["evolution.py", "descents.py", "minimax.py", "newton.py", "atlas.py"]
+
+
+def test_no_criterion_name_in_generic_search_code():
+    """The strategies read the criteria's capabilities (``guard``, ``quantity``, ``grid_value``), never a name: no
+    string in the generic synthesis modules is a criterion's name, objective or bound."""
+    names = {criteria.SIZE_OBJECTIVE}
+    for c in criteria.CRITERIA.values():
+        names |= {c.name, c.objective, c.bound}
+    found = []
+    for part in GENERIC:
+        for path in [SYNTHESIS / part] if part.endswith(".py") else sorted((SYNTHESIS / part).glob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, ast.Constant) and isinstance(node.value, str) and node.value in names:
+                    found.append(f"{path.name}:{node.lineno} {node.value!r}")
+    assert found == []
+
+
+def test_each_default_strategy_is_one_module_with_a_name():
+    """One module per strategy in qropt/synthesis/search/, each strategy named, every name distinct."""
+    stages = [*search.DEFAULT, *search.STARTS]
+    named = [s for s in stages if not isinstance(s, search.Phase)]
+    assert all(isinstance(s, search.Strategy) for s in stages)
+    assert len({s.name for s in named}) == len(named) and all(s.name for s in named)
+    by_module: dict = {}
+    for s in named:
+        by_module.setdefault(type(s).__module__, []).append(s.name)
+    shared = {k: v for k, v in by_module.items() if len(v) > 1}
+    assert shared == {"qropt.synthesis.search.diagnosis": ["failed", "diagnosis"]}  # the two ends of a failed solve
