@@ -130,7 +130,9 @@ class Mechanism:
     CLOSED_FORMS: ClassVar[tuple[Callable, ...]] = ()
     # a named option -> the optional parameters (PARAMS default None) it gives together (e.g. a rod: r6 and h)
     OPTIONS: ClassVar[dict[str, tuple[str, ...]]] = {}
-    EXAMPLE: ClassVar[dict[str, float]] = {}  # a valid design of the type (parameter -> value): the app opens with it
+    # a valid design of the type (parameter -> value), the app's first: a shipped slider's is its design for TR 1.5
+    # and stroke 0.3 m (the drag-link slider's the paper's, the others' qropt.design's best gamma_min to 0.1 mm)
+    EXAMPLE: ClassVar[dict[str, float]] = {}
 
     def __init_subclass__(cls, **kw):
         super().__init_subclass__(**kw)
