@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 from qropt.mechanisms import DragLinkSlider
-from qropt.synthesis import analytic
 from qropt.synthesis.problem import Problem
 
 
 def paper_mechanism() -> DragLinkSlider:
-    """The paper's design: TR 1.5, stroke 0.3 m, r3 from eqs. (7)-(13) (the root with the larger gamma_min)."""
-    r3 = analytic.drag_link_r3(1.5, 0.1, 0.225, 0.275)[-1].r3
-    return DragLinkSlider(r1=0.1, r2=0.225, r3=r3, r4=0.275, r5=0.15, r6=0.3)
+    """The paper's design: TR 1.5, stroke 0.3 m, r3 from eqs. (7)-(13) (the root with the larger gamma_min); the
+    drag-link slider's example design (``DragLinkSlider.EXAMPLE``)."""
+    return DragLinkSlider(**DragLinkSlider.EXAMPLE)
 
 
 def paper_problem() -> Problem:

@@ -15,13 +15,14 @@ pytest.importorskip("flask")
 
 import qropt
 from qropt.app import create_app
-from qropt.app.defaults import SHIPPED, default_params
+from qropt.app.defaults import default_params
 from qropt.dynamics.cycle import CycleDynamics
 from qropt.dynamics.model import Loads, Masses
 from qropt.examples import paper_mechanism
 from qropt.io.export import load_design
-from qropt.mechanisms import mechanism_type
+from qropt.mechanisms import TYPES, mechanism_type
 
+SHIPPED = {cls.KIND: cls.EXAMPLE for cls in TYPES}  # every shipped type's example design, by its KIND
 PAPER = {"r1": 0.1, "r2": 0.225, "r3": 0.2504281217548, "r4": 0.275, "r5": 0.15, "r6": 0.3}
 README_PROBLEM = {
     "mechanism": "DragLinkSlider",
@@ -285,3 +286,19 @@ def test_defaults_follow_the_types():
         cls = mechanism_type(kind)
         assert set(default_params(cls)) <= set(cls.PARAMS)
         assert set(cls.required()) <= set(default_params(cls))
+
+
+def test_the_default_design_is_the_librarys_example(client):
+    """Every shipped type opens with the example design it declares; the drag-link slider's is the paper's design
+    (qropt.examples, the README: sigma = -1 and the exact r3), its slider at x = 0.529649 m at theta2 = 60 deg."""
+    info = {t["type"]: t for t in client.get("/api/types").get_json()}
+    for cls in TYPES:
+        assert default_params(cls) == cls.EXAMPLE, cls.KIND
+        assert cls(**info[cls.KIND]["params"]) == cls(**cls.EXAMPLE), cls.KIND
+    drag = mechanism_type("drag-link-slider")(**info["drag-link-slider"]["params"])
+    assert drag == paper_mechanism() and drag.params["sigma"] == -1.0
+    assert drag.params["r3"] == pytest.approx(PAPER["r3"], abs=1e-13)
+    body = {"type": "drag-link-slider", "params": info["drag-link-slider"]["params"], "theta2": math.radians(60.0)}
+    r = client.post("/api/analyze", json=body)
+    assert r.status_code == 200, r.get_json()
+    assert r.get_json()["cycle"]["x"][30] == pytest.approx(0.529649, abs=5e-7)  # the README's x at 60 deg

@@ -15,16 +15,16 @@ import pytest
 
 import qropt
 from qropt import cli, validate
-from qropt.app.defaults import SHIPPED
 from qropt.errors import ChartError, InvalidParameter, ProblemError
 from qropt.examples import paper_mechanism
 from qropt.io.export import load_design, read_design
-from qropt.mechanisms import REQUIRED, Mechanism, mechanism_type
+from qropt.mechanisms import REQUIRED, TYPES, Mechanism, mechanism_type
 from qropt.mechanisms.builder import Linkage, LinkageError
 from qropt.studies import Chart
 from qropt.validate import picture_path
 
 ROOT = Path(__file__).resolve().parent.parent
+SHIPPED = {cls.KIND: cls.EXAMPLE for cls in TYPES}  # every shipped type's example design, by its KIND
 NAN, INF = math.nan, math.inf
 
 

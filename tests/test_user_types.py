@@ -371,3 +371,49 @@ def test_the_example_files_solve_as_the_command_line_runs_them(tmp_path):
         assert out.returncode == 0, out.stderr
         d = json.loads(out.stdout)
         assert d["status"] == "optimal" and d["type"].startswith(f"problems.{name}:")
+
+
+def test_a_user_type_declares_its_closed_forms_crank_and_example():
+    """A type of one's own names its closed forms (CLOSED_FORMS, tried in order: the first that applies gives the
+    starts; a warm_starts hook that answers comes first), its crank (CRANK) and its example design (EXAMPLE, the
+    app's first; a subclass does not inherit it), as the shipped types do."""
+    from qropt.app.defaults import default_params
+    from qropt.mechanisms import SliderCrank
+    from qropt.mechanisms.closed_forms import slider_crank_starts
+    from qropt.synthesis import analytic, evolution
+
+    def never(c):
+        return None
+
+    def mid_bounds(c):
+        c.emit()
+        return c.result("partial", "mid-bounds")
+
+    class DeclaredSliderCrank(SliderCrank):
+        KIND = "declared-slider-crank"
+        CLOSED_FORMS = (never, mid_bounds, slider_crank_starts)
+        CRANK = "r3"
+        EXAMPLE = {"r2": 0.1, "r3": 0.4, "e": 0.05}
+
+    class InheritingSliderCrank(DeclaredSliderCrank):
+        KIND = "inheriting-slider-crank"
+
+    try:
+        p = Problem(
+            mechanism=DeclaredSliderCrank,
+            free={"r2": (0.1, 0.3), "r3": (0.4, 1.0), "e": (0.0, 0.2)},
+            targets={"time_ratio": 1.2, "stroke": 0.4},
+            objective="max_gamma_min",
+        )
+        w = analytic.warm_starts(p)
+        assert (w.kind, w.how, w.points) == ("partial", "mid-bounds", [{"r2": 0.2, "r3": 0.7, "e": 0.1}])
+        shipped = analytic.warm_starts(p.replace(mechanism=SliderCrank))
+        assert shipped.kind == "family" and shipped.points and shipped.points != w.points
+        assert analytic.warm_starts(p.replace(mechanism=InheritingSliderCrank)).points == w.points
+        other_crank = type("OtherCrankSliderCrank", (DeclaredSliderCrank,), {"CRANK": "r9"})
+        assert evolution.applies(p) and not evolution.applies(p.replace(mechanism=other_crank))
+        assert default_params(DeclaredSliderCrank) == DeclaredSliderCrank.EXAMPLE
+        assert default_params(InheritingSliderCrank) == {}
+    finally:
+        for kind in ("declared-slider-crank", "inheriting-slider-crank"):
+            REGISTRY.pop(kind, None)

@@ -30,6 +30,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from qropt.errors import InvalidParameter, QroptError
+from qropt.mechanisms import (
+    CrankRockerSlider,
+    CrankShaper,
+    DragLinkSlider,
+    Mechanism,
+    SliderCrank,
+    SlotRamShaper,
+    Whitworth,
+)
 from qropt.studies._design import bounds_of
 
 STROKE_RANGE = (0.1, 0.6)  # m
@@ -41,10 +50,11 @@ MIN_GAMMA = math.radians(15.0)  # a design worth building: its gamma_min over th
 
 @dataclass(frozen=True)
 class Spec:
-    """A type's project: the class, the given links (multiples of the stroke), the links to find, the adjustable
-    link, the TR range, the solve's conditions, each link's name and the four discussion issues."""
+    """A type's project: the mechanism type, the given links (multiples of the stroke), the links to find, the
+    adjustable link, the TR range, the solve's conditions, each link's name, the four discussion issues and the
+    worked answer to the third (how many designs the links to find and the further free link leave)."""
 
-    mechanism: str
+    mechanism: type[Mechanism]
     title: str
     layout: str
     given: dict
@@ -54,6 +64,7 @@ class Spec:
     conditions: dict
     names: dict
     issues: tuple
+    freedom: str
 
 
 _FOUR_BAR_NAMES = {
@@ -64,6 +75,14 @@ _FOUR_BAR_NAMES = {
     "r5": "pin C on the follower, O4C",
     "r6": "slider's rod CD",
 }
+_FOUR_BAR_FREEDOM = (
+    "A single infinity of solutions: with both r1 and r3 free the TR is one equation in two unknowns, which "
+    "leaves a curve of (r1, r3) designs (within the Grashof class); the stroke still fixes r5 alone."
+)
+_LEVER_FREEDOM = (
+    "A single infinity: the TR depends on the ratio of r1 and r2 only, so it fixes the ratio and every centre "
+    "distance r1 has its crank r2; the stroke then fixes the remaining link."
+)
 _LEVER_ISSUES = (
     "How many mechanisms providing the specified TR are possible if only the crank radius r2 is varied?",
     "What is the range of TR that would be possible by adjusting the crank radius r2 (within its bounds)?",
@@ -92,26 +111,27 @@ def _four_bar(mechanism, title, grashof, given, tr) -> Spec:
             "the coupler length could be changed?",
             "Discuss the issues you would consider in the isolation of a unique mechanism design.",
         ),
+        _FOUR_BAR_FREEDOM,
     )
 
 
-SPECS = {
-    "drag-link-slider": _four_bar(
-        "DragLinkSlider",
+SPECS = (
+    _four_bar(
+        DragLinkSlider,
         "drag-link-driven slider",
         "drag-link",
         {"r1": (0.25, 0.4), "r2": (0.65, 0.85), "r4": (0.85, 1.05), "r6": (0.9, 1.3)},
         (1.45, 1.8),
     ),
-    "crank-rocker-slider": _four_bar(
-        "CrankRockerSlider",
+    _four_bar(
+        CrankRockerSlider,
         "crank-rocker-driven slider",
         "crank-rocker",
         {"r1": (0.9, 1.2), "r2": (0.25, 0.4), "r4": (0.7, 1.0), "r6": (1.8, 2.4)},
         (1.1, 1.4),
     ),
-    "whitworth": Spec(
-        "Whitworth",
+    Spec(
+        Whitworth,
         "Whitworth quick-return",
         "the crank O2A (O2 at the origin) turns the slotted lever about O4 = (0, -r1), r2 > r1; pin C on the "
         "lever drives the rod CD and the ram D on the line through O4 (h = 0)",
@@ -127,9 +147,10 @@ SPECS = {
             "r6": "ram's rod CD",
         },
         _LEVER_ISSUES,
+        _LEVER_FREEDOM,
     ),
-    "crank-shaper": Spec(
-        "CrankShaper",
+    Spec(
+        CrankShaper,
         "crank-shaper",
         "the crank O2A (O2 at the origin) rocks the slotted lever about O4 = (0, -r1), r2 < r1; pin C on the lever "
         "at O4C = r4 drives the ram through a yoke (the ram moves with x_C)",
@@ -144,9 +165,10 @@ SPECS = {
             "r4": "pin C on the slotted lever, O4C",
         },
         _LEVER_ISSUES,
+        _LEVER_FREEDOM,
     ),
-    "slot-ram-shaper": Spec(
-        "SlotRamShaper",
+    Spec(
+        SlotRamShaper,
         "slot-ram shaper",
         "the crank O2A (O2 at the origin) rocks the slotted lever about O4 = (0, -r1), r2 < r1; the ram's pin D "
         "rides in the lever's slot on the slide line a height h above O4",
@@ -161,9 +183,10 @@ SPECS = {
             "h": "height of the slide line above O4",
         },
         _LEVER_ISSUES,
+        _LEVER_FREEDOM,
     ),
-    "slider-crank": Spec(
-        "SliderCrank",
+    Spec(
+        SliderCrank,
         "offset slider-crank",
         "the crank O2A (O2 at the origin) drives the slider C through the rod AC on the slide line y = e",
         {"r3": (0.9, 1.4)},
@@ -179,9 +202,11 @@ SPECS = {
             "could be changed too?",
             "Discuss the issues you would consider in the isolation of a unique mechanism design.",
         ),
+        "A single infinity: the TR and the stroke are two equations in r2, r3 and e, which leaves a curve of "
+        "designs; each rod length has its crank and offset.",
     ),
-}
-KINDS = tuple(SPECS)
+)
+KINDS = tuple(spec.mechanism.KIND for spec in SPECS)
 
 
 @dataclass(frozen=True)
@@ -213,7 +238,7 @@ class Project:
 
     @property
     def spec(self) -> Spec:
-        return SPECS[self.kind]
+        return _spec(self.kind)
 
     @property
     def mechanism(self):
@@ -236,8 +261,13 @@ class Project:
         return float(mo.v[0]), float(mo.a[0])
 
 
+def _spec(kind: str) -> Spec:
+    """The project of the type whose KIND this is."""
+    return next(spec for spec in SPECS if kind == spec.mechanism.KIND)
+
+
 def _kind(kind) -> str:
-    if not isinstance(kind, str) or kind not in SPECS:
+    if not isinstance(kind, str) or kind not in KINDS:
         raise InvalidParameter(f"unknown project type {kind!r}; the types are {', '.join(KINDS)}")
     return kind
 
@@ -248,14 +278,15 @@ def _seed(seed) -> int:
     return int(seed)
 
 
-def _free_bounds(name: str, stroke: float) -> tuple:
-    return bounds_of("offset" if name in ("e", "h") else "length", stroke)
+def _free_bounds(cls, name: str, stroke: float) -> tuple:
+    """A link's bounds in requirement 1: design's default bounds of its kind (``Mechanism.kinds()``)."""
+    return bounds_of(cls.kinds()[name], stroke)
 
 
-def _scan_bounds(p: dict, name: str, stroke: float) -> tuple:
+def _scan_bounds(cls, p: dict, name: str, stroke: float) -> tuple:
     """The adjustable link's scanned interval: its bounds in requirement 1, for a slotted lever kept where the TR
     stays below about 9 (r2 / r1 or r1 / r2 at most 0.95: the TR grows without bound as the ratio nears 1)."""
-    lo, hi = _free_bounds(name, stroke)
+    lo, hi = _free_bounds(cls, name, stroke)
     if name == "r2" and "r1" in p:
         lo, hi = (max(lo, p["r1"] / 0.95), hi) if p["r2"] > p["r1"] else (lo, min(hi, 0.95 * p["r1"]))
     return lo, hi
@@ -266,7 +297,7 @@ def _attempt(kind: str, rng):
     from qropt import reachable, solve
     from qropt.synthesis.problem import Problem
 
-    spec = SPECS[kind]
+    spec = _spec(kind)
     tr = round(float(rng.uniform(*spec.time_ratio)), 2)
     s = round(float(rng.uniform(*STROKE_RANGE)), 3)
     given = {k: round(float(rng.uniform(lo, hi)) * s, 3) for k, (lo, hi) in spec.given.items()}
@@ -277,7 +308,7 @@ def _attempt(kind: str, rng):
     problem = Problem(
         spec.mechanism,
         fixed=given,
-        free={k: _free_bounds(k, s) for k in spec.find},
+        free={k: _free_bounds(spec.mechanism, k, s) for k in spec.find},
         targets={"time_ratio": tr, "stroke": s},
         conditions=dict(spec.conditions),
         objective="max_gamma_min",
@@ -288,7 +319,7 @@ def _attempt(kind: str, rng):
         return None
     try:
         m = result.mechanism
-        reach = reachable(m, spec.adjustable, bounds=_scan_bounds(m.params, spec.adjustable, s))
+        reach = reachable(m, spec.adjustable, bounds=_scan_bounds(type(m), m.params, spec.adjustable, s))
         low = math.ceil(100 * reach.time_ratio_range.low + 1) / 100  # the band within the reachable TRs
         band = fields["band"] = (max(band[0], low), band[1])
         adjust = reach.adjustable(*band)
@@ -323,8 +354,8 @@ def project(kind: str, seed: int) -> Project:
         got = _attempt(kind, rng)
         if got is not None:
             fields, problem, result, reach, adjust = got
-            current = _current(SPECS[kind], result.mechanism, rng)
-            spec = SPECS[kind]
+            spec = _spec(kind)
+            current = _current(spec, result.mechanism, rng)
             return Project(
                 kind=kind,
                 seed=seed,
@@ -456,7 +487,7 @@ def _solution(p: Project) -> str:
     reach, adj = p.reach, p.adjust
     t = reach.time_ratio_range
     ivs = ", ".join(f"[{a:.4f}, {b:.4f}]" for a, b in reach.intervals)
-    scan = _scan_bounds(m.params, p.adjustable, p.stroke)
+    scan = _scan_bounds(type(m), m.params, p.adjustable, p.stroke)
     parts += [
         "<h2>Design requirement 2: the adjustable link</h2>",
         f"<p>With the other links as solved, {p.adjustable} works for {p.adjustable} in {ivs} {u} (scanned within "
@@ -473,7 +504,7 @@ def _solution(p: Project) -> str:
         + ", ".join(f"{x:.4f} {u}" for x in sols)
         + f" (the TR against {p.adjustable} is the figure above: zero, one or more crossings of a level).</li>",
         f"<li>Adjusting {p.adjustable} over its working range gives {t.low:.4f} &lt;= TR &lt;= {t.high:.4f}.</li>",
-        f"<li>{html.escape(_issue3(p))}</li>",
+        f"<li>{html.escape(p.spec.freedom)}</li>",
         f"<li>{html.escape(_issue4(p))}</li></ol>",
     ]
     rm = p.relative_motion()
@@ -527,23 +558,6 @@ def _command(p: Project) -> str:
     m = p.mechanism
     flags = " ".join(f"--{k.replace('_', '-')} {v:.10g}" for k, v in m.params.items() if not (k == "h" and v == 0.0))
     return f"qropt analyze {p.kind} {flags} --theta2 {math.degrees(p.theta2):.0f}deg --omega2 {p.omega2:g}"
-
-
-def _issue3(p: Project) -> str:
-    if p.kind in ("drag-link-slider", "crank-rocker-slider"):
-        return (
-            "A single infinity of solutions: with both r1 and r3 free the TR is one equation in two unknowns, which "
-            "leaves a curve of (r1, r3) designs (within the Grashof class); the stroke still fixes r5 alone."
-        )
-    if p.kind == "slider-crank":
-        return (
-            "A single infinity: the TR and the stroke are two equations in r2, r3 and e, which leaves a curve of "
-            "designs; each rod length has its crank and offset."
-        )
-    return (
-        "A single infinity: the TR depends on the ratio of r1 and r2 only, so it fixes the ratio and every centre "
-        "distance r1 has its crank r2; the stroke then fixes the remaining link."
-    )
 
 
 def _issue4(p: Project) -> str:

@@ -3,7 +3,8 @@
 The public building blocks of a type of one's own (see docs/extending.md): ``Mechanism`` (the protocol),
 ``Loop`` (what a loop returns), ``Rule`` (a feasibility rule), ``Body`` (a moving body to draw), ``REQUIRED``
 (a parameter without default), the ``closures`` every loop is written with (``qropt.mechanisms.closures``
-re-exports ``qropt.kinematics.closures``), the four-bar helpers ``four_bar`` and ``grashof_rules``, and the registry:
+re-exports ``qropt.kinematics.closures``), the four-bar helpers ``four_bar`` and ``grashof_rules``, the closed forms a
+type names for its synthesis starts (``qropt.mechanisms.closed_forms``: ``Context``, ``WarmStarts``), and the registry:
 ``mechanism_type`` finds a type by its class, KIND, class name or a ``"module:Class"`` reference, and
 ``type_reference`` names a type so that another process finds it (a shipped type by its KIND, any other as
 ``"module:Class"``). Installed packages add types through the entry-point group ``qropt.mechanisms``, loaded

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from types import MappingProxyType
 from typing import Any, ClassVar
 
@@ -123,6 +124,15 @@ class Mechanism:
     BODIES: ClassVar[tuple[Body, ...]] = ()  # every moving body (see Body): pictures and the mass model read them
     GROUND: ClassVar[tuple[str, ...]] = ()  # the joints fixed to the frame (ground pivots)
     OUTPUT_JOINT: ClassVar[str | None] = None  # the joint whose x is a slider output; None for a follower angle
+    CRANK: ClassVar[str] = "r2"  # the length parameter of the input crank (O2A), turning about O2 at the origin
+    # the closed forms that give a synthesis problem's starts, tried in order (the first that applies gives them):
+    # functions of a ``closed_forms.Context`` returning ``closed_forms.WarmStarts`` or None where they do not apply
+    CLOSED_FORMS: ClassVar[tuple[Callable, ...]] = ()
+    # a named option -> the optional parameters (PARAMS default None) it gives together (e.g. a rod: r6 and h)
+    OPTIONS: ClassVar[dict[str, tuple[str, ...]]] = {}
+    # a valid design of the type (parameter -> value), the app's first: a shipped slider's is its design for TR 1.5
+    # and stroke 0.3 m (the drag-link slider's the paper's, the others' qropt.design's best gamma_min to 0.1 mm)
+    EXAMPLE: ClassVar[dict[str, float]] = {}
 
     def __init_subclass__(cls, **kw):
         super().__init_subclass__(**kw)
@@ -163,8 +173,8 @@ class Mechanism:
     @classmethod
     def warm_starts(cls, problem):
         """Starting designs for a synthesis problem of this type (override): a ``WarmStarts`` of
-        ``qropt.synthesis.analytic`` (free-parameter dicts, their kind and how they were found), or None for the
-        closed forms registered for the type's kind (the shipped types') and otherwise a multi-start."""
+        ``qropt.mechanisms.closed_forms`` (free-parameter dicts, their kind and how they were found), or None for
+        the first of the type's ``CLOSED_FORMS`` that applies and otherwise a multi-start."""
         return None
 
     @classmethod

@@ -36,6 +36,10 @@ class CouplerSlider(_FourBarBase):
     # sliders (EXACT_TRANSMISSION), and the Grashof rules make the four-bar assemble (RULED_MARGINS), both inherited.
     ACCEL_EXTREMES = 6  # a coupler point's path adds acceleration extremes beyond the four-bar sliders' four
     BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
+    EXAMPLE = {
+        **{"r1": 1.0561, "r2": 0.0827, "r3": 0.3681, "r4": 0.9933, "r5": 1.5, "beta": -0.5201, "r6": 1.0128},
+        **{"h": 0.9477, "sigma": -1.0, "sigma_slider": 1.0},
+    }
     loop = staticmethod(LINKAGE.loop)
 
     @classmethod

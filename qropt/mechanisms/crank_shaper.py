@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from qropt.errors import InvalidParameter
+from qropt.mechanisms import closed_forms
 from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.builder import Linkage
 from qropt.mechanisms.values import Rule
@@ -41,6 +42,9 @@ class CrankShaper(Mechanism):
     ROD_BODIES = ROD.bodies()  # with a rod r6
     GROUND = YOKE.ground_joints()
     OUTPUT_JOINT = YOKE.output_joint()
+    OPTIONS = {"rod": ("r6", "h")}
+    CLOSED_FORMS = (closed_forms.crank_shaper_starts,)
+    EXAMPLE = {"r1": 0.2178, "r2": 0.0673, "r4": 0.4854, "sigma_slider": 1.0}
 
     def bodies(self):
         """BODIES with the yoke; ROD_BODIES with a rod r6."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from qropt.mechanisms import closed_forms
 from qropt.mechanisms.four_bar import FourBarSlider
 
 
@@ -11,3 +12,9 @@ class DragLinkSlider(FourBarSlider):
     KIND = "drag-link-slider"
     CLASS = "drag-link"
     SHORTEST = "r1"
+    CLOSED_FORMS = (closed_forms.drag_link_slider_starts, closed_forms.four_bar_slider_starts)
+    # the paper's design: TR 1.5, stroke 0.3 m, r3 from eqs. (7)-(13) (the root with the larger gamma_min)
+    EXAMPLE = {
+        **{"r1": 0.1, "r2": 0.225, "r3": closed_forms.drag_link_r3(1.5, 0.1, 0.225, 0.275)[-1].r3, "r4": 0.275},
+        **{"r5": 0.15, "r6": 0.3, "h": 0.0, "sigma": -1.0, "sigma_slider": 1.0},
+    }

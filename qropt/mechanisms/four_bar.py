@@ -9,6 +9,7 @@ from typing import ClassVar, NamedTuple
 
 from qropt.errors import GrashofError
 from qropt.kinematics.closures import circle_circle
+from qropt.mechanisms import closed_forms
 from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.builder import Linkage
 from qropt.mechanisms.values import Rule
@@ -127,6 +128,8 @@ class FourBar(_FourBarBase):
     OUTPUT = "follower"
     TRAVEL = "swing"
     BODIES, GROUND = FOUR_BAR.bodies(), FOUR_BAR.ground_joints()
+    CLOSED_FORMS = (closed_forms.four_bar_starts,)
+    EXAMPLE = {"r1": 0.3, "r2": 0.1, "r3": 0.35, "r4": 0.3, "sigma": -1.0}
     loop = staticmethod(FOUR_BAR.loop)
 
     @classmethod

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from qropt.mechanisms import closed_forms
 from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.builder import Linkage
 from qropt.mechanisms.values import Rule
@@ -22,6 +23,8 @@ class SliderCrank(Mechanism):
     PARAMS = {"r2": REQUIRED, "r3": REQUIRED, "e": 0.0, "sigma_slider": 1.0}
     LENGTHS = ("r2", "r3")
     BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
+    CLOSED_FORMS = (closed_forms.slider_crank_starts,)
+    EXAMPLE = {"r2": 0.1352, "r3": 0.2499, "e": 0.0865, "sigma_slider": 1.0}
 
     @classmethod
     def rules(cls, xp, p, grashof=None):

@@ -3,6 +3,7 @@ and on the slide line y = -r1 + h (no rod)."""
 
 from __future__ import annotations
 
+from qropt.mechanisms import closed_forms
 from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.crank_shaper import slotted_lever
 from qropt.mechanisms.values import Rule
@@ -16,7 +17,7 @@ class SlotRamShaper(Mechanism):
     """Slot-ram shaper (r1 centres, r2 < r1 crank, h > 0 the slide line's height above O4 = (0, -r1)).
 
     The ram's pin D is where the lever's line O4->A crosses the slide line; the output is x_D. Closed forms
-    (``qropt.synthesis.analytic``): TR = (pi + 2 asin(r2/r1)) / (pi - 2 asin(r2/r1)),
+    (``qropt.mechanisms.closed_forms``): TR = (pi + 2 asin(r2/r1)) / (pi - 2 asin(r2/r1)),
     stroke = 2 h r2 / sqrt(r1^2 - r2^2), gamma_min = acos(r2/r1) (at D, with the lever at its extremes)."""
 
     ONE_REVERSAL = True
@@ -26,6 +27,8 @@ class SlotRamShaper(Mechanism):
     LENGTHS = ("r1", "r2")  # h is the slide line's offset (positive by a rule), as the crank-shaper's
     TIES = ("r1", "r2")  # the motion depends on r2/r1 and h only
     BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
+    CLOSED_FORMS = (closed_forms.slot_ram_shaper_starts,)
+    EXAMPLE = {"r1": 0.2073, "r2": 0.0641, "h": 0.4617}
 
     @classmethod
     def rules(cls, xp, p, grashof=None):

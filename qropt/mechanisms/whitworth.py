@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from qropt.mechanisms import closed_forms
 from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.crank_shaper import slotted_lever
 from qropt.mechanisms.values import Rule
@@ -20,6 +21,8 @@ class Whitworth(Mechanism):
     LENGTHS = ("r1", "r2", "r5", "r6")
     TIES = ("r1", "r2")  # the motion depends on r1/r2 (the lever), r5, r6 and h only
     BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
+    CLOSED_FORMS = (closed_forms.whitworth_starts,)
+    EXAMPLE = {"r1": 0.0212, "r2": 0.0688, "r5": 0.15, "r6": 0.4, "h": 0.0, "sigma_slider": 1.0}
 
     @classmethod
     def rules(cls, xp, p, grashof=None):

@@ -2,10 +2,12 @@
 
 Each type's problem has bounds that scale with the stroke s (every length in [s/20, 5 s], offsets in
 [-5 s, 5 s]; angles, which a stroke does not scale, in [-pi, pi]) and its own conditions (the Grashof class of the
-four-bar types). The built-in rows are ``TYPES``; any other slider type (a class of one's own, its KIND or a
-``"module:Class"`` reference) gets a default row from its parameter kinds (``Mechanism.kinds()``): every length
-and offset free, its angles fixed at their defaults (free in [-pi, pi] where they have none, or where ``bounds``
-names them), its branch signs at their defaults. Every row is a certified solve;
+four-bar types). Every row comes from its type's parameter kinds (``Mechanism.kinds()``): every length and offset
+free (an optional one only in the row of a type's option that gives it, ``Mechanism.OPTIONS``), its angles fixed at
+their defaults (free in [-pi, pi] where they have none, or where ``bounds`` names them), its branch signs at their
+defaults. The built-in rows are ``TYPES``: every shipped slider type and its options; any other slider type (a
+class of one's own, its KIND or a ``"module:Class"`` reference) gets its row the same way. Every row is a certified
+solve;
 every criterion of a row is evaluated exactly on its design. Lengths in the stated unit (``units``, that of the
 stroke and the bounds; metres by default), angles in radians.
 """
@@ -21,6 +23,7 @@ from dataclasses import dataclass, field
 
 from qropt import units as units_
 from qropt.errors import ProblemError, QroptError
+from qropt.mechanisms import TYPES as SHIPPED
 from qropt.mechanisms import mechanism_type
 from qropt.mechanisms.base import REQUIRED
 from qropt.studies import _workers
@@ -29,16 +32,27 @@ from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import SOLUTION_PRESENT, Result, json_safe
 from qropt.validate import MAGNITUDE
 
-# type name -> (mechanism kind, free lengths, free offsets, fixed values, free angles)
+
+def _kinds_row(cls, bounds=None, option: str = "") -> tuple:
+    """(mechanism, free lengths, free offsets, fixed values, free angles) of a type from its parameter kinds
+    (``Mechanism.kinds()``): every length and offset it has (an optional one, PARAMS default None, only where
+    ``option``, a name of its ``OPTIONS``, gives it), its angles without a default or named by ``bounds``."""
+    kinds, given, extra = cls.kinds(), set(bounds or ()), cls.OPTIONS.get(option, ())
+
+    def free(kind):
+        return tuple(k for k, v in cls.PARAMS.items() if kinds[k] == kind and (v is not None or k in extra))
+
+    angles = tuple(k for k, v in cls.PARAMS.items() if kinds[k] == "angle" and (v is REQUIRED or k in given))
+    return cls, free("length"), free("offset"), {}, angles
+
+
+# the built-in rows, type name -> (mechanism kind, free lengths, free offsets, fixed values, free angles): every
+# shipped slider type by its KIND, and by KIND-option for each of its OPTIONS
 TYPES = {
-    "slider-crank": ("slider-crank", ("r2", "r3"), ("e",), {}, ()),
-    "crank-shaper": ("crank-shaper", ("r1", "r2", "r4"), (), {}, ()),
-    "crank-shaper-rod": ("crank-shaper", ("r1", "r2", "r4", "r6"), ("h",), {}, ()),
-    "whitworth": ("whitworth", ("r1", "r2", "r5", "r6"), ("h",), {}, ()),
-    "crank-rocker-slider": ("crank-rocker-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}, ()),
-    "drag-link-slider": ("drag-link-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}, ()),
-    "coupler-slider": ("coupler-slider", ("r1", "r2", "r3", "r4", "r5", "r6"), ("h",), {}, ("beta",)),
-    "slot-ram-shaper": ("slot-ram-shaper", ("r1", "r2"), ("h",), {}, ()),
+    f"{cls.KIND}-{option}" if option else cls.KIND: (cls.KIND, *_kinds_row(cls, option=option)[1:])
+    for cls in SHIPPED
+    if cls.TRAVEL == "stroke"
+    for option in ("", *cls.OPTIONS)
 }
 
 
@@ -63,12 +77,7 @@ def type_row(t, bounds=None) -> tuple:
         raise ProblemError(f"unknown type {t!r}; types are {list(TYPES)}, or a slider type of your own")
     if cls.TRAVEL != "stroke":
         raise ProblemError(f"{cls.__name__} has no slider (its output is a {cls.TRAVEL}): design compares strokes")
-    name = cls.__dict__.get("KIND") or cls.__name__
-    kinds, given = cls.kinds(), set(bounds or ())
-    lengths = tuple(k for k, v in cls.PARAMS.items() if kinds[k] == "length" and v is not None)
-    offsets = tuple(k for k, v in cls.PARAMS.items() if kinds[k] == "offset" and v is not None)
-    angles = tuple(k for k, v in cls.PARAMS.items() if kinds[k] == "angle" and (v is REQUIRED or k in given))
-    return name, (cls, lengths, offsets, {}, angles)
+    return cls.__dict__.get("KIND") or cls.__name__, _kinds_row(cls, bounds)
 
 
 def type_problem(

@@ -1,6 +1,7 @@
 """Designs on the targets without the NLP: a differential evolution over the box and descents on the exact objective.
 
-For a problem with TR and stroke targets whose lengths scale freely and whose crank length (``CRANK``) is free.
+For a problem with TR and stroke targets whose lengths scale freely and whose crank length (the type's
+``Mechanism.CRANK``) is free.
 
 - ``evolve``: SciPy's differential evolution over the unit box (lengths log-uniform, other parameters uniform).
   Each candidate is moved onto the TR target by its crank length: its TR on a crank-angle grid (the type's loop
@@ -32,7 +33,6 @@ from qropt.errors import QroptError
 from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
 
-CRANK = "r2"  # the crank length: the evolution's handle on the TR
 NODES = 48  # crank lengths (uniform in log over its bounds) at which a candidate's grid TR is read
 GRID = 64  # crank angles of that grid
 WINDOW = 0.01  # relative: a candidate whose exact TR is this near the target competes on its objective
@@ -70,7 +70,7 @@ def applies(problem) -> bool:
     return (
         bool(problem.objective)
         and {"time_ratio", "stroke"} <= set(problem.targets)
-        and CRANK in problem.free
+        and problem.mechanism.CRANK in problem.free
         and not any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable)
         and all(problem.free[k][0] > 0 for k in problem.free if problem.mechanism.kinds()[k] == "length")
     )
@@ -128,8 +128,8 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
     for a user type whose loop takes one design at a time (it does not vectorise over designs)."""
     from scipy.optimize import differential_evolution  # imported here: scipy.optimize takes a while to import
 
-    names = list(problem.free)
-    others = [k for k in names if k != CRANK]
+    names, crank = list(problem.free), problem.mechanism.CRANK
+    others = [k for k in names if k != crank]
     branch = starts_.branches(problem)[0]
     nodes = np.linspace(0.0, 1.0, NODES)
     found: list[tuple[float, dict]] = []
@@ -141,7 +141,7 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
             return INFEASIBLE * (3.0 + (float(near.min()) if near.size else 10.0))
         c = ends[np.argmin(np.abs(ends + 0.5 - gene * (NODES - 1)))]  # the crossing nearest the crank gene
         u = nodes[c] + row[c] / (row[c] - row[c + 1]) * (nodes[c + 1] - nodes[c])
-        d = d | {CRANK: float(starts_.from_unit(problem, CRANK, u))}
+        d = d | {crank: float(starts_.from_unit(problem, crank, u))}
         try:
             m = problem.build(d, branch)
             miss = abs(math.log(m.time_ratio() / problem.targets["time_ratio"]))
@@ -160,9 +160,9 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
     def values(u: np.ndarray) -> np.ndarray:  # u: (parameters, candidates), SciPy's vectorised call
         n = u.shape[1]
         cols = {k: np.repeat(starts_.from_unit(problem, k, u[names.index(k)]), NODES) for k in others}
-        cols[CRANK] = np.tile(starts_.from_unit(problem, CRANK, nodes), n)
+        cols[crank] = np.tile(starts_.from_unit(problem, crank, nodes), n)
         miss = _grid_miss(problem, cols).reshape(n, NODES)
-        gene = u[names.index(CRANK)]
+        gene = u[names.index(crank)]
         return np.array(
             [candidate(miss[i], float(gene[i]), {k: float(cols[k][i * NODES]) for k in others}) for i in range(n)]
         )
@@ -227,19 +227,19 @@ def on_targets(problem, design: dict, bounds: tuple | None = None) -> dict | Non
     None if neither finds one. ``bounds``: the crank lengths searched (default: its box)."""
     from scipy.optimize import brentq
 
-    branch = starts_.branches(problem)[0]
-    lo, hi = bounds or problem.free[CRANK]
+    branch, crank = starts_.branches(problem)[0], problem.mechanism.CRANK
+    lo, hi = bounds or problem.free[crank]
     built: dict = {}  # crank length -> its mechanism, the last one only (the root's is built once)
 
     def miss(c: float) -> float:
         try:
             built.clear()
-            built[c] = problem.build(design | {CRANK: c}, branch)
+            built[c] = problem.build(design | {crank: c}, branch)
             return math.log(built[c].time_ratio() / problem.targets["time_ratio"])
         except (QroptError, ValueError, ZeroDivisionError):
             return math.nan
 
-    c0 = design[CRANK]
+    c0 = design[crank]
     e0 = miss(c0)
     if not math.isfinite(e0):
         return None
@@ -255,8 +255,8 @@ def on_targets(problem, design: dict, bounds: tuple | None = None) -> dict | Non
     if root is None:
         return None
     try:
-        m = built.get(root) or problem.build(design | {CRANK: root}, branch)
-        return _to_stroke(problem, design | {CRANK: root}, m.stroke())
+        m = built.get(root) or problem.build(design | {crank: root}, branch)
+        return _to_stroke(problem, design | {crank: root}, m.stroke())
     except (QroptError, ValueError, ZeroDivisionError):
         return None
 
@@ -266,7 +266,7 @@ def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dic
     (module docstring), of ``evals`` exact evaluations (DESCENT_EVALS): the best (value, design) met, or None."""
     from scipy.optimize import minimize
 
-    names = [k for k in problem.free if k != CRANK]
+    names = [k for k in problem.free if k != problem.mechanism.CRANK]
     log = {k: problem.mechanism.kinds()[k] == "length" for k in names}
     branch = starts_.branches(problem)[0]
     best: list = [None]
@@ -296,6 +296,5 @@ __all__ = [
     "apart",
     "outside",
     "value",
-    "CRANK",
     "WINDOW",
 ]
