@@ -42,8 +42,9 @@ class Candidate:
     iterations: int = 0
     t_ipopt: float = 0.0
     rounds: int = 0
-    origin: str = ""
+    origin: str = ""  # the strategy's word for its start ('atlas', 'multistart', 'guard', 'wrapped', ...)
     start: int = -1  # the index of its start in a MultiStart.run's list
+    parent: object = None  # the candidate it was continued or solved again from (a guarded or wrapped design)
     q: dict | None = None
     pruned: bool = False
     problem: object = None  # the problem as the design fixes it (a free counterweight chosen); None: the solve's
@@ -55,6 +56,11 @@ class Candidate:
 
     def residuals_over(self, tol: float) -> bool:
         return max(self.residuals.values(), default=0.0) > tol
+
+    @property
+    def cost(self) -> float:
+        """Its IPOPT time, s (its ``iterations`` counted beside it)."""
+        return self.t_ipopt
 
 
 def _dynamic_key(problem) -> tuple:

@@ -169,7 +169,7 @@ def solve(stages, problem, context: Context):
 class Phase(Stage):
     """A named list of strategies run as one (a STOP inside ends the phase only)."""
 
-    name: ClassVar[str] = "phase"
+    name: ClassVar[str] = "starts phase"
     stages: tuple = ()
 
     def run(self, problem, pool, context):

@@ -31,10 +31,12 @@ class Guarded(Stage):
         guard, ms = guard_of(problem, pool.plan), context.solver.multistart
         found, _, _ = context.multistart(under(problem, guard), pool.plan, context.starts_n, context.seed, pool.designs)
         good = distinct([x for x in found if x.ok])
-        out = [ms.continued(problem, x, guard, context.targets, context.max_rounds, pool.designs) for x in good]
-        out = [x for x in out if x]
-        for x in out:
-            x.origin = "guard"
+        out = []
+        for g in good:
+            x = ms.continued(problem, g, guard, context.targets, context.max_rounds, pool.designs)
+            if x:
+                x.origin, x.parent = "guard", g
+                out.append(x)
         own = problem.conditions.get(criteria.GUARDED, 0.0)
         to = "the problem's bound" if own > 0 else "none"
         kept = f"{len(good)} distinct design{'s' * (len(good) != 1)}"

@@ -24,7 +24,7 @@ class Wrapped(Stage):
         return bool(turns(problem))
 
     def run(self, problem, pool, context):
-        edge, runs = context.settings.wrap_edge, []
+        edge, runs, parents = context.settings.wrap_edge, [], []
         for c in distinct(pool.good):
             for k in turns(problem):
                 lo, hi = problem.free[k]
@@ -32,10 +32,13 @@ class Wrapped(Stage):
                 if min(x - lo, hi - x) <= edge:
                     across = x - 2 * math.pi if hi - x <= edge else x + 2 * math.pi
                     runs.append(("wrapped", {**c.values, k: min(max(across, lo), hi)}, c.branch))
+                    parents.append(c)
         if not runs:
             return
         ms = context.solver.multistart
         out = ms.run(problem, runs, context.targets, context.max_rounds, pool.designs, both_ways=False)
+        for x in out:
+            x.parent = parents[x.start]
         n = len(runs)
         pool.candidates += out
         pool.notes.append(
