@@ -4,12 +4,15 @@ flywheel (``cycle``), and the crank's motion under a motor (``forward``)."""
 
 from qropt.dynamics.forward import Motor, Simulation, TurnSpeeds, simulate, steady_mean_torque
 from qropt.dynamics.inverse import Dynamics, body_masses, inverse_dynamics
-from qropt.dynamics.model import BodyMass, Counterweight, Loads, Masses
+from qropt.dynamics.model import BodyMass, Counterweight, Force, Loads, Masses, Torque, Window
 
 __all__ = [
     "BodyMass",
     "Counterweight",
     "Loads",
+    "Force",
+    "Torque",
+    "Window",
     "Masses",
     "Dynamics",
     "body_masses",
