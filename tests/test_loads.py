@@ -419,3 +419,16 @@ def test_simulate_and_the_flywheel_take_them():
         T = qropt.dynamics.steady_mean_torque(m, 5.0, masses, loads)
         runs.append(qropt.simulate(m, qropt.Motor.constant(T), masses=masses, loads=loads, omega0=5.0, turns=2))
     assert np.allclose(runs[0].omega2, runs[1].omega2, rtol=1e-7)
+
+
+@pytest.mark.parametrize("stroke, share", [("working", 1.0), ("return", -1.0), ("both", 0.0)])
+def test_the_energy_of_a_window_is_its_work(stroke, share):
+    """Route: the work of a constant force along the slide over a window of the ram's positions, F (x1 - x0) on a
+    stroke, resisted on the working stroke (the motor delivers it) and driving on the return (it gives it back):
+    the flywheel's energy per turn, with the quadrature split at the window's ends, to 1e-9."""
+    m = qropt.Whitworth(r1=0.2, r2=0.5, r5=0.5, r6=1.0)
+    way = 1.0 if m.working_direction(3.0) == "+x" else -1.0
+    F, x0, x1 = 1500.0, 0.7, 1.2
+    loads = Loads(forces=[Force("D", -way * F, "slide", Window(x=(x0, x1), stroke=stroke))])
+    fw = m.flywheel(3.0, 0.05, loads=loads)
+    assert fw.energy_per_turn == pytest.approx(share * F * (x1 - x0), abs=1e-9 * F)

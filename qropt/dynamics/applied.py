@@ -124,3 +124,37 @@ def evaluate(m, s, resolved, pts, t, working, x, sense: float, rate: float) -> l
 
 
 __all__ = ["Applied", "carrier", "resolve", "evaluate", "joints_of"]
+
+
+EDGE_GRID = 720  # crank angles where the ram's crossings of a window's or a table's x are bracketed
+
+
+def edges(m, loads: Loads) -> list[float]:
+    """The crank angles (rad, in [0, 2 pi)) where a force's or torque's window opens or closes, or its table
+    turns a corner: the ends of theta2 windows and the theta2 rows of tables, and where the ram passes the x ends
+    of windows and the x rows of tables (brentq on the positions). A quadrature splits its pieces there."""
+    from scipy.optimize import brentq
+
+    angles, xs = set(), set()
+    for load in (*loads.forces, *loads.torques):
+        w = load.window
+        if w.theta2 is not None:
+            angles.update(a % TWO_PI for a in w.theta2)
+        if w.x is not None:
+            xs.update(w.x)
+        if isinstance(load.magnitude, tuple) and len(load.magnitude) > 1:
+            rows = [r[0] for r in load.magnitude]
+            (xs if load.against == "x" else angles).update(rows if load.against == "x" else [a % TWO_PI for a in rows])
+    if xs and m.output_joint() is not None:
+        t = np.linspace(0.0, TWO_PI, EDGE_GRID + 1)
+        x = m.positions(t).x
+
+        def at(th, v):
+            return float(m.positions(np.array([th])).x[0]) - v
+
+        for v in xs:
+            d = x - v
+            for i in np.flatnonzero(d[:-1] * d[1:] < 0):
+                angles.add(brentq(at, t[i], t[i + 1], args=(v,), xtol=1e-14) % TWO_PI)
+            angles.update(float(t[i]) % TWO_PI for i in np.flatnonzero(d == 0))
+    return sorted(angles)

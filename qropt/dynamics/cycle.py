@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
+from qropt.dynamics import applied
 from qropt.dynamics.inverse import _solve, require_sense, system_of, working_way
 from qropt.dynamics.model import Loads, Masses
 from qropt.validate import LIMIT, number
@@ -86,6 +87,7 @@ class CycleDynamics:
         first = _first_is_working(m, self.omega2 or 1.0, way)
         self.working_pieces = (first, not first)
         self.switching = self.loads.jumps and way is not None
+        self.edges = applied.edges(m, self.loads)  # a window's ends, a table's corners: the quadrature splits there
 
     def at(self, theta2, working=None):
         """The dynamics at crank angles theta2 (rad); ``working`` forces the cutting force on or off."""
@@ -93,13 +95,20 @@ class CycleDynamics:
         return _solve(self.m, self.system, t, self.omega2, self.alpha2, self.loads, working)
 
     def quadrature(self, f, pieces=None):
-        """integral of f(Dynamics) over the pieces (default: the two strokes, i.e. a turn), Gauss-Legendre."""
+        """integral of f(Dynamics) over the pieces (default: the two strokes, i.e. a turn), Gauss-Legendre on each
+        piece split at the loads' edges within it."""
         x, w = np.polynomial.legendre.leggauss(GAUSS)
         total = 0.0
-        for lo, hi in pieces or self.pieces:
-            t = 0.5 * (hi - lo) * x + 0.5 * (hi + lo)
-            total += 0.5 * (hi - lo) * float(np.dot(w, f(self.at(t % TWO_PI))))
+        for piece in pieces or self.pieces:
+            for lo, hi in self._split(*piece):
+                t = 0.5 * (hi - lo) * x + 0.5 * (hi + lo)
+                total += 0.5 * (hi - lo) * float(np.dot(w, f(self.at(t % TWO_PI))))
         return total
+
+    def _split(self, lo: float, hi: float) -> list[tuple]:
+        cuts = sorted(c for c in (lo + (e - lo) % TWO_PI for e in self.edges) if lo < c < hi)
+        ends = [lo, *cuts, hi]
+        return list(zip(ends, ends[1:], strict=False))
 
     def peak(self, f, jumps: bool = False) -> Peak:
         """The largest f(Dynamics) over the turn: the largest of the grid's local maxima within NEAR of its best
