@@ -255,7 +255,7 @@ def test_the_centred_slider_crank_needs_its_working_direction():
 
 def test_the_shorthands_are_unchanged():
     """Gravity (0, -g) is the number g; a force against the ram's velocity on the working stroke is the cutting
-    force (away from the dead centres, where the velocity's direction decides)."""
+    force, its cycle's extremes included."""
     m = qropt.Whitworth(r1=0.2, r2=0.5, r5=0.5, r6=1.0)
     assert Loads(gravity=(0.0, -9.81)) == Loads(gravity=9.81)
     masses = Masses(density=8.0, ram=20.0)
@@ -267,6 +267,22 @@ def test_the_shorthands_are_unchanged():
     assert np.allclose(d0.torque, d2.torque, rtol=0, atol=1e-9 * np.abs(d0.torque).max())
     for j in d0.joint_forces:
         assert np.allclose(d0.joint_forces[j], d2.joint_forces[j], rtol=0, atol=1e-8 * 3000)
+    from qropt.dynamics.cycle import CycleDynamics
+
+    cut, force = (
+        CycleDynamics(m, 4.0, 0.0, masses, Loads(cutting_force=3000.0)).extremes(),
+        CycleDynamics(m, 4.0, 0.0, masses, Loads(forces=[Force("D", 3000.0)])).extremes(),
+    )
+    assert force.mean_torque == pytest.approx(cut.mean_torque, rel=1e-9)
+    for j, p in cut.peak_forces.items():
+        assert force.peak_forces[j].value == pytest.approx(p.value, rel=1e-7), j
+    dc = m.dead_centres()
+    ends = np.array([dc.theta_max, dc.theta_min])
+    for on in (True, False):  # a stroke closed at its dead centres: the force resists the stroke's way there
+        a = CycleDynamics(m, 4.0, 0.0, masses, Loads(cutting_force=3000.0)).at(ends, on)
+        b = CycleDynamics(m, 4.0, 0.0, masses, Loads(forces=[Force("D", 3000.0)])).at(ends, on)
+        for j in a.joint_forces:
+            assert np.allclose(a.joint_forces[j], b.joint_forces[j], rtol=0, atol=1e-8 * 3000), (on, j)
 
 
 def test_point_masses_join_their_body():

@@ -81,12 +81,14 @@ def resolve(m, s, link, loads: Loads) -> list[tuple]:
     return out
 
 
-def evaluate(m, s, resolved, pts, t, working, x, sense: float, rate: float) -> list[Applied]:
+def evaluate(m, s, resolved, pts, t, working, x, sense: float, rate: float, ends=None) -> list[Applied]:
     """The resolved loads (``resolve``) at crank angles t (rad): ``pts`` joint -> ((x, x', x''), (y, y', y''))
     in metres with the rates of the actual motion (or per unit crank angle), ``working`` (bool, on the working
     stroke; None where no load needs it), x the ram's positions (the mechanism's unit; None without a ram),
     ``sense``: the sign that turns the rates into the motion's direction (1 for the actual motion's rates, the sense
-    of rotation for rates per unit crank angle), ``rate``: |omega2| (rad/s), or 1 per unit crank angle."""
+    of rotation for rates per unit crank angle), ``rate``: |omega2| (rad/s), or 1 per unit crank angle; ``ends``:
+    the way (+1 or -1 along x) the output moves at each angle where its stroke is given (a stroke closed at its
+    dead centres), which a force against the output's velocity resists where the output is at rest, or None."""
     bodies = {b.name: b for b in s.bodies}
     size = max(float(np.max(np.hypot(px[0], py[0]))) for px, py in pts.values())
     rest = AT_REST * rate * max(size, 1e-300)
@@ -114,6 +116,8 @@ def evaluate(m, s, resolved, pts, t, working, x, sense: float, rate: float) -> l
             moving = speed > rest
             inv = np.where(moving, -sense / np.where(moving, speed, 1.0), 0.0)
             fx, fy = size_of * vx * inv, size_of * vy * inv
+            if ends is not None and b.kind in ("ram", "yoke"):  # at a dead centre: the limit along its stroke
+                fx = np.where(moving, fx, -size_of * ends)
         elif d == "slide":
             fx, fy = size_of, np.zeros(t.shape)
         else:

@@ -426,7 +426,8 @@ def _loaded(m, s: _System, t, omega2, alpha2, loads, working=None) -> tuple:
         else compiled.parts(m, s, t, omega2, alpha2, loads.gravity, k, known, table or sliding)
     )
     if a is None:
-        extra = None if general is None else (loads, general, working)
+        ends = np.where(working, way, -way) if forced and way else None
+        extra = None if general is None else (loads, general, working, ends)
         a = _numpy_parts(m, s, t, omega2, alpha2, loads.gravity, k, known, extra)
     # along x, through the ram's point (no moment about a yoke's centre on its line)
     load = np.where(working, loads.force_at(a.x_out), 0.0) * way if table else None
@@ -558,7 +559,8 @@ def crank_acceleration(m, s: _System, theta: float, omega2: float, loads, torque
 def _numpy_parts(m, s: _System, t, omega2, alpha2, g, k, known=None, general=None) -> Parts:
     """``Parts`` from the jets and the elimination in numpy (``known``: the load that does not depend on the
     motion, (n,) on the load's row, or None; ``general``: (loads, their ``applied.resolve``, the working stroke's
-    mask) for the forces, torques and a gravity vector, or None)."""
+    mask, the output's way along each closed stroke or None: ``applied.evaluate``'s ends) for the forces, torques
+    and a gravity vector, or None)."""
     pts, P, kin, vel = _kinetics(m, s, t, omega2, alpha2, k, rates=True)
     if general is not None and isinstance(g, tuple):
         g = 0.0  # the vector's weights go on the rows below
@@ -582,7 +584,7 @@ def _numpy_parts(m, s: _System, t, omega2, alpha2, g, k, known=None, general=Non
     return Parts(solve, x_out, v_out, normals, shaking(kin))
 
 
-def _apply(m, s: _System, t, omega2, k, pts, kin, rows, loads, resolved, working) -> None:
+def _apply(m, s: _System, t, omega2, k, pts, kin, rows, loads, resolved, working, ends) -> None:
     """Put the general loads on the right-hand side (known external forces and moments leave it): each force
     (fx, fy) at point p on body b and torque tau, -(fx, fy, (p - G) x F + tau); a gravity vector's weight m g."""
 
@@ -597,7 +599,7 @@ def _apply(m, s: _System, t, omega2, k, pts, kin, rows, loads, resolved, working
             sub(s.rows[b.name] + 1, mass * gy)
     joint = m.output_joint()
     x = pts[joint][0][0] / k if joint is not None else None
-    for ap in applied.evaluate(m, s, resolved, pts, t, working, x, 1.0, abs(omega2)):
+    for ap in applied.evaluate(m, s, resolved, pts, t, working, x, 1.0, abs(omega2), ends):
         r, (gx, gy) = s.rows[ap.body], kin[ap.body][0]
         (fx, fy), (px, py) = ap.force, ap.point
         sub(r, fx)
