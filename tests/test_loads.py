@@ -415,7 +415,12 @@ def test_what_cannot_take_them_says_so():
         )
     with pytest.raises(UnsupportedLoad, match="servo.*the torque on rod"):
         qropt.speed_profile(m, omega_max=10.0, masses=Masses(density=1.0), loads=Loads(torques=[Torque("rod", 1.0)]))
+    from qropt.dynamics import compiled
+    from qropt.dynamics.inverse import system_of
     from qropt.io import plots
+
+    with pytest.raises(UnsupportedLoad, match="compiled.*gravity"):
+        compiled.parts(m, system_of(m, Masses(density=1.0)), np.array([0.1]), 1.0, 0.0, (1.0, -9.81), 1.0)
 
     with pytest.raises(UnsupportedLoad, match="figure.*gravity"):
         plots.dynamics_figure(m, 2.0, Masses(density=1.0), Loads(gravity=(1.0, -9.81)))

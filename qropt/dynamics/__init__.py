@@ -1,4 +1,5 @@
-"""Dynamics: the mass model and loads (``model``), a rigid body's motion from its joints' (``rigid``), exact
+"""Dynamics: the mass model and loads (``model``; general forces and torques at crank angles: ``applied``), a
+rigid body's motion from its joints' (``rigid``), exact
 inverse dynamics (``inverse``; compiled once a call shape is hot: ``compiled``), cycle quantities and the
 flywheel (``cycle``), and the crank's motion under a motor (``forward``)."""
 

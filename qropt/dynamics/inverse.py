@@ -9,7 +9,9 @@ the guide's normal force under the ram (and the moment a yoke-ram's guide carrie
 massive crank-pin block and its slot. A massless block (the default) passes its force straight from the crank to
 the lever along the slot's normal. Friction on the slide (mu |N| against the ram's velocity) makes the system
 depend on N; as the system is linear in a load on the ram, N has a closed form (``friction_load``), the same in
-the exact analysis and in the NLP. SI units throughout.
+the exact analysis and in the NLP. General loads (forces at points, torques on bodies, a gravity vector:
+``applied``) are known external forces and moments on the right-hand side, solved on the jets in numpy. SI units
+throughout.
 """
 
 from __future__ import annotations
