@@ -11,12 +11,14 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from scipy.optimize import brentq
 
 from qropt.dynamics.model import TWO_PI, Force, Loads, level
 from qropt.dynamics.rigid import body_motion, frame
 from qropt.errors import InvalidParameter
 
 AT_REST = 1e-9  # a point is at rest where its speed is below this times |omega2| times the mechanism's size
+EDGE_GRID = 720  # crank angles where the ram's crossings of a window's or a table's x are bracketed
 
 
 class Applied(NamedTuple):
@@ -98,10 +100,10 @@ def evaluate(m, s, resolved, pts, t, working, x, sense: float, rate: float, ends
         (ox, oy), rot = frame(b, pts)
         spin = rot[2]
         arg = x if load.against == "x" else np.mod(t, TWO_PI)
-        size_of = level(load.magnitude, arg) * load.window.active(t, working, x)
+        amount = level(load.magnitude, arg) * load.window.active(t, working, x)
         if not isinstance(load, Force):
             zero = np.zeros(t.shape)
-            out.append(Applied(name, (ox[0] + zero, oy[0] + zero), (zero, zero), (zero, zero), size_of, spin))
+            out.append(Applied(name, (ox[0] + zero, oy[0] + zero), (zero, zero), (zero, zero), amount, spin))
             continue
         if isinstance(load.at, str):
             (px, py) = (pts[load.at][0][0], pts[load.at][1][0])
@@ -115,30 +117,22 @@ def evaluate(m, s, resolved, pts, t, working, x, sense: float, rate: float, ends
             speed = np.hypot(vx, vy)
             moving = speed > rest
             inv = np.where(moving, -sense / np.where(moving, speed, 1.0), 0.0)
-            fx, fy = size_of * vx * inv, size_of * vy * inv
+            fx, fy = amount * vx * inv, amount * vy * inv
             if ends is not None and b.kind in ("ram", "yoke"):  # at a dead centre: the limit along its stroke
-                fx = np.where(moving, fx, -size_of * ends)
+                fx = np.where(moving, fx, -amount * ends)
         elif d == "slide":
-            fx, fy = size_of, np.zeros(t.shape)
+            fx, fy = amount, np.zeros(t.shape)
         else:
             n = float(np.hypot(*d))
-            fx, fy = size_of * (d[0] / n), size_of * (d[1] / n)
+            fx, fy = amount * (d[0] / n), amount * (d[1] / n)
         out.append(Applied(name, (px, py), (vx, vy), (fx, fy), 0.0, spin))
     return out
-
-
-__all__ = ["Applied", "carrier", "resolve", "evaluate", "joints_of"]
-
-
-EDGE_GRID = 720  # crank angles where the ram's crossings of a window's or a table's x are bracketed
 
 
 def edges(m, loads: Loads) -> list[float]:
     """The crank angles (rad, in [0, 2 pi)) where a force's or torque's window opens or closes, or its table
     turns a corner: the ends of theta2 windows and the theta2 rows of tables, and where the ram passes the x ends
     of windows and the x rows of tables (brentq on the positions). A quadrature splits its pieces there."""
-    from scipy.optimize import brentq
-
     angles, xs = set(), set()
     for load in (*loads.forces, *loads.torques):
         w = load.window
@@ -148,7 +142,10 @@ def edges(m, loads: Loads) -> list[float]:
             xs.update(w.x)
         if isinstance(load.magnitude, tuple) and len(load.magnitude) > 1:
             rows = [r[0] for r in load.magnitude]
-            (xs if load.against == "x" else angles).update(rows if load.against == "x" else [a % TWO_PI for a in rows])
+            if load.against == "x":
+                xs.update(rows)
+            else:
+                angles.update(a % TWO_PI for a in rows)
     if xs and m.output_joint() is not None:
         t = np.linspace(0.0, TWO_PI, EDGE_GRID + 1)
         x = m.positions(t).x
@@ -162,3 +159,6 @@ def edges(m, loads: Loads) -> list[float]:
                 angles.add(brentq(at, t[i], t[i + 1], args=(v,), xtol=1e-14) % TWO_PI)
             angles.update(float(t[i]) % TWO_PI for i in np.flatnonzero(d == 0))
     return sorted(angles)
+
+
+__all__ = ["Applied", "carrier", "resolve", "evaluate", "edges", "joints_of"]
