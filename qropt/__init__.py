@@ -7,7 +7,19 @@ view (``qropt.io.views``).
 
 from qropt.convex.servo import SpeedProfile, speed_profile
 from qropt.convex.tolerance import Allocation, MonteCarlo, allocate, sensitivities
-from qropt.dynamics import BodyMass, Counterweight, Dynamics, Loads, Masses, Motor, Simulation, simulate
+from qropt.dynamics import (
+    BodyMass,
+    Counterweight,
+    Dynamics,
+    Force,
+    Loads,
+    Masses,
+    Motor,
+    Simulation,
+    Torque,
+    Window,
+    simulate,
+)
 from qropt.errors import (
     AssemblyError,
     ChartError,
@@ -17,6 +29,7 @@ from qropt.errors import (
     NoDeadCentres,
     ProblemError,
     QroptError,
+    UnsupportedLoad,
 )
 from qropt.io import views  # noqa: F401 - attaches every object's plot() and notebook view
 from qropt.mechanisms import (
@@ -77,6 +90,9 @@ __all__ = [
     "BodyMass",
     "Counterweight",
     "Loads",
+    "Force",
+    "Torque",
+    "Window",
     "Dynamics",
     "Motor",
     "Simulation",
@@ -97,4 +113,5 @@ __all__ = [
     "DegenerateMechanism",
     "ProblemError",
     "ChartError",
+    "UnsupportedLoad",
 ]

@@ -60,6 +60,11 @@ class SlideLocked(DegenerateMechanism):
         self.theta2 = theta2
 
 
+class UnsupportedLoad(InvalidParameter):
+    """A part of qropt that cannot apply a load yet was given one (a general force, torque, gravity vector, point
+    mass or named working stroke in the synthesis NLP, the servo's convex problem or a picture)."""
+
+
 class ProblemError(QroptError):
     """A synthesis problem is malformed: unknown names, empty or contradictory bounds, no free parameter."""
 

@@ -490,6 +490,8 @@ def _check_dynamics(m, masses, loads, force, inertia):
         raise InvalidParameter(f"loads is a qropt.Loads, got {type(loads).__name__}")
     if loads is not None and loads.friction:
         raise InvalidParameter("friction makes the load depend on omega2^2: it stays out of the convex problem")
+    if loads is not None:
+        loads.require_plain("the servo's convex problem (speed_profile)")
     if force and loads is not None and (isinstance(loads.cutting_force, tuple) or loads.cutting_force):
         raise InvalidParameter("give the cutting force once: force= or loads=Loads(cutting_force=...), not both")
     if inertia and masses is not None:

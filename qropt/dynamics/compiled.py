@@ -10,7 +10,9 @@ follow them to a different design). Where a row is not finite (a singular angle)
 One function serves every design and mass model of a type: the parameters, the bodies' masses, centres and
 inertias, omega2, alpha2, gravity, the length unit and a load known beforehand (a constant cutting force, a
 follower's torque) are its inputs. A load that depends on the motion (a table of the ram's position, friction's
-iteration) is added in numpy: the superposed variant gives the unknowns per unit load too.
+iteration) is added in numpy: the superposed variant gives the unknowns per unit load too. General loads (forces,
+torques, a gravity vector: ``qropt.dynamics.applied``) are not its inputs: ``inverse`` solves them on the jets in
+numpy.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import numpy as np
 
 from qropt.dynamics.elimination import Elimination, Parts
 from qropt.dynamics.rigid import body_motion, shaking
+from qropt.errors import UnsupportedLoad
 from qropt.kinematics.kernel import CSE, Batched
 from qropt.kinematics.ops import CASADI
 
@@ -86,6 +89,11 @@ def parts(m, s, t, omega2, alpha2, g, k, known=None, superposed=False):
     """``elimination.Parts`` from the structure's Function (``known``: the load that does not depend on the motion,
     (n,) on the load's row, or None), or None where a row is not finite (a singular angle, which the numpy route
     reports)."""
+    if isinstance(g, tuple):
+        raise UnsupportedLoad(
+            f"the compiled dynamics kernel cannot apply gravity {g} yet (it takes a number g along -y); "
+            "inverse_dynamics applies a gravity vector on the jets in numpy"
+        )
     n = t.size
     f = kernel(m, s, superposed)  # CasADi's VM until its calls are HOT, then machine code: the same numbers
     z = np.empty((n, f.m))

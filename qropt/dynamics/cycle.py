@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from qropt.dynamics.inverse import _solve, system_of
+from qropt.dynamics import applied
+from qropt.dynamics.inverse import _solve, require_sense, system_of, working_way
 from qropt.dynamics.model import Loads, Masses
 from qropt.validate import LIMIT, number
 
@@ -70,7 +71,6 @@ class CycleDynamics:
     """The dynamics of one mechanism, masses and loads at omega2 and alpha2, evaluated at any crank angles."""
 
     def __init__(self, m, omega2: float, alpha2: float = 0.0, masses=None, loads=None):
-        from qropt.dynamics.inverse import _has_load
         from qropt.errors import InvalidParameter
 
         self.m = m
@@ -78,15 +78,16 @@ class CycleDynamics:
         self.loads = Loads() if loads is None else loads
         if not isinstance(self.loads, Loads):
             raise InvalidParameter(f"loads is a qropt.Loads, got {type(self.loads).__name__}")
-        if self.omega2 == 0.0 and _has_load(self.loads):
-            raise InvalidParameter("omega2 must be nonzero with a cutting force or friction: they resist the motion")
+        require_sense(self.omega2, self.loads)
         self.system = system_of(m, Masses() if masses is None else masses)
         d = m.dead_centres()
         a, _ = m.stroke_angles()
         self.pieces = [(d.theta_max, d.theta_max + a), (d.theta_max + a, d.theta_max + TWO_PI)]
-        first = _first_is_working(m, self.omega2 or 1.0)
+        way = working_way(m, self.loads, self.omega2 or 1.0)
+        first = _first_is_working(m, self.omega2 or 1.0, way)
         self.working_pieces = (first, not first)
-        self.switching = self.loads.jumps and m.working_direction(self.omega2 or 1.0) is not None
+        self.switching = self.loads.jumps and way is not None
+        self.edges = applied.edges(m, self.loads)  # a window's ends, a table's corners: the quadrature splits there
 
     def at(self, theta2, working=None):
         """The dynamics at crank angles theta2 (rad); ``working`` forces the cutting force on or off."""
@@ -94,13 +95,20 @@ class CycleDynamics:
         return _solve(self.m, self.system, t, self.omega2, self.alpha2, self.loads, working)
 
     def quadrature(self, f, pieces=None):
-        """integral of f(Dynamics) over the pieces (default: the two strokes, i.e. a turn), Gauss-Legendre."""
+        """integral of f(Dynamics) over the pieces (default: the two strokes, i.e. a turn), Gauss-Legendre on each
+        piece split at the loads' edges within it."""
         x, w = np.polynomial.legendre.leggauss(GAUSS)
         total = 0.0
-        for lo, hi in pieces or self.pieces:
-            t = 0.5 * (hi - lo) * x + 0.5 * (hi + lo)
-            total += 0.5 * (hi - lo) * float(np.dot(w, f(self.at(t % TWO_PI))))
+        for piece in pieces or self.pieces:
+            for lo, hi in self._split(*piece):
+                t = 0.5 * (hi - lo) * x + 0.5 * (hi + lo)
+                total += 0.5 * (hi - lo) * float(np.dot(w, f(self.at(t % TWO_PI))))
         return total
+
+    def _split(self, lo: float, hi: float) -> list[tuple]:
+        cuts = sorted(c for c in (lo + (e - lo) % TWO_PI for e in self.edges) if lo < c < hi)
+        ends = [lo, *cuts, hi]
+        return list(zip(ends, ends[1:], strict=False))
 
     def peak(self, f, jumps: bool = False) -> Peak:
         """The largest f(Dynamics) over the turn: the largest of the grid's local maxima within NEAR of its best
@@ -218,13 +226,14 @@ class CycleDynamics:
         return Flywheel(cs, self.omega2, delta, inertia, mean, sense * TWO_PI * mean, w, r)
 
 
-def _first_is_working(m, omega2) -> bool:
-    """Whether the crank interval theta_max -> theta_min (counter-clockwise) is the working stroke."""
+def _first_is_working(m, omega2, way=None) -> bool:
+    """Whether the crank interval theta_max -> theta_min (counter-clockwise) is the working stroke (``way``: its
+    direction, default the slow stroke's)."""
     from qropt.dynamics.inverse import _working
 
     d = m.dead_centres()
     a, _ = m.stroke_angles()
-    return bool(_working(m, np.array([(d.theta_max + a / 2) % TWO_PI]), omega2)[0])
+    return bool(_working(m, np.array([(d.theta_max + a / 2) % TWO_PI]), omega2, way)[0])
 
 
 __all__ = ["CycleDynamics", "DynamicExtremes", "Flywheel", "Peak"]

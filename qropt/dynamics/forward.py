@@ -31,6 +31,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from qropt.dynamics import applied
 from qropt.dynamics.inverse import body_masses, crank_acceleration, generalised, system_of
 from qropt.dynamics.model import Loads, Masses, _real
 from qropt.errors import InvalidParameter, NoDeadCentres
@@ -154,12 +155,14 @@ def steady_mean_torque(m, omega2: float, masses=None, loads=None) -> float:
 
 
 def _breaks(m, loads: Loads, sense: float) -> list[float]:
-    """The dead centres as progress (sense * theta2) in [0, 2 pi): where the load Q jumps."""
+    """The dead centres and the loads' edges (``applied.edges``) as progress (sense * theta2) in [0, 2 pi): where
+    the load Q jumps or turns a corner."""
+    cuts = {(sense * e) % TWO_PI for e in applied.edges(m, loads)}
     try:
         d = m.dead_centres()
     except NoDeadCentres:
-        return []
-    return sorted({(sense * d.theta_max) % TWO_PI, (sense * d.theta_min) % TWO_PI})
+        return sorted(cuts)
+    return sorted(cuts | {(sense * d.theta_max) % TWO_PI, (sense * d.theta_min) % TWO_PI})
 
 
 def simulate(

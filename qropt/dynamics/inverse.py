@@ -9,7 +9,9 @@ the guide's normal force under the ram (and the moment a yoke-ram's guide carrie
 massive crank-pin block and its slot. A massless block (the default) passes its force straight from the crank to
 the lever along the slot's normal. Friction on the slide (mu |N| against the ram's velocity) makes the system
 depend on N; as the system is linear in a load on the ram, N has a closed form (``friction_load``), the same in
-the exact analysis and in the NLP. SI units throughout.
+the exact analysis and in the NLP. General loads (forces at points, torques on bodies, a gravity vector:
+``applied``) are known external forces and moments on the right-hand side, solved on the jets in numpy. SI units
+throughout.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from qropt import units as units_
-from qropt.dynamics import compiled
+from qropt.dynamics import applied, compiled
 from qropt.dynamics.elimination import Elimination, Parts, pivots
 from qropt.dynamics.model import BodyMass, Loads, Masses, slender_bar, union
 from qropt.dynamics.rigid import body_motion, is_zero, shaking
@@ -128,7 +130,28 @@ def body_masses(m, masses: Masses) -> dict[str, BodyMass]:
         if b.name == "crank" and masses.counterweight is not None and masses.counterweight.mass > 0:
             bm = _combined(bm, BodyMass(*masses.counterweight.part()))
         out[b.name] = bm
+    link = linkage_of(m)
+    for joint, mass in masses.points.items():
+        name = applied.carrier(m, link, joint)
+        body = next(b for b in bodies if b.name == name)
+        where = (0.0, 0.0) if body.kind in ("ram", "yoke") else _fixed_point(m, body, joint, k)
+        out[name] = _combined(out[name], BodyMass(mass, where))
     return out
+
+
+def _fixed_point(m, body, joint: str, k: float) -> tuple:
+    """(x, y) (m) of a joint in the frame of a turning body that carries it; InvalidParameter where the joint
+    slides on the body (its place in the frame changes over the turn)."""
+    from qropt.dynamics.rigid import frame
+
+    t = np.array([0.0, 2.1, 4.2])
+    pts = {j: ((p[:, 0] * k, 0.0, 0.0), (p[:, 1] * k, 0.0, 0.0)) for j, p in m.positions(t).points.items()}
+    (ox, oy), (c, sn, _, _) = frame(body, pts)
+    dx, dy = pts[joint][0][0] - ox[0], pts[joint][1][0] - oy[0]
+    x, y = c * dx + sn * dy, -sn * dx + c * dy
+    if np.ptp(x) > 1e-9 * (1.0 + np.abs(x).max()) or np.ptp(y) > 1e-9 * (1.0 + np.abs(y).max()):
+        raise InvalidParameter(f"the point mass at {joint}: {joint} slides on the {body.name}, it is not fixed on it")
+    return float(x[0]), float(y[0])
 
 
 def _reaches(m, t):
@@ -348,20 +371,25 @@ def inverse_dynamics(m, theta2, omega2: float = 1.0, alpha2: float = 0.0, *, mas
     if not isinstance(loads, Loads):
         raise InvalidParameter(f"loads is a qropt.Loads, got {type(loads).__name__}")
     omega2, alpha2 = number("omega2", omega2, limit=LIMIT), number("alpha2", alpha2, limit=LIMIT)
-    if omega2 == 0.0 and (_has_load(loads)):
-        raise InvalidParameter("omega2 must be nonzero with a cutting force or friction: they resist the motion")
+    require_sense(omega2, loads)
     t = m._angles(theta2)
     return _solve(m, system_of(m, masses), t, omega2, alpha2, loads)
 
 
-def _has_load(loads: Loads) -> bool:
-    return bool(loads.friction) or loads.switching
+def require_sense(omega2: float, loads: Loads) -> None:
+    """InvalidParameter where omega2 is zero and a load needs the crank's sense of rotation (it resists the motion
+    or acts on a stroke)."""
+    against = any(f.direction == "against" for f in loads.forces)
+    if omega2 == 0.0 and (loads.friction or loads.switching or against or loads.by_stroke()):
+        raise InvalidParameter(
+            "omega2 must be nonzero with a cutting force, friction, or a load on a stroke or against a velocity"
+        )
 
 
-def _kinetics(m, s: _System, t, omega2, alpha2, k):
-    """From the loop's jets: the joints' positions (m), every body's (G, a_G, alpha, mass, inertia) and the
-    velocity friction needs (the output body's); the jets themselves
-    are dropped on return, which keeps the solve's memory small."""
+def _kinetics(m, s: _System, t, omega2, alpha2, k, rates: bool = False):
+    """From the loop's jets: the joints' positions (m) (with ``rates``, their rates first), every body's (G, a_G,
+    alpha, mass, inertia) and the velocity friction needs (the output body's); the jets themselves are dropped on
+    return, which keeps the solve's memory small."""
     pts = _triples(m.evaluate(JET, Jet.seed(t, omega2, alpha2)), k)
     P = {j: (x[0], y[0]) for j, (x, y) in pts.items()}
     kin, vel = {}, {}
@@ -371,7 +399,7 @@ def _kinetics(m, s: _System, t, omega2, alpha2, k):
         kin[b.name] = (G, a, ph[3], bm.mass, bm.inertia)
         if b.kind in ("ram", "yoke"):
             vel[b.name] = v
-    return P, kin, vel
+    return (pts, P, kin, vel) if rates else (P, kin, vel)
 
 
 def _loaded(m, s: _System, t, omega2, alpha2, loads, working=None) -> tuple:
@@ -380,8 +408,8 @@ def _loaded(m, s: _System, t, omega2, alpha2, loads, working=None) -> tuple:
     there, else (None, None)). ``working`` as ``_solve``."""
     k = units_.to_metres(m.units)
     forced = working is not None
-    working = _working(m, t, omega2) if working is None else np.full(t.shape, bool(working))
-    way = m.working_direction(omega2 or 1.0)  # the load resists the working stroke's motion, its ends included
+    way = working_way(m, loads, omega2 or 1.0)  # the load resists the working stroke's motion, its ends included
+    working = _working(m, t, omega2, way) if working is None else np.full(t.shape, bool(working))
     way = 0.0 if way is None else (1.0 if way == "+x" else -1.0)
     out_body = s.output
     guide_col = next((col for c, col, _ in s.cols if c.kind == "guide"), None)
@@ -392,9 +420,17 @@ def _loaded(m, s: _System, t, omega2, alpha2, loads, working=None) -> tuple:
         known = np.where(working, loads.cutting_force * way, 0.0)
     elif out_body is None and loads.follower_torque and m.OUTPUT == "follower":
         known = np.where(working, loads.follower_torque * way, 0.0)
-    a = compiled.parts(m, s, t, omega2, alpha2, loads.gravity, k, known, table or sliding)
+    general = applied.resolve(m, s, linkage_of(m), loads) if loads.general else None
+    # the compiled kernel takes the shorthands only: general loads take the jets and numpy
+    a = (
+        None
+        if general is not None
+        else compiled.parts(m, s, t, omega2, alpha2, loads.gravity, k, known, table or sliding)
+    )
     if a is None:
-        a = _numpy_parts(m, s, t, omega2, alpha2, loads.gravity, k, known)
+        ends = np.where(working, way, -way) if forced and way else None
+        extra = None if general is None else (loads, general, working, ends)
+        a = _numpy_parts(m, s, t, omega2, alpha2, loads.gravity, k, known, extra)
     # along x, through the ram's point (no moment about a yoke's centre on its line)
     load = np.where(working, loads.force_at(a.x_out), 0.0) * way if table else None
     if not sliding:
@@ -522,11 +558,17 @@ def crank_acceleration(m, s: _System, theta: float, omega2: float, loads, torque
     return found[0]
 
 
-def _numpy_parts(m, s: _System, t, omega2, alpha2, g, k, known=None) -> Parts:
+def _numpy_parts(m, s: _System, t, omega2, alpha2, g, k, known=None, general=None) -> Parts:
     """``Parts`` from the jets and the elimination in numpy (``known``: the load that does not depend on the
-    motion, (n,) on the load's row, or None)."""
-    P, kin, vel = _kinetics(m, s, t, omega2, alpha2, k)
+    motion, (n,) on the load's row, or None; ``general``: (loads, their ``applied.resolve``, the working stroke's
+    mask, the output's way along each closed stroke or None: ``applied.evaluate``'s ends) for the forces, torques
+    and a gravity vector, or None)."""
+    pts, P, kin, vel = _kinetics(m, s, t, omega2, alpha2, k, rates=True)
+    if general is not None and isinstance(g, tuple):
+        g = 0.0  # the vector's weights go on the rows below
     entries, rows = s.assemble(P, kin, g, np.sqrt)
+    if general is not None:
+        _apply(m, s, t, omega2, k, pts, kin, rows, *general)
     elim = Elimination(entries, s.n, t.size, s.pivots(entries))
     r = s.load_row()
     if known is not None:
@@ -542,6 +584,30 @@ def _numpy_parts(m, s: _System, t, omega2, alpha2, g, k, known=None) -> Parts:
         v_out = vel[out_body.name][0]
     normals = {c.joint: s.normal(c, P, np.sqrt) for c, _, _ in s.cols if c.kind == "slot"}
     return Parts(solve, x_out, v_out, normals, shaking(kin))
+
+
+def _apply(m, s: _System, t, omega2, k, pts, kin, rows, loads, resolved, working, ends) -> None:
+    """Put the general loads on the right-hand side (known external forces and moments leave it): each force
+    (fx, fy) at point p on body b and torque tau, -(fx, fy, (p - G) x F + tau); a gravity vector's weight m g."""
+
+    def sub(r, v):
+        rows[r] = rows.get(r, 0.0) - v
+
+    if isinstance(loads.gravity, tuple):
+        gx, gy = loads.gravity
+        for b in s.bodies:
+            mass = kin[b.name][3]
+            sub(s.rows[b.name], mass * gx)
+            sub(s.rows[b.name] + 1, mass * gy)
+    joint = m.output_joint()
+    x = pts[joint][0][0] / k if joint is not None else None
+    for ap in applied.evaluate(m, s, resolved, pts, t, working, x, 1.0, abs(omega2), ends):
+        r, (gx, gy) = s.rows[ap.body], kin[ap.body][0]
+        (fx, fy), (px, py) = ap.force, ap.point
+        sub(r, fx)
+        sub(r + 1, fy)
+        if s.kind(ap.body) != "ram":
+            sub(r + 2, (px - gx) * fy - (py - gy) * fx + ap.torque)
 
 
 def _pairs(a, b, n) -> np.ndarray:
@@ -573,20 +639,32 @@ def generalised(m, theta2, *, masses=None, loads=None, sense: float = 1.0) -> Ge
     t = m._angles(theta2)
     s = system_of(m, masses)
     k = units_.to_metres(m.units)
+    way = working_way(m, loads, sense)
     lp = m.evaluate(JET, Jet.seed(t, 1.0, 0.0))
     pts = _triples(lp, k)
     M = np.zeros(t.shape)
     dM = np.zeros(t.shape)
     Q = np.zeros(t.shape)
+    tilted = isinstance(loads.gravity, tuple)
     for b in s.bodies:
         bm = s.props[b.name]
         _, (vx, vy), (ax, ay), ph = body_motion(b, bm.com, pts)  # per unit theta2 (seeded 1, 0)
         M += bm.mass * (vx * vx + vy * vy) + bm.inertia * ph[2] ** 2
         dM += 2 * (bm.mass * (vx * ax + vy * ay) + bm.inertia * ph[2] * ph[3])
-        Q += bm.mass * loads.gravity * vy
+        if tilted:
+            Q -= bm.mass * (loads.gravity[0] * vx + loads.gravity[1] * vy)
+        else:
+            Q += bm.mass * loads.gravity * vy
+    if loads.forces or loads.torques:
+        joint = m.output_joint()
+        x = pts[joint][0][0] / k if joint is not None else None
+        on = _working(m, t, sense, way) if way is not None else None
+        resolved = applied.resolve(m, s, linkage_of(m), loads)
+        for ap in applied.evaluate(m, s, resolved, pts, t, on, x, math.copysign(1.0, sense), 1.0):
+            Q -= ap.force[0] * ap.velocity[0] + ap.force[1] * ap.velocity[1] + ap.torque * ap.spin
     if m.output_joint() is not None or m.OUTPUT == "follower":
         x = _parts(lp.x, t.shape)
-        working = _working(m, t, sense)
+        working = _working(m, t, sense, way)
         if m.OUTPUT == "slider":
             Q += np.where(working, loads.force_at(x[0]) * np.abs(x[1]) * k, 0.0) * math.copysign(1.0, sense)
         else:
@@ -594,14 +672,37 @@ def generalised(m, theta2, *, masses=None, loads=None, sense: float = 1.0) -> Ge
     return Generalised(t, M, dM, Q)
 
 
-def _working(m, t, omega2) -> np.ndarray:
-    """Where the output moves on its working (slow) stroke at these crank angles."""
+def working_way(m, loads: Loads, omega2: float) -> str | None:
+    """The way the output moves on the working stroke: the slow stroke's ('+x' or '-x'), or where the strokes take
+    equal time (TR = 1) the one the loads name (``Loads.working``); None where neither decides and no load needs it.
+    InvalidParameter naming the load where one acts on a stroke that cannot be decided, or where the named way is
+    not the slow stroke's."""
+    way = m.working_direction(omega2 if omega2 else 1.0)
+    if loads.working is not None:
+        if way is not None and way != loads.working:
+            raise InvalidParameter(
+                f"{m!r}: its working (slow) stroke moves {way} at omega2 = {omega2:g} rad/s, but the loads name "
+                f"{loads.working}"
+            )
+        return loads.working
+    named = loads.by_stroke() if way is None else []
+    if named:
+        raise InvalidParameter(
+            f"{m!r} has TR = 1: its strokes take equal time, so {named[0]} has no working stroke to act on; name "
+            "the working stroke's direction, Loads(..., working='+x' or '-x')"
+        )
+    return way
+
+
+def _working(m, t, omega2, way=None) -> np.ndarray:
+    """Where the output moves on its working stroke at these crank angles (``way``: its direction, default the
+    slow stroke's)."""
     a, _ = m.stroke_angles()
     d = m.dead_centres()
     s = t - d.theta_max
     s -= (2 * math.pi) * np.floor(s * (0.5 / math.pi))  # mod 2 pi, a third of np.remainder's time
     down = s < a  # from theta_max to theta_min counter-clockwise: the output decreases for omega2 > 0
-    way = m.working_direction(omega2 if omega2 else 1.0)
+    way = m.working_direction(omega2 if omega2 else 1.0) if way is None else way
     if way is None:
         return np.zeros(t.shape, bool)
     decreasing = down if omega2 > 0 else ~down

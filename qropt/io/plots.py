@@ -117,6 +117,8 @@ def cycle_figure(m: Mechanism, theta2: float = math.radians(60), omega2: float =
 def dynamics_figure(m: Mechanism, omega2: float, masses=None, loads=None, theta2: float = math.radians(60), n=721):
     """Figure: the mechanism at theta2 with the force each joint passes on (arrows to one scale, newtons) (left);
     the crank torque and every joint force's magnitude over a turn (right), strokes shaded."""
+    if loads is not None:
+        loads.require_plain("the dynamics figure")
     _mechanism(m)
     drawing.check(m)
     fig = plt.figure(figsize=(12, 6))

@@ -21,7 +21,7 @@ import numpy as np
 from qropt import units as units_
 from qropt.dynamics.model import slender_bar, union
 from qropt.dynamics.rigid import body_motion
-from qropt.errors import InvalidParameter
+from qropt.errors import InvalidParameter, UnsupportedLoad
 from qropt.mechanisms.base import working_sign
 from qropt.synthesis.criteria import Criterion, Exchange, register
 
@@ -45,6 +45,15 @@ def _problem_check(c, problem) -> str | None:
     loads = problem.loads
     if problem.masses is None and loads is None:
         return f"{c.objective} needs masses or loads (Problem(..., masses=qropt.Masses..., loads=qropt.Loads(...)))"
+    what = f"the synthesis NLP ({c.objective})"
+    if loads is not None:
+        try:
+            loads.require_plain(what)
+        except UnsupportedLoad as e:
+            return str(e)
+    if problem.masses is not None and problem.masses.points:
+        joint = next(iter(problem.masses.points))
+        return f"{what} cannot take the point mass at {joint} yet (Masses(points=...)); inverse_dynamics does"
     return None
 
 

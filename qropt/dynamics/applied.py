@@ -1,0 +1,164 @@
+"""General loads at crank angles: where each ``Force`` and ``Torque`` of a ``Loads`` acts, on which body, with what
+force vector (N) and torque (N m), and the velocity of its point (what the inverse dynamics and the generalised
+load ``Q`` read). SI units: points in metres, the ram's position for windows and tables in the mechanism's unit.
+
+A joint's load acts on the body that carries the joint (``carrier``): the output body (the ram, the yoke) for the
+output's joint, else the first body in the linkage's order whose joints include it (the crank-pin block aside).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from scipy.optimize import brentq
+
+from qropt.dynamics.model import TWO_PI, Force, Loads, level
+from qropt.dynamics.rigid import body_motion, frame
+from qropt.errors import InvalidParameter
+
+AT_REST = 1e-9  # a point is at rest where its speed is below this times |omega2| times the mechanism's size
+EDGE_GRID = 720  # crank angles where the ram's crossings of a window's or a table's x are bracketed
+
+
+class Applied(NamedTuple):
+    """One load at n crank angles: the body it acts on, its point (x, y) (m), the point's velocity (x, y) (m/s or m
+    per unit crank angle, as the joints' rates), the force (fx, fy) (N), the torque (N m) and the body's angular
+    velocity (rad/s or per unit crank angle)."""
+
+    body: str
+    point: tuple
+    velocity: tuple
+    force: tuple
+    torque: object
+    spin: object
+
+
+def joints_of(link) -> list[str]:
+    return sorted({j for b in link.bodies() for j in b.joints})
+
+
+def carrier(m, link, joint: str) -> str:
+    """The body that carries ``joint`` (see the module); InvalidParameter naming the joints for an unknown one."""
+    bodies = link.bodies()
+    if joint == m.output_joint():
+        out = next((b.name for b in bodies if b.kind in ("ram", "yoke")), None)
+        if out is not None:
+            return out
+    for b in bodies:
+        if b.kind != "block" and joint in b.joints:
+            return b.name
+    raise InvalidParameter(f"{type(m).__name__} has no joint {joint!r}; its joints: {joints_of(link)}")
+
+
+def resolve(m, s, link, loads: Loads) -> list[tuple]:
+    """Each force and torque with the body it acts on, checked against the mechanism: (load, body). InvalidParameter
+    naming the load for an unknown joint or body, a body the system does not hold (a massless block), a torque on
+    the ram (it does not turn) or a window or table on the ram's position without a ram."""
+    names = [b.name for b in link.bodies()]
+    held = {b.name for b in s.bodies}
+    out = []
+    for load in (*loads.forces, *loads.torques):
+        at = load.at if isinstance(load, Force) else (load.on,)
+        if isinstance(load, Force) and isinstance(at, str):
+            try:
+                body = carrier(m, link, at)
+            except InvalidParameter as e:
+                raise InvalidParameter(f"{load}: {e}") from None
+        else:
+            body = at[0]
+            if body not in names:
+                raise InvalidParameter(f"{load}: {type(m).__name__} has no body {body!r}; its bodies: {names}")
+        if body not in held:
+            raise InvalidParameter(
+                f"{load}: the {body} is massless and passes its force straight on; give it a mass to load it "
+                "(Masses(block=...))"
+            )
+        if not isinstance(load, Force) and s.kind(body) == "ram":
+            raise InvalidParameter(f"{load}: the ram does not turn (its guide carries a torque on it)")
+        table = isinstance(load.magnitude, tuple) and load.against == "x"
+        if (table or load.window.x is not None) and m.output_joint() is None:
+            raise InvalidParameter(f"{load}: {type(m).__name__} has no ram: no window or table on its position x")
+        out.append((load, body))
+    return out
+
+
+def evaluate(m, s, resolved, pts, t, working, x, sense: float, rate: float, ends=None) -> list[Applied]:
+    """The resolved loads (``resolve``) at crank angles t (rad): ``pts`` joint -> ((x, x', x''), (y, y', y''))
+    in metres with the rates of the actual motion (or per unit crank angle), ``working`` (bool, on the working
+    stroke; None where no load needs it), x the ram's positions (the mechanism's unit; None without a ram),
+    ``sense``: the sign that turns the rates into the motion's direction (1 for the actual motion's rates, the sense
+    of rotation for rates per unit crank angle), ``rate``: |omega2| (rad/s), or 1 per unit crank angle; ``ends``:
+    the way (+1 or -1 along x) the output moves at each angle where its stroke is given (a stroke closed at its
+    dead centres), which a force against the output's velocity resists where the output is at rest, or None."""
+    bodies = {b.name: b for b in s.bodies}
+    size = max(float(np.max(np.hypot(px[0], py[0]))) for px, py in pts.values())
+    rest = AT_REST * rate * max(size, 1e-300)
+    out = []
+    for load, name in resolved:
+        b = bodies[name]
+        (ox, oy), rot = frame(b, pts)
+        spin = rot[2]
+        arg = x if load.against == "x" else np.mod(t, TWO_PI)
+        amount = level(load.magnitude, arg) * load.window.active(t, working, x)
+        if not isinstance(load, Force):
+            zero = np.zeros(t.shape)
+            out.append(Applied(name, (ox[0] + zero, oy[0] + zero), (zero, zero), (zero, zero), amount, spin))
+            continue
+        if isinstance(load.at, str):
+            (px, py) = (pts[load.at][0][0], pts[load.at][1][0])
+            v = (ox[1] - spin * (py - oy[0]), oy[1] + spin * (px - ox[0]))
+        else:
+            (px, py), v, _, _ = body_motion(b, load.at[1:], pts)
+        px, py = np.broadcast_to(px, t.shape), np.broadcast_to(py, t.shape)
+        vx, vy = np.broadcast_to(v[0], t.shape), np.broadcast_to(v[1], t.shape)
+        d = load.direction
+        if d == "against":
+            speed = np.hypot(vx, vy)
+            moving = speed > rest
+            inv = np.where(moving, -sense / np.where(moving, speed, 1.0), 0.0)
+            fx, fy = amount * vx * inv, amount * vy * inv
+            if ends is not None and b.kind in ("ram", "yoke"):  # at a dead centre: the limit along its stroke
+                fx = np.where(moving, fx, -amount * ends)
+        elif d == "slide":
+            fx, fy = amount, np.zeros(t.shape)
+        else:
+            n = float(np.hypot(*d))
+            fx, fy = amount * (d[0] / n), amount * (d[1] / n)
+        out.append(Applied(name, (px, py), (vx, vy), (fx, fy), 0.0, spin))
+    return out
+
+
+def edges(m, loads: Loads) -> list[float]:
+    """The crank angles (rad, in [0, 2 pi)) where a force's or torque's window opens or closes, or its table
+    turns a corner: the ends of theta2 windows and the theta2 rows of tables, and where the ram passes the x ends
+    of windows and the x rows of tables (brentq on the positions). A quadrature splits its pieces there."""
+    angles, xs = set(), set()
+    for load in (*loads.forces, *loads.torques):
+        w = load.window
+        if w.theta2 is not None:
+            angles.update(a % TWO_PI for a in w.theta2)
+        if w.x is not None:
+            xs.update(w.x)
+        if isinstance(load.magnitude, tuple) and len(load.magnitude) > 1:
+            rows = [r[0] for r in load.magnitude]
+            if load.against == "x":
+                xs.update(rows)
+            else:
+                angles.update(a % TWO_PI for a in rows)
+    if xs and m.output_joint() is not None:
+        t = np.linspace(0.0, TWO_PI, EDGE_GRID + 1)
+        x = m.positions(t).x
+
+        def at(th, v):
+            return float(m.positions(np.array([th])).x[0]) - v
+
+        for v in xs:
+            d = x - v
+            for i in np.flatnonzero(d[:-1] * d[1:] < 0):
+                angles.add(brentq(at, t[i], t[i + 1], args=(v,), xtol=1e-14) % TWO_PI)
+            angles.update(float(t[i]) % TWO_PI for i in np.flatnonzero(d == 0))
+    return sorted(angles)
+
+
+__all__ = ["Applied", "carrier", "resolve", "evaluate", "edges", "joints_of"]
