@@ -22,6 +22,7 @@ from qropt.synthesis import criteria
 
 QUIET = False  # --quiet: no progress bars
 PARAM_NAMES = ("r1", "r2", "r3", "r4", "r5", "r6", "e", "h", "sigma", "sigma_slider")
+TIME_LIMIT_HELP = "seconds of wall time: the best certified design found by then, the claim naming what did not run"
 
 
 class CliError(Exception):
@@ -444,6 +445,7 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--objective", choices=[o for o in criteria.objectives() if o] + ["none"])
     s.add_argument("--size", choices=["sum", "longest", "footprint"], help="size measure for min_size")
     s.add_argument("--starts", type=int, help="space-filling multi-start points (default: the solver's)")
+    s.add_argument("--time-limit", dest="time_limit", type=real, help=TIME_LIMIT_HELP)
     s.add_argument("--json", action="store_true", help="print the Result as JSON")
     s.add_argument("--plot", help="PNG file: the best design over its cycle")
     _export_arguments(s)
@@ -730,7 +732,7 @@ def cmd_synth(args):
         problem = problem.replace(**changes)
     if args.starts is not None and args.starts < 0:
         raise CliError(f"--starts must be >= 0, got {args.starts}")
-    r = solve(problem, starts_n=args.starts)
+    r = solve(problem, starts_n=args.starts, time_limit=args.time_limit)
     if args.json:
         json.dump(r.to_dict(), sys.stdout, indent=2, default=str, allow_nan=False)
         sys.stdout.write("\n")

@@ -10,7 +10,7 @@ HELP = "type synthesis: the task solved for every quick-return type, compared cr
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from qropt.cli import real
+    from qropt.cli import TIME_LIMIT_HELP, real
     from qropt.studies._design import TYPES
     from qropt.synthesis import criteria
     from qropt.units import LENGTH_UNITS
@@ -53,6 +53,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--pareto", nargs=2, metavar=("A", "B"), help="also each type's front between two objectives")
     parser.add_argument("--n", type=int, default=12, help="front points per type with --pareto (default 12)")
     parser.add_argument("--workers", type=int, help="solve the types in this many worker processes")
+    parser.add_argument("--time-limit", dest="time_limit", type=real, help=TIME_LIMIT_HELP)
     parser.add_argument("--csv", metavar="FILE", help="write the comparison table as CSV")
     parser.add_argument("--json", action="store_true", help="print the comparison as JSON")
     parser.add_argument("--plot", metavar="FILE", help="draw the designs side by side (.png, .pdf, .svg)")
@@ -116,6 +117,7 @@ def run(args) -> int:
             masses=masses,
             loads=loads,
             workers=args.workers,
+            time_limit=args.time_limit,
         )
     if args.csv:
         cmp.to_csv(args.csv)

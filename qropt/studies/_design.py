@@ -18,10 +18,12 @@ import csv
 import dataclasses
 import json
 import math
+import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from qropt import units as units_
+from qropt import validate
 from qropt.errors import ProblemError, QroptError
 from qropt.mechanisms import TYPES as SHIPPED
 from qropt.mechanisms import mechanism_type
@@ -313,6 +315,7 @@ def design(
     masses=None,
     loads=None,
     workers: int | None = None,
+    time_limit: float | None = None,
 ) -> Comparison:
     """Solve the task (TR, stroke) for every type (or ``types``) and compare; see the module docstring.
 
@@ -322,8 +325,11 @@ def design(
     unit of the stroke, the bounds and every length of the answer (one of ``qropt.units.LENGTH_UNITS``); masses,
     loads: every type's mass model and loads (``qropt.Masses``, ``qropt.Loads``; the bars follow each design's
     links), for the dynamic objectives and bounds; workers: solve the rows in that many worker processes, kept
-    for later calls (``qropt.studies._workers``; the same rows as in this process, the largest given out first).
-    Every argument is checked (every type's problem built, the front's objectives and ``n``) before any solve.
+    for later calls (``qropt.studies._workers``; the same rows as in this process, the largest given out first);
+    time_limit: seconds of wall time for the whole comparison, shared by the rows (in this process each row gets
+    an equal share of what is left when it starts; in K workers each row K / rows of the whole), each row's
+    Result the best found within its share (``Solver.solve``'s time_limit). Every argument is checked (every
+    type's problem built, the front's objectives and ``n``) before any solve.
     """
     from qropt.synthesis.solver import DEFAULT, Solver
 
@@ -333,6 +339,10 @@ def design(
         raise ProblemError(f"progress is a callable (called once per finished type) or None, got {progress!r}")
     if workers is not None:
         _workers.check_workers(workers)
+    if time_limit is not None:
+        time_limit = validate.number("time_limit", time_limit, limit=1e12)
+        if time_limit <= 0:
+            raise ProblemError(f"time_limit is a positive number of seconds, got {time_limit!r}")
     solver = solver or DEFAULT
     problems = task_problems(
         time_ratio,
@@ -356,11 +366,14 @@ def design(
     rows, fronts = [], {}
     if workers is not None and workers > 1:
         each = (lambda _: progress(1)) if progress and pareto is None else None  # with fronts: once each is done
-        solved = _workers.solve_all(problems, solver, workers, done=each)
+        share = None if time_limit is None else time_limit * min(workers, len(problems)) / len(problems)
+        solved = _workers.solve_all(problems, solver, workers, done=each, time_limit=share)
     else:
         solved = None
-    for kind, p in problems.items():
-        r = solved[kind] if solved is not None else solver.solve(p)
+    end = None if time_limit is None else time.perf_counter() + time_limit
+    for i, (kind, p) in enumerate(problems.items()):
+        share = None if end is None else max(end - time.perf_counter(), 1e-3) / (len(problems) - i)
+        r = solved[kind] if solved is not None else solver.solve(p, time_limit=share)
         if r.mechanism is None and r.units != units:  # a Result without a design names the problem's unit too
             r = dataclasses.replace(r, units=units)
         rows.append(_row(kind, p, r))

@@ -89,17 +89,18 @@ def shutdown() -> None:
         ex.shutdown(wait=True, cancel_futures=True)
 
 
-def _solve(problem, options: dict):
+def _solve(problem, options: dict, time_limit=None):
     """Run in a worker: the problem solved by this process's Solver for ``options``."""
     from qropt.synthesis.solver import shared
 
-    return shared(options).solve(problem)
+    return shared(options).solve(problem, time_limit=time_limit)
 
 
-def solve_all(problems: dict, solver, workers: int, done=None) -> dict:
+def solve_all(problems: dict, solver, workers: int, done=None, time_limit=None) -> dict:
     """{key: Result} of every problem, solved by ``workers`` processes with Solvers equal to ``solver`` (the
     largest problems, by free parameters, given out first; a problem that cannot travel solved here); ``done``
-    is called with each key as its result arrives. A lost worker is a ProblemError naming it."""
+    is called with each key as its result arrives; time_limit: each solve's (s), or None. A lost worker is a
+    ProblemError naming it."""
     from qropt.synthesis.solver import not_rebuilt, shared
 
     why = not_rebuilt(solver)
@@ -112,9 +113,9 @@ def solve_all(problems: dict, solver, workers: int, done=None) -> dict:
     out = {}
     try:
         ex = _executor(workers)
-        futures = {ex.submit(_solve, problems[k], options): k for k in away}
+        futures = {ex.submit(_solve, problems[k], options, time_limit): k for k in away}
         for k, p in here.items():
-            out[k] = solver.solve(p)
+            out[k] = solver.solve(p, time_limit=time_limit)
             if done:
                 done(k)
         for fut in cf.as_completed(futures):

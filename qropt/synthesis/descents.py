@@ -4,24 +4,36 @@
 
 from __future__ import annotations
 
+import time
+
 from qropt.synthesis import evolution, minimax
 
 
 def descended(
-    problem, generations: int, seed: int, keep: int = evolution.KEEP, evals: int | None = None, sqp: bool = False
+    problem,
+    generations: int,
+    seed: int,
+    keep: int = evolution.KEEP,
+    evals: int | None = None,
+    sqp: bool = False,
+    deadline: float | None = None,
 ) -> list[evolution.End]:
     """The ``descents`` of an evolution's designs (``evolve``: ``generations`` from ``seed``, ``keep`` of them)."""
-    return descents(problem, evolution.evolve(problem, generations, seed, keep), evals, sqp)
+    return descents(problem, evolution.evolve(problem, generations, seed, keep), evals, sqp, deadline)
 
 
-def descents(problem, designs: list[dict], evals: int | None = None, sqp: bool = False) -> list[evolution.End]:
+def descents(
+    problem, designs: list[dict], evals: int | None = None, sqp: bool = False, deadline: float | None = None
+) -> list[evolution.End]:
     """The designs, each put on the targets and descended by Nelder-Mead (``descend``, ``evals`` evaluations); with
     ``sqp``, where the objective is a peak over the turn, the SQP on its exact extremes (``minimax.polish``) runs
     from the design and from Nelder-Mead's end too (the two often reach different minima; the ends then kept where
-    they differ, ``apart``). The ends, best first."""
+    they differ, ``apart``). The ends, best first; deadline: no descent starts after it (perf_counter s)."""
     ends: list[evolution.End] = []
     sqp = sqp and minimax.applies(problem)
     for d in designs:
+        if deadline is not None and time.perf_counter() >= deadline:
+            break
         on = evolution.on_targets(problem, d)
         if on is None:
             continue

@@ -5,6 +5,8 @@ starts run, in which order, is the search pipeline's (``qropt.synthesis.search``
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from qropt.errors import QroptError
@@ -57,13 +59,13 @@ class MultiStart:
                 return x
         return None
 
-    def run(self, problem, runs, targets, max_rounds, designs, both_ways, patient=False, hint=None):
+    def run(self, problem, runs, targets, max_rounds, designs, both_ways, patient=False, hint=None, deadline=None):
         """A local solve from every start; the incumbent's NLP value prunes starts that cannot beat it; patient:
         each run with the backend's larger iteration limit (``LocalSolve.run``). A start of a NEAR origin runs
         from the backend's small barrier; one from the atlas or a descent (AGAIN) that gives no design there runs
         from its default barrier too (not in a patient rerun, where the default barrier can spend the larger
         iteration limit for nothing): from such a start the small barrier can reach its iteration limit where the
-        default one certifies a design."""
+        default one certifies a design. deadline: no start runs after it (perf_counter s)."""
         plans, count = [], {1: 0, -1: 0}
         for i, (origin, v, *br) in enumerate(runs):
             for b in br or starts_.branches(problem):
@@ -82,6 +84,8 @@ class MultiStart:
                 count[-ways[0]] += 1
         out, bound = [], None
         for i, origin, v, b, ways in plans:
+            if deadline is not None and time.perf_counter() >= deadline:
+                break
             for way in ways:
                 kw = {"orientation": way, "max_rounds": max_rounds, "designs": designs, "bound": bound}
                 given = hint if origin == "given" else None

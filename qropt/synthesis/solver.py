@@ -167,6 +167,7 @@ class Solver:
         extra_starts=(),
         diagnose: bool = True,
         continue_from: Result | None = None,
+        time_limit: float | None = None,
     ) -> Result:
         """Solve a synthesis problem by one pass of the Solver's pipeline; returns a Result whatever happens (only
         invalid input raises).
@@ -177,7 +178,10 @@ class Solver:
         (within the diagnosis budget); without it a failure is 'failed' with the backend's reasons, or
         'infeasible' where a closed form that gives every design gives none that is valid; continue_from: a
         Result of a nearby problem (a chart's neighbour) whose design is one of ``extra_starts``: that start is
-        continued by Newton on the optimum's active set, verified, before the backend runs (``newton``).
+        continued by Newton on the optimum's active set, verified, before the backend runs (``newton``);
+        time_limit: seconds of wall time, after which no strategy starts but those that make the Result of what
+        was found (a local solve, an evolution or an SQP under way ends first); the claim names the strategies it
+        left out, and a solve without a certified design is 'failed' and not diagnosed.
         """
         t0 = time.perf_counter()
         asked = starts_n is not None
@@ -187,8 +191,13 @@ class Solver:
             problem, targets, extra_starts, starts_n, seed, max_rounds
         )
         hint = continue_from.continuation if continue_from is not None and extra else None
+        if time_limit is not None:
+            time_limit = _real("time_limit", time_limit)
+            if time_limit <= 0:
+                raise ProblemError(f"time_limit is a positive number of seconds, got {time_limit!r}")
+        deadline = None if time_limit is None else t0 + time_limit
         context = search.Context(
-            self, targets, starts_n, seed, max_rounds, extra, use_analytic, diagnose, asked, hint, t0
+            self, targets, starts_n, seed, max_rounds, extra, use_analytic, diagnose, asked, hint, t0, deadline
         )
         return search.solve(self.pipeline, problem, context)
 

@@ -31,6 +31,18 @@ class Plan:
     atlas: atlas_.Starts = atlas_.Starts()  # where no closed form enumerates or walks every solution
     related: atlas_.Starts = atlas_.Starts()  # the same, where the objective is dynamic: the atlas's kinematic optima
     walk: analytic.Walk | None = None  # a family's designs as a function of its parameter (``analytic.Walk``)
+    given: int = 0  # starts the solve was given (``extra_starts``): they replace the closed forms' own searches
+
+    @property
+    def spread(self) -> bool:
+        """Whether the space-filling starts run: no closed form enumerates or walks every design, or starts are
+        given."""
+        return bool(self.given) or self.kind not in ("enumeration", "family")
+
+    @property
+    def searching(self) -> bool:
+        """Whether the solve searches on its own (no starts given): the global strategies run only then."""
+        return not self.given
 
 
 def _build(problem, values, branch):

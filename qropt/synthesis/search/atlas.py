@@ -11,20 +11,29 @@ class AtlasStarts(Stage):
     name = "atlas"
 
     def accepts(self, problem, plan):
-        return plan is not None and bool(plan.atlas.designs)
+        return plan is not None and bool(plan.atlas.designs) and plan.searching and plan.spread
 
     def run(self, problem, pool, context):
-        if context.given or pool.plan.kind in ("enumeration", "family"):
-            return None
         ms, plan, tol = context.solver.multistart, pool.plan, context.settings.atlas_short
         first = [("atlas", v, b) for v, b in plan.atlas.designs]
-        cands = ms.run(problem, first, context.targets, context.max_rounds, pool.designs, both_ways=False)
+        cands = ms.run(
+            problem, first, context.targets, context.max_rounds, pool.designs, False, deadline=context.deadline
+        )
         between, floor = expected(problem, plan.atlas, pool.designs)
         how = plan.atlas.how
         done = {c.start for c in cands if c.ok}
         if short(problem, cands, between, tol) and len(done) < len(first):  # again, with a larger iteration limit
             again = [r for i, r in enumerate(first) if i not in done]
-            cands += ms.run(problem, again, context.targets, context.max_rounds, pool.designs, False, patient=True)
+            cands += ms.run(
+                problem,
+                again,
+                context.targets,
+                context.max_rounds,
+                pool.designs,
+                False,
+                True,
+                deadline=context.deadline,
+            )
             how += ", those without a design run again with a larger iteration limit"
         pool.candidates += cands
         if any(c.ok for c in cands) and not short(problem, cands, floor, tol):

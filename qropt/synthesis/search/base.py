@@ -26,6 +26,7 @@ class Strategy(Protocol):
     """One stage of a solve. ``name``: a few words for claims and tables."""
 
     name: ClassVar[str]
+    finishing: ClassVar[bool]  # runs after a time limit too (it makes the Result of what was found, cheaply)
 
     def accepts(self, problem, plan) -> bool:
         """Whether it applies to ``problem`` with this plan of starts (``starts.Plan``; None before one is made)."""
@@ -38,6 +39,7 @@ class Stage:
     """A convenient base for strategies: accepts every problem."""
 
     name: ClassVar[str] = ""
+    finishing: ClassVar[bool] = False
 
     def accepts(self, problem, plan) -> bool:
         return True
@@ -62,6 +64,7 @@ class Pool:
     retry: Any = None  # the multi-start's second pass, deferred (a callable) where the diagnosis may run it
     spent: dict = field(default_factory=dict)  # statistics the strategies add to the Result's
     ran: list = field(default_factory=list)  # (strategy name, seconds) in the order they ran
+    skipped: list = field(default_factory=list)  # strategies that applied but did not run: the time limit had passed
     result: Any = None  # the Result, once made
 
     @property
@@ -79,7 +82,8 @@ class Pool:
 class Context:
     """One solve's options and the Solver's parts. given: starts given (free-parameter dicts), tried first;
     asked: whether ``starts_n`` was named (else grown with the free parameters); hint: a nearby optimum to
-    continue (``newton.Hint``); t0: when the solve began (perf_counter s)."""
+    continue (``newton.Hint``); t0: when the solve began (perf_counter s); deadline: when its time limit ends
+    (perf_counter s), or None."""
 
     solver: Any
     targets: dict
@@ -92,10 +96,15 @@ class Context:
     asked: bool = False
     hint: Any = None
     t0: float = field(default_factory=time.perf_counter)
+    deadline: float | None = None
 
     @property
     def settings(self):
         return self.solver.settings
+
+    def out_of_time(self) -> bool:
+        """Whether the solve's time limit has passed."""
+        return self.deadline is not None and time.perf_counter() >= self.deadline
 
     def options(self, **changed) -> dict:
         """This solve's options as ``run`` takes them, some changed."""
@@ -109,6 +118,7 @@ class Context:
             "diagnose": self.diagnose,
             "asked": self.asked,
             "hint": self.hint,
+            "deadline": self.deadline,
         }
         out.update(changed)
         return out
@@ -133,15 +143,13 @@ class Context:
         return pool.candidates, pool.claim, pool.retry
 
 
-def spread(pool: Pool, context: Context) -> bool:
-    """Whether the space-filling starts run: no closed form enumerates or walks every design, or starts are given."""
-    return bool(context.given) or pool.plan.kind not in ("enumeration", "family")
-
-
 def run(stages, problem, pool: Pool, context: Context) -> str | None:
     """Each strategy of ``stages`` that accepts the problem, in order, until one returns STOP (returned)."""
     for s in stages:
         if not s.accepts(problem, pool.plan):
+            continue
+        if context.out_of_time() and not getattr(s, "finishing", False):
+            pool.skipped.append(s.name)
             continue
         t = time.perf_counter()
         said = s.run(problem, pool, context)
@@ -159,10 +167,26 @@ def solve(stages, problem, context: Context):
     if pool.result is None:
         names = [s.name for s in stages]
         raise ProblemError(f"the pipeline {names} made no Result (it needs a strategy that makes one, as Failed does)")
-    if "strategies" in pool.result.stats:
-        return pool.result
+    r = pool.result
+    if pool.skipped:
+        r = timed_out(r, list(dict.fromkeys(pool.skipped)), context)
+    if "strategies" in r.stats:
+        return r
     ran = list(dict.fromkeys(name for name, _ in pool.ran))
-    return dataclasses.replace(pool.result, stats={**pool.result.stats, "strategies": ran})
+    return dataclasses.replace(r, stats={**r.stats, "strategies": ran})
+
+
+def timed_out(r, skipped: list, context: Context):
+    """The Result with its claim (and message) saying that the time limit left these strategies out."""
+    limit = context.deadline - context.t0
+    words = f"the time limit ({limit:g} s) left out: {', '.join(skipped)}"
+    stats = {**r.stats, "skipped": [*r.stats.get("skipped", []), *skipped]}
+    if r.certificate is None:
+        return dataclasses.replace(r, message=f"{r.message}; {words}", stats=stats)
+    claim = f"{r.certificate.global_claim}; {words}"
+    cert = dataclasses.replace(r.certificate, global_claim=claim)
+    message = r.message.replace(r.certificate.global_claim, claim)
+    return dataclasses.replace(r, certificate=cert, message=message, stats=stats)
 
 
 @dataclass(frozen=True)
@@ -176,4 +200,4 @@ class Phase(Stage):
         run(self.stages, problem, pool, context)
 
 
-__all__ = ["Strategy", "Stage", "Pool", "Context", "Phase", "run", "solve", "spread", "STOP"]
+__all__ = ["Strategy", "Stage", "Pool", "Context", "Phase", "run", "solve", "STOP"]

@@ -8,6 +8,7 @@ from qropt.synthesis.search.base import Stage
 
 class Best(Stage):
     name = "best certified"
+    finishing = True
 
     def run(self, problem, pool, context):
         if pool.good:

@@ -81,6 +81,7 @@ def descended(solver, problem, r, ends: list, how: str, stats: dict | None = Non
 
 class Descended(Stage):
     name = "descents' ends"
+    finishing = True
 
     def run(self, problem, pool, context):
         solver, polished = context.solver, pool.spent.get("sqp_ends", 0)

@@ -35,20 +35,22 @@ class Failed(Stage):
     """Where no diagnosis is asked for: 'failed', with the backend's reasons."""
 
     name = "failed"
+    finishing = True
 
     def run(self, problem, pool, context):
-        if context.diagnose:
+        late = context.out_of_time()
+        if context.diagnose and not late:
             return None
         cands = pool.candidates
         stats = {**results.stats(context.solver, problem, cands, pool.plan), **pool.spent}
         stats["t_total"] = time.perf_counter() - context.t0
         why = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
-        pool.result = Result(
-            "failed",
-            f"no start gave a certified design ({'; '.join(w for w in why[:3] if w)}); not diagnosed",
-            stats=stats,
-            units=problem.units,
-        )
+        why = "; ".join(w for w in why[:3] if w)
+        if late:
+            msg = f"no certified design within the time limit ({len(cands)} local solves{': ' * bool(why)}{why})"
+        else:
+            msg = f"no start gave a certified design ({why})"
+        pool.result = Result("failed", f"{msg}; not diagnosed", stats=stats, units=problem.units)
         return STOP
 
 

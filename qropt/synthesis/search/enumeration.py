@@ -10,11 +10,9 @@ class Enumeration(Stage):
     name = "enumeration"
 
     def accepts(self, problem, plan):
-        return plan is not None and plan.kind == "enumeration"
+        return plan is not None and plan.kind == "enumeration" and plan.searching
 
     def run(self, problem, pool, context):
-        if context.given:
-            return
         local = context.solver.local_solve
         for v in pool.plan.analytic:
             for br in starts.branches(problem):

@@ -22,13 +22,19 @@ class Evolution(Stage):
 
     def run(self, problem, pool, context):
         solver = context.solver
-        if context.given or not solver.evolution:
+        if not solver.evolution:
             return
         t0, seed = time.perf_counter(), context.seed
         count, generations = solver.evolutions_of(problem), context.settings.evolution_generations
-        each = [descents.descended(problem, generations, seed + i, sqp=solver.sqp) for i in range(count)]
+        each = []
+        for i in range(count):
+            if context.out_of_time():
+                break
+            each.append(descents.descended(problem, generations, seed + i, sqp=solver.sqp, deadline=context.deadline))
         runs = [("evolution", e.design) for ends in each for e in ends[: evolution_.KEEP]]  # the best distinct ends
-        out = solver.multistart.run(problem, runs, context.targets, context.max_rounds, pool.designs, both_ways=False)
+        out = solver.multistart.run(
+            problem, runs, context.targets, context.max_rounds, pool.designs, False, deadline=context.deadline
+        )
         which = (
             "a differential evolution"
             if count == 1

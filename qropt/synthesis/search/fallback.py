@@ -10,10 +10,10 @@ class WithoutClosedForms(Stage):
     name = "without closed forms"
 
     def accepts(self, problem, plan):
-        return plan is not None and plan.kind in ("family", "enumeration")
+        return plan is not None and plan.kind in ("family", "enumeration") and plan.searching
 
     def run(self, problem, pool, context):
-        if context.given or pool.good or context.diagnose:
+        if pool.good or context.diagnose:
             return None
         pool.result = context.sub(problem, use_analytic=False, diagnose=False, targets=context.targets)
         return STOP

@@ -9,11 +9,9 @@ class FamilyScan(Stage):
     name = "closed-form family"
 
     def accepts(self, problem, plan):
-        return plan is not None and plan.kind == "family"
+        return plan is not None and plan.kind == "family" and plan.searching
 
     def run(self, problem, pool, context):
-        if context.given:
-            return
         plan = pool.plan
         pool.runs += context.solver.multistart.family_starts(problem, plan, pool.designs)
         pool.claim = (

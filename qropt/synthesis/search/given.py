@@ -8,5 +8,8 @@ from qropt.synthesis.search.base import Stage
 class Given(Stage):
     name = "given starts"
 
+    def accepts(self, problem, plan):
+        return plan is not None and plan.given > 0
+
     def run(self, problem, pool, context):
         pool.runs += [("given", v) for v in context.given]

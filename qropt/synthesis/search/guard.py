@@ -14,7 +14,7 @@ from qropt.synthesis.search.base import Stage
 def guard_of(problem, plan) -> float | None:
     """The guard (rad) that applies to the problem with this plan, else None."""
     c = criteria.of_problem(problem)
-    if c is None or c.guard is None or plan is None or plan.kind not in ("none", "partial"):
+    if c is None or c.guard is None or plan is None or plan.kind not in ("none", "partial") or not plan.searching:
         return None
     return c.guard if problem.conditions.get(criteria.GUARDED, 0.0) < c.guard else None
 
@@ -26,13 +26,13 @@ class Guarded(Stage):
         return guard_of(problem, plan) is not None
 
     def run(self, problem, pool, context):
-        if context.given:
-            return
         guard, ms = guard_of(problem, pool.plan), context.solver.multistart
         found, _, _ = context.multistart(under(problem, guard), pool.plan, context.starts_n, context.seed, pool.designs)
         good = distinct([x for x in found if x.ok])
         out = []
         for g in good:
+            if context.out_of_time():
+                break
             x = ms.continued(problem, g, guard, context.targets, context.max_rounds, pool.designs)
             if x:
                 x.origin, x.parent = "guard", g

@@ -11,5 +11,12 @@ class LocalSolves(Stage):
     def run(self, problem, pool, context):
         ms = context.solver.multistart
         pool.candidates += ms.run(
-            problem, pool.runs, context.targets, context.max_rounds, pool.designs, both_ways=False, hint=context.hint
+            problem,
+            pool.runs,
+            context.targets,
+            context.max_rounds,
+            pool.designs,
+            both_ways=False,
+            hint=context.hint,
+            deadline=context.deadline,
         )

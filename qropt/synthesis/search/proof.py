@@ -11,12 +11,13 @@ from qropt.synthesis.search.base import STOP, Stage
 
 class ProvedInfeasible(Stage):
     name = "proof by enumeration"
+    finishing = True
 
     def accepts(self, problem, plan):
-        return plan is not None and plan.kind == "enumeration"
+        return plan is not None and plan.kind == "enumeration" and plan.searching
 
     def run(self, problem, pool, context):
-        if context.given or pool.good or context.diagnose:
+        if pool.good or context.diagnose:
             return None
         plan, cands = pool.plan, pool.candidates
         why = sorted({c.info.get("reason", "") or "it breaks a condition" for c in cands})

@@ -15,11 +15,11 @@ class Refresh(Stage):
 
     def accepts(self, problem, plan):
         c = criteria.of_problem(problem)
-        return c is not None and not c.kinematic
+        return c is not None and not c.kinematic and plan is not None and plan.searching
 
     def run(self, problem, pool, context):
         r = pool.result
-        if r is None or context.given or r.status != "optimal":
+        if r is None or r.status != "optimal":
             return
         c, s = criteria.of_problem(problem), context.settings
         best, times = r, 0

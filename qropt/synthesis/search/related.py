@@ -3,16 +3,14 @@ backend's default barrier)."""
 
 from __future__ import annotations
 
-from qropt.synthesis.search.base import Stage, spread
+from qropt.synthesis.search.base import Stage
 
 
 class Related(Stage):
     name = "related atlas optima"
 
     def accepts(self, problem, plan):
-        return plan is not None and bool(plan.related.designs)
+        return plan is not None and bool(plan.related.designs) and plan.spread and plan.searching
 
     def run(self, problem, pool, context):
-        if context.given or not spread(pool, context):
-            return
         pool.runs += [("related", v, b) for v, b in pool.plan.related.designs]

@@ -11,6 +11,7 @@ from qropt.synthesis.search.base import STOP, Stage
 
 class UnitScale(Stage):
     name = "unit scale"
+    finishing = True
 
     def accepts(self, problem, plan):
         return scaling.factor(problem) != 1.0

@@ -10,11 +10,11 @@ from qropt.synthesis.search.diagnosis import searched
 
 class SecondPass(Stage):
     name = "joined"
+    finishing = True
 
     def run(self, problem, pool, context):
-        if context.given:
-            return
-        if pool.retry is not None and (any(c.ok for c in pool.more) or pool.ends) and not pool.good:
+        found = any(c.ok for c in pool.more) or pool.ends
+        if pool.retry is not None and found and not pool.good and not context.out_of_time():
             pool.candidates, pool.claim, pool.plan = searched(
                 context, problem, pool.plan, pool.candidates, pool.claim, pool.retry
             )

@@ -4,16 +4,14 @@
 from __future__ import annotations
 
 from qropt.synthesis import criteria, starts
-from qropt.synthesis.search.base import Stage, spread
+from qropt.synthesis.search.base import Stage
 
 
 class Shapes(Stage):
     name = "shape search"
 
     def accepts(self, problem, plan):
-        return plan is not None and criteria.grid_criterion(problem) is not None
+        return plan is not None and plan.spread and plan.searching and criteria.grid_criterion(problem) is not None
 
     def run(self, problem, pool, context):
-        if context.given or not spread(pool, context):
-            return
         pool.runs += [("shape", v) for v in starts.shapes(problem, starts.SHAPES_KEEP, context.seed)]

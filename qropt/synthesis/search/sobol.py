@@ -4,13 +4,14 @@
 from __future__ import annotations
 
 from qropt.synthesis import starts
-from qropt.synthesis.search.base import Stage, spread
+from qropt.synthesis.search.base import Stage
 
 
 class Sobol(Stage):
     name = "Sobol multi-start"
 
+    def accepts(self, problem, plan):
+        return plan is not None and plan.spread
+
     def run(self, problem, pool, context):
-        if not spread(pool, context):
-            return
         pool.runs += [("multistart", v) for v in starts.sobol(problem, context.starts_n, context.seed, pool.designs)]

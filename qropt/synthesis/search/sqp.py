@@ -12,9 +12,10 @@ from qropt.synthesis import evolution, minimax
 from qropt.synthesis.search.base import Stage
 
 
-def polished(problem, r, ends: list, count: int) -> tuple[list, dict]:
+def polished(problem, r, ends: list, count: int, deadline: float | None = None) -> tuple[list, dict]:
     """``ends`` with the SQP's ends from the ``count`` best certified designs of ``r`` (or None) and from each of
-    ``ends``, best first; and {'sqp_ends': how many were added, 't_sqp': the time taken, s}."""
+    ``ends``, best first; and {'sqp_ends': how many were added, 't_sqp': the time taken, s}. deadline: no SQP
+    starts after it (perf_counter s)."""
     t0 = time.perf_counter()
     if not minimax.applies(problem):
         return ends, {"sqp_ends": 0, "t_sqp": time.perf_counter() - t0}
@@ -22,6 +23,8 @@ def polished(problem, r, ends: list, count: int) -> tuple[list, dict]:
     seeds = [{k: x.params[k] for k in problem.free} for x in certified] + [e.design for e in ends]
     added = []
     for d in seeds:
+        if deadline is not None and time.perf_counter() >= deadline:
+            break
         p = minimax.polish(problem, d)
         if p is not None and p.steps:
             added.append(evolution.End(p.value, p.design, p.local))
@@ -32,10 +35,11 @@ def polished(problem, r, ends: list, count: int) -> tuple[list, dict]:
 class PeakSQP(Stage):
     name = "SQP on the exact peak"
 
+    def accepts(self, problem, plan):
+        return plan is not None and plan.searching and minimax.applies(problem)
+
     def run(self, problem, pool, context):
-        if pool.result is not None and context.given:
-            return
         if pool.result is None and not pool.ends:
             return
-        pool.ends, spent = polished(problem, pool.result, pool.ends, context.settings.polished)
+        pool.ends, spent = polished(problem, pool.result, pool.ends, context.settings.polished, context.deadline)
         pool.spent.update(spent)

@@ -10,11 +10,10 @@ class FamilyWalk(Stage):
     name = "family walk"
 
     def accepts(self, problem, plan):
-        return plan is not None and plan.kind == "family" and plan.walk is not None and bool(problem.objective)
+        family = plan is not None and plan.kind == "family" and plan.searching
+        return family and plan.walk is not None and bool(problem.objective)
 
     def run(self, problem, pool, context):
-        if context.given:
-            return
         ms = context.solver.multistart
         failed = [
             (pool.runs[c.start], c) for c in pool.candidates if c.origin == "family" and not c.ok and not c.pruned

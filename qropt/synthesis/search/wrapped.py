@@ -36,7 +36,7 @@ class Wrapped(Stage):
         if not runs:
             return
         ms = context.solver.multistart
-        out = ms.run(problem, runs, context.targets, context.max_rounds, pool.designs, both_ways=False)
+        out = ms.run(problem, runs, context.targets, context.max_rounds, pool.designs, False, deadline=context.deadline)
         for x in out:
             x.parent = parents[x.start]
         n = len(runs)
