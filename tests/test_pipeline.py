@@ -6,9 +6,11 @@ from __future__ import annotations
 
 import ast
 import json
+import math
 import pathlib
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -148,3 +150,37 @@ def test_each_default_strategy_is_one_module_with_a_name():
         by_module.setdefault(type(s).__module__, []).append(s.name)
     shared = {k: v for k, v in by_module.items() if len(v) > 1}
     assert shared == {"qropt.synthesis.search.diagnosis": ["failed", "diagnosis"]}  # the two ends of a failed solve
+
+
+def test_a_time_limit_is_kept_and_the_claim_says_what_it_left_out():
+    """``solve(..., time_limit=20)`` on a row that takes minutes (the coupler slider by peak torque): it returns
+    within 10 % of the limit, with a design checked by exact evaluation or a failure that says so, and the claim
+    names the strategies the limit left out (the evolution among them)."""
+    p = type_problem("coupler-slider", 1.5, 0.3, objective="min_peak_torque", **KW)
+    t = time.perf_counter()
+    r = Solver().solve(p, time_limit=20.0)
+    took = time.perf_counter() - t
+    assert took <= 20.0 * 1.1, took
+    assert "differential evolution" in r.stats["skipped"]
+    assert "the time limit (20 s) left out: " in r.message
+    if r.success:
+        assert "differential evolution" in r.certificate.global_claim.split("left out: ")[1]
+        assert (r.mechanism.time_ratio(), r.mechanism.stroke()) == pytest.approx((1.5, 0.3), rel=1e-8)
+    else:
+        assert r.status == "failed" and "within the time limit" in r.message
+
+
+def test_a_time_limit_that_does_not_bind_changes_nothing():
+    problem = type_problem("drag-link-slider", 1.8, 0.4)
+    a, b = Solver().solve(problem), Solver().solve(problem, time_limit=600)
+    assert (a.status, a.objective, a.params, a.message) == (b.status, b.objective, b.params, b.message)
+    assert "skipped" not in b.stats
+    assert _rows(design(1.5, 0.3, time_limit=600)) == _rows(design(1.5, 0.3))
+
+
+@pytest.mark.parametrize("bad", [0, -1.0, math.nan, math.inf, "10", True])
+def test_a_time_limit_is_a_positive_number_of_seconds(bad):
+    with pytest.raises(ProblemError, match="time_limit"):
+        Solver().solve(type_problem("slider-crank", 1.5, 0.3), time_limit=bad)
+    with pytest.raises(ProblemError, match="time_limit"):
+        design(1.5, 0.3, time_limit=bad)

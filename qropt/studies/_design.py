@@ -23,7 +23,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from qropt import units as units_
-from qropt import validate
 from qropt.errors import ProblemError, QroptError
 from qropt.mechanisms import TYPES as SHIPPED
 from qropt.mechanisms import mechanism_type
@@ -331,7 +330,7 @@ def design(
     Result the best found within its share (``Solver.solve``'s time_limit). Every argument is checked (every
     type's problem built, the front's objectives and ``n``) before any solve.
     """
-    from qropt.synthesis.solver import DEFAULT, Solver
+    from qropt.synthesis.solver import DEFAULT, Solver, check_time_limit
 
     if solver is not None and not isinstance(solver, Solver):
         raise ProblemError(f"solver is a qropt.Solver or None, got {type(solver).__name__}")
@@ -339,10 +338,7 @@ def design(
         raise ProblemError(f"progress is a callable (called once per finished type) or None, got {progress!r}")
     if workers is not None:
         _workers.check_workers(workers)
-    if time_limit is not None:
-        time_limit = validate.number("time_limit", time_limit, limit=1e12)
-        if time_limit <= 0:
-            raise ProblemError(f"time_limit is a positive number of seconds, got {time_limit!r}")
+    time_limit = check_time_limit(time_limit)
     solver = solver or DEFAULT
     problems = task_problems(
         time_ratio,

@@ -8,6 +8,7 @@ closed-form point of a square problem.
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -136,13 +137,14 @@ class LocalSolve:
         patient=False,
         near=False,
         hint=None,
+        deadline=None,
     ) -> Candidate:
         """From values0 on branch; orientation: which way the TR equality is met (+1, -1), None for the start's
         own; designs: the solve's memo of built mechanisms; bound: the incumbent's NLP objective value, above
         which the exchange loop stops (the start is pruned); patient: a start near an optimum of a nearby problem,
         run on the backend's ``patient()`` variant (a larger iteration limit) where it has one; near: a start at an
         optimum of a nearby problem, run on the backend's ``near()`` variant (a small, monotone barrier) where it has
-        one."""
+        one; deadline: no exchange round starts after it (perf_counter s; the candidate is then not certified)."""
         max_rounds = self.max_rounds if max_rounds is None else max_rounds
         backend = self.backend.patient() if patient and hasattr(self.backend, "patient") else self.backend
         # a re-solve starts at the last round's optimum: from the small barrier too (fewer IPOPT runs and
@@ -195,6 +197,8 @@ class LocalSolve:
         first = continued[2] if continued is not None else None
         rounds = []  # what each round's certificate asked (``_stuck``)
         while c.rounds < max_rounds:
+            if c.rounds and deadline is not None and time.perf_counter() >= deadline:
+                break
             c.rounds += 1
             warm = c.rounds > 1  # a re-solve: from the small barrier, unless a start not near an optimum ended at a
             # design that turned back in a stroke (its optimum is not near)

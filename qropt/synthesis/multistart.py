@@ -24,7 +24,9 @@ class MultiStart:
     def __init__(self, local: LocalSolve, settings):
         self.local, self.settings = local, settings
 
-    def continued(self, problem, start: Candidate, guard: float, targets, max_rounds, designs) -> Candidate | None:
+    def continued(
+        self, problem, start: Candidate, guard: float, targets, max_rounds, designs, deadline=None
+    ) -> Candidate | None:
         """A design certified under a transmission guard, solved again under guards ``guard_step`` times smaller in
         turn (down to ``guard_least``, or the problem's own bound) and then on the problem itself, each from the last
         design certified, from the backend's small barrier; once the guard does not bind, the problem itself next.
@@ -41,7 +43,15 @@ class MultiStart:
         def run(sub):  # a local solve of sub from the last design, its time and iterations counted
             nonlocal t_ipopt, iterations
             x = self.local.run(
-                sub, values, start.branch, targets, orientation=way, max_rounds=max_rounds, designs=designs, near=True
+                sub,
+                values,
+                start.branch,
+                targets,
+                orientation=way,
+                max_rounds=max_rounds,
+                designs=designs,
+                near=True,
+                deadline=deadline,
             )
             t_ipopt, iterations = t_ipopt + x.t_ipopt, iterations + x.iterations
             return x
@@ -88,6 +98,7 @@ class MultiStart:
                 break
             for way in ways:
                 kw = {"orientation": way, "max_rounds": max_rounds, "designs": designs, "bound": bound}
+                kw["deadline"] = deadline
                 given = hint if origin == "given" else None
                 c = self.local.run(problem, v, b, targets, patient=patient, near=origin in NEAR, hint=given, **kw)
                 if origin in AGAIN and not patient and not c.ok and not c.pruned:

@@ -191,10 +191,7 @@ class Solver:
             problem, targets, extra_starts, starts_n, seed, max_rounds
         )
         hint = continue_from.continuation if continue_from is not None and extra else None
-        if time_limit is not None:
-            time_limit = _real("time_limit", time_limit)
-            if time_limit <= 0:
-                raise ProblemError(f"time_limit is a positive number of seconds, got {time_limit!r}")
+        time_limit = check_time_limit(time_limit)
         deadline = None if time_limit is None else t0 + time_limit
         context = search.Context(
             self, targets, starts_n, seed, max_rounds, extra, use_analytic, diagnose, asked, hint, t0, deadline
@@ -312,6 +309,15 @@ def _pipeline(stages) -> tuple:
             f"got {bad[0] if bad else 'none'!r}"
         )
     return stages
+
+
+def check_time_limit(v) -> float | None:
+    """A time limit as given: None, or a positive finite number of seconds (ProblemError otherwise)."""
+    if v is None:
+        return None
+    if not _positive(v) or v > 1e12:
+        raise ProblemError(f"time_limit is a positive number of seconds (or None), got {v!r}")
+    return float(v)
 
 
 def _positive(v) -> bool:

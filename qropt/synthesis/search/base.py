@@ -161,7 +161,8 @@ def run(stages, problem, pool: Pool, context: Context) -> str | None:
 
 def solve(stages, problem, context: Context):
     """The Result of one pass of ``stages`` over a fresh pool (a pipeline must make one); its stats name the
-    strategies that ran (``strategies``: those of the pass that made it, where another pass made it)."""
+    strategies that ran (``strategies``) and the seconds each took (``t_strategies``; a phase's include its own
+    strategies'), those of the pass that made it where another pass made it."""
     pool = Pool()
     run(stages, problem, pool, context)
     if pool.result is None:
@@ -172,8 +173,10 @@ def solve(stages, problem, context: Context):
         r = timed_out(r, list(dict.fromkeys(pool.skipped)), context)
     if "strategies" in r.stats:
         return r
-    ran = list(dict.fromkeys(name for name, _ in pool.ran))
-    return dataclasses.replace(r, stats={**r.stats, "strategies": ran})
+    spent: dict = {}
+    for name, seconds in pool.ran:
+        spent[name] = spent.get(name, 0.0) + seconds
+    return dataclasses.replace(r, stats={**r.stats, "strategies": list(spent), "t_strategies": spent})
 
 
 def timed_out(r, skipped: list, context: Context):

@@ -33,7 +33,7 @@ class Guarded(Stage):
         for g in good:
             if context.out_of_time():
                 break
-            x = ms.continued(problem, g, guard, context.targets, context.max_rounds, pool.designs)
+            x = ms.continued(problem, g, guard, context.targets, context.max_rounds, pool.designs, context.deadline)
             if x:
                 x.origin, x.parent = "guard", g
                 out.append(x)
