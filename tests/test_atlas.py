@@ -261,7 +261,7 @@ def test_no_value_is_expected_where_one_node_has_no_design():
     found = atlas.starts(p)
     assert found.designs and set(found.nodes) == {0}
     assert multistart.expected(p, found, Designs()) == (None, None)
-    assert not multistart.short(p, [], None)
+    assert not multistart.short(p, [], None, Solver().settings.atlas_short)
 
 
 def test_a_solve_still_short_after_the_rerun_runs_the_multi_start_as_well(monkeypatch):

@@ -6,6 +6,8 @@ import csv
 import importlib
 import json
 
+import pytest
+
 from benchmarks import suite
 from benchmarks.methods import METHODS
 
@@ -96,3 +98,49 @@ def test_evolutions_summary_compares_each_row_with_the_default():
     }
     md = evolutions.markdown(s)
     assert "2 better, 1 worse, 1 the same" in md and "| none | 50 (better) |" in md
+
+
+def test_strategies_summary_counts_rows_changed_by_leaving_a_strategy_out():
+    from benchmarks import strategies
+
+    def row(pipeline, task, kind, status, value, s, spent=None):
+        return {
+            "pipeline": pipeline,
+            "objective": "min_peak_torque",
+            "task": task,
+            "type": kind,
+            "status": status,
+            "value": value,
+            "s": s,
+            "strategies": spent or {},
+        }
+
+    records = [
+        row("default", 0, "a", "optimal", 10.0, 5.0, {"evolution": 4.0, "plan": 0.5}),
+        row("default", 0, "b", "optimal", 20.0, 7.0, {"evolution": 6.0}),
+        row("default", 1, "a", "failed", None, 3.0),
+        row("default", 1, "b", "optimal", 30.0, 2.0),
+        row("evolution", 0, "a", "optimal", 10.0 * (1 + 1e-9), 1.0),  # the same
+        row("evolution", 0, "b", "optimal", 25.0, 1.0),  # worse without it
+        row("evolution", 1, "a", "feasible", 9.0, 1.0),  # gained without it
+        row("evolution", 1, "b", "failed", None, 1.0),  # lost without it
+    ]
+    s = strategies.summary(records)
+    assert s["left_out"]["evolution"] == {
+        "better": 0,
+        "worse": 1,
+        "gained": 1,
+        "lost": 1,
+        "same": 1,
+        "seconds_saved": 13.0,
+    }
+    assert s["default_seconds"] == {"evolution": 10.0, "plan": 0.5}
+    md = strategies.markdown(s)
+    assert "| evolution | 0 | 1 | 1 | 1 | 1 | 13.0 |" in md and "| evolution | 10.0 |" in md
+    pipes = strategies.pipelines(["differential evolution", "Sobol multi-start"])
+    assert [p.name for p in pipes["default"]] != [p.name for p in pipes["differential evolution"]]
+    assert "differential evolution" not in [p.name for p in pipes["differential evolution"]]
+    phase = next(p for p in pipes["Sobol multi-start"] if hasattr(p, "stages"))
+    assert "Sobol multi-start" not in [p.name for p in phase.stages]
+    with pytest.raises(SystemExit, match="unknown strategies"):
+        strategies.pipelines(["no such"])

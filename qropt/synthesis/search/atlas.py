@@ -3,7 +3,7 @@ none falls short of its nodes' designs, the rest of the starts phase does not ru
 
 from __future__ import annotations
 
-from qropt.synthesis.multistart import expected, short
+from qropt.synthesis import multistart
 from qropt.synthesis.search.base import STOP, Stage
 
 
@@ -19,10 +19,10 @@ class AtlasStarts(Stage):
         cands = ms.run(
             problem, first, context.targets, context.max_rounds, pool.designs, False, deadline=context.deadline
         )
-        between, floor = expected(problem, plan.atlas, pool.designs)
+        between, floor = multistart.expected(problem, plan.atlas, pool.designs)
         how = plan.atlas.how
         done = {c.start for c in cands if c.ok}
-        if short(problem, cands, between, tol) and len(done) < len(first):  # again, with a larger iteration limit
+        if multistart.short(problem, cands, between, tol) and len(done) < len(first):  # again, with a larger iteration limit
             again = [r for i, r in enumerate(first) if i not in done]
             cands += ms.run(
                 problem,
@@ -36,7 +36,7 @@ class AtlasStarts(Stage):
             )
             how += ", those without a design run again with a larger iteration limit"
         pool.candidates += cands
-        if any(c.ok for c in cands) and not short(problem, cands, floor, tol):
+        if any(c.ok for c in cands) and not multistart.short(problem, cands, floor, tol):
             pool.claim = f"best of {how}"
             return STOP
         return None  # none certified, or still short: the multi-start as well (these candidates kept, counted)
