@@ -26,7 +26,8 @@ class SynthesisHints:
     """every design that turns has an output reversing exactly once a turn; else the NLP states it (default
     False)."""
     crank: str = "r2"
-    """the length parameter of the input crank (O2A): the evolution and the descents move it to meet the TR."""
+    """the length parameter of the input crank (O2A): the evolution and the descents move it to meet the TR (default
+    "r2")."""
     closed_forms: tuple[Callable, ...] = ()
     """the closed forms that give a problem's starts, tried in order: functions of a ``closed_forms.Context``
     returning ``closed_forms.WarmStarts``, or None where they do not apply (default none)."""
