@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 
 from qropt import Problem
-from qropt.mechanisms import REQUIRED, Body, Loop, Mechanism, four_bar, grashof, grashof_rules
+from qropt.mechanisms import REQUIRED, Body, Loop, Mechanism, SynthesisHints, four_bar, grashof, grashof_rules
 from qropt.mechanisms.closures import circle_circle, joint_lines, on_ray, rod_lines, rod_to_line
 
 
@@ -36,9 +36,11 @@ class WattSixBarShaper(Mechanism):
     ANGLES = ("alpha",)  # x6, y6 and h are offsets; sigma, sigma2 and sigma_slider branch signs
     FOUR_BAR = True  # the first four-bar's Grashof class is a condition of every problem
     CLASS = "crank-rocker"
-    EXACT_TRANSMISSION = {"B": (0.0, math.pi)}  # the first four-bar's coupler-follower extremes
-    RULED_MARGINS = ("first four-bar closure at B",)  # the Grashof rules make it assemble
-    ACCEL_EXTREMES = 6  # two four-bars add acceleration extremes of note
+    SYNTHESIS = SynthesisHints(
+        exact_transmission={"B": (0.0, math.pi)},  # the first four-bar's coupler-follower extremes
+        ruled_margins=("first four-bar closure at B",),  # the Grashof rules make it assemble
+        accel_extremes=6,  # two four-bars add acceleration extremes of note
+    )
     BODIES = (
         Body("crank", ("O2", "A"), "bar"),
         Body("coupler", ("A", "B"), "bar"),

@@ -5,6 +5,7 @@ scaling, tolerances and --param; the registry refuses a KIND or class name that 
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 import json
 import math
@@ -374,11 +375,11 @@ def test_the_example_files_solve_as_the_command_line_runs_them(tmp_path):
 
 
 def test_a_user_type_declares_its_closed_forms_crank_and_example():
-    """A type of one's own names its closed forms (CLOSED_FORMS, tried in order: the first that applies gives the
-    starts; a warm_starts hook that answers comes first), its crank (CRANK) and its example design (EXAMPLE, the
-    app's first; a subclass does not inherit it), as the shipped types do."""
+    """A type of one's own names its closed forms (SYNTHESIS.closed_forms, tried in order: the first that applies
+    gives the starts; a warm_starts hook that answers comes first), its crank (SYNTHESIS.crank) and its example
+    design (EXAMPLE, the app's first; a subclass does not inherit it), as the shipped types do."""
     from qropt.app.defaults import default_params
-    from qropt.mechanisms import SliderCrank
+    from qropt.mechanisms import SliderCrank, SynthesisHints
     from qropt.mechanisms.closed_forms import slider_crank_starts
     from qropt.synthesis import analytic, evolution
 
@@ -391,8 +392,7 @@ def test_a_user_type_declares_its_closed_forms_crank_and_example():
 
     class DeclaredSliderCrank(SliderCrank):
         KIND = "declared-slider-crank"
-        CLOSED_FORMS = (never, mid_bounds, slider_crank_starts)
-        CRANK = "r3"
+        SYNTHESIS = SynthesisHints(closed_forms=(never, mid_bounds, slider_crank_starts), crank="r3")
         EXAMPLE = {"r2": 0.1, "r3": 0.4, "e": 0.05}
 
     class InheritingSliderCrank(DeclaredSliderCrank):
@@ -410,10 +410,42 @@ def test_a_user_type_declares_its_closed_forms_crank_and_example():
         shipped = analytic.warm_starts(p.replace(mechanism=SliderCrank))
         assert shipped.kind == "family" and shipped.points and shipped.points != w.points
         assert analytic.warm_starts(p.replace(mechanism=InheritingSliderCrank)).points == w.points
-        other_crank = type("OtherCrankSliderCrank", (DeclaredSliderCrank,), {"CRANK": "r9"})
+        hints = dataclasses.replace(DeclaredSliderCrank.SYNTHESIS, crank="r9")
+        other_crank = type("OtherCrankSliderCrank", (DeclaredSliderCrank,), {"SYNTHESIS": hints})
         assert evolution.applies(p) and not evolution.applies(p.replace(mechanism=other_crank))
         assert default_params(DeclaredSliderCrank) == DeclaredSliderCrank.EXAMPLE
         assert default_params(InheritingSliderCrank) == {}
     finally:
         for kind in ("declared-slider-crank", "inheriting-slider-crank"):
             REGISTRY.pop(kind, None)
+
+
+@pytest.mark.parametrize(
+    ("old", "value", "field"),
+    [
+        ("EXACT_TRANSMISSION", {"B": (0.0, math.pi)}, "exact_transmission"),
+        ("RULED_MARGINS", ("rod closure",), "ruled_margins"),
+        ("ACCEL_EXTREMES", 4, "accel_extremes"),
+        ("TIES", ("r2", "r3"), "ties"),
+        ("ONE_REVERSAL", True, "one_reversal"),
+        ("CRANK", "r3", "crank"),
+        ("CLOSED_FORMS", (), "closed_forms"),
+    ],
+)
+def test_a_synthesis_hint_by_its_old_name_is_refused_with_the_new_spelling(old, value, field):
+    """A type that declares a synthesis hint as a class attribute of its own (TIES = ...) is refused when the class
+    is defined, by a typed error naming the SYNTHESIS field that holds it now; SYNTHESIS must be a SynthesisHints."""
+    from qropt.mechanisms import SliderCrank, SynthesisHints
+
+    with pytest.raises(
+        qropt.InvalidParameter, match=rf"OldHints: {old} is now declared as SYNTHESIS = SynthesisHints\({field}="
+    ):
+        type("OldHints", (SliderCrank,), {"KIND": "old-hints", old: value})
+    with pytest.raises(qropt.InvalidParameter, match="OldHints: SYNTHESIS is a qropt.mechanisms.hints.SynthesisHints"):
+        type("OldHints", (SliderCrank,), {"KIND": "old-hints", "SYNTHESIS": {field: value}})
+    assert "old-hints" not in REGISTRY
+    hinted = type("NewHints", (SliderCrank,), {"KIND": "new-hints", "SYNTHESIS": SynthesisHints(**{field: value})})
+    try:
+        assert getattr(hinted.SYNTHESIS, field) == value and dataclasses.is_dataclass(hinted.SYNTHESIS)
+    finally:
+        REGISTRY.pop("new-hints", None)

@@ -2,9 +2,10 @@
 
 The public building blocks of a type of one's own (see docs/extending.md): ``Mechanism`` (the protocol),
 ``Loop`` (what a loop returns), ``Rule`` (a feasibility rule), ``Body`` (a moving body to draw), ``REQUIRED``
-(a parameter without default), the ``closures`` every loop is written with (``qropt.mechanisms.closures``
-re-exports ``qropt.kinematics.closures``), the four-bar helpers ``four_bar`` and ``grashof_rules``, the closed forms a
-type names for its synthesis starts (``qropt.mechanisms.closed_forms``: ``Context``, ``WarmStarts``), and the registry:
+(a parameter without default), ``SynthesisHints`` (what a type tells the synthesis: ``Mechanism.SYNTHESIS``), the
+``closures`` every loop is written with (``qropt.mechanisms.closures`` re-exports ``qropt.kinematics.closures``), the
+four-bar helpers ``four_bar`` and ``grashof_rules``, the closed forms a type names for its synthesis starts
+(``qropt.mechanisms.closed_forms``: ``Context``, ``WarmStarts``), and the registry:
 ``mechanism_type`` finds a type by its class, KIND, class name or a ``"module:Class"`` reference, and
 ``type_reference`` names a type so that another process finds it (a shipped type by its KIND, any other as
 ``"module:Class"``). Installed packages add types through the entry-point group ``qropt.mechanisms``, loaded
@@ -21,6 +22,7 @@ from qropt.mechanisms.crank_rocker_slider import CrankRockerSlider
 from qropt.mechanisms.crank_shaper import CrankShaper
 from qropt.mechanisms.drag_link_slider import DragLinkSlider
 from qropt.mechanisms.four_bar import FourBar, FourBarSlider, Grashof, four_bar, grashof, grashof_rules
+from qropt.mechanisms.hints import SynthesisHints
 from qropt.mechanisms.registry import REGISTRY, RegistryError, register
 from qropt.mechanisms.slider_crank import SliderCrank
 from qropt.mechanisms.slot_ram_shaper import SlotRamShaper
@@ -151,6 +153,7 @@ __all__ = [
     "Rule",
     "Body",
     "REQUIRED",
+    "SynthesisHints",
     "PARAMETER_KINDS",
     "closures",
     "four_bar",

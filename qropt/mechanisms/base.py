@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable
 from types import MappingProxyType
 from typing import Any, ClassVar
 
@@ -26,6 +25,7 @@ from qropt.kinematics import cycle
 from qropt.kinematics.closures import Loop, transmission_angle
 from qropt.kinematics.kernel import kernel, resolved_spectrum, spectral_derivative, spectrum
 from qropt.kinematics.ops import NUMPY
+from qropt.mechanisms.hints import OLD_NAMES, SynthesisHints
 from qropt.mechanisms.registry import register
 from qropt.mechanisms.values import (
     AccelerationExtremes,
@@ -82,7 +82,8 @@ def _rebuilt(cls, params: dict, units: str) -> Mechanism:
 
 def _check_declaration(cls) -> None:
     """InvalidParameter naming the type where its PARAMS is not a dict of parameter name -> default (a number, None
-    for an optional parameter, or REQUIRED)."""
+    for an optional parameter, or REQUIRED), where it declares a synthesis hint by an old name (``TIES``, ...: they
+    are ``SYNTHESIS`` fields) or where its SYNTHESIS is not a ``SynthesisHints``."""
     params = cls.PARAMS
     if not isinstance(params, dict):
         raise InvalidParameter(
@@ -96,6 +97,19 @@ def _check_declaration(cls) -> None:
             raise InvalidParameter(
                 f"{cls.__name__}: parameter {k}'s default is a number, None or REQUIRED, got {v!r:.80}"
             )
+    old = [name for name in OLD_NAMES if name in cls.__dict__]
+    if old:
+        spelled = ", ".join(f"{OLD_NAMES[name]}=..." for name in old)
+        raise InvalidParameter(
+            f"{cls.__name__}: {', '.join(old)} {'is' if len(old) == 1 else 'are'} now declared as "
+            f"SYNTHESIS = SynthesisHints({spelled}) (qropt.mechanisms.hints; a subclass: "
+            f"dataclasses.replace(Base.SYNTHESIS, {spelled}))"
+        )
+    if not isinstance(cls.SYNTHESIS, SynthesisHints):
+        raise InvalidParameter(
+            f"{cls.__name__}: SYNTHESIS is a qropt.mechanisms.hints.SynthesisHints, got "
+            f"{type(cls.SYNTHESIS).__name__} {cls.SYNTHESIS!r:.80}"
+        )
 
 
 class Mechanism:
@@ -112,22 +126,10 @@ class Mechanism:
     # are offsets (lengths that may be negative or zero)
     FOUR_BAR: ClassVar[bool] = False  # driven by a four-bar whose Grashof class is a problem condition
     CLASS: ClassVar[str] = ""  # the Grashof class the type requires ('' any)
-    EXACT_TRANSMISSION: ClassVar[dict[str, tuple[float, ...]]] = {}  # joint -> crank angles of its extremes
-    RULED_MARGINS: ClassVar[tuple[str, ...]] = ()  # closures that assemble wherever the type's rules hold
-    ACCEL_EXTREMES: ClassVar[int] = 2  # acceleration extremes the NLP lifts for the peak acceleration
-    # lengths that, scaled together by one factor, leave the motion and so every kinematic criterion the same: such
-    # optima form a continuum, and a solve breaks the tie by the least size
-    TIES: ClassVar[tuple[str, ...]] = ()
-    # whether every design of the type that turns has an output reversing exactly once a turn (driven, through
-    # links that each move one way, by a crank that turns once); else the synthesis NLP states it (guard rows)
-    ONE_REVERSAL: ClassVar[bool] = False
     BODIES: ClassVar[tuple[Body, ...]] = ()  # every moving body (see Body): pictures and the mass model read them
     GROUND: ClassVar[tuple[str, ...]] = ()  # the joints fixed to the frame (ground pivots)
     OUTPUT_JOINT: ClassVar[str | None] = None  # the joint whose x is a slider output; None for a follower angle
-    CRANK: ClassVar[str] = "r2"  # the length parameter of the input crank (O2A), turning about O2 at the origin
-    # the closed forms that give a synthesis problem's starts, tried in order (the first that applies gives them):
-    # functions of a ``closed_forms.Context`` returning ``closed_forms.WarmStarts`` or None where they do not apply
-    CLOSED_FORMS: ClassVar[tuple[Callable, ...]] = ()
+    SYNTHESIS: ClassVar[SynthesisHints] = SynthesisHints()  # what only the synthesis reads (qropt.mechanisms.hints)
     # a named option -> the optional parameters (PARAMS default None) it gives together (e.g. a rod: r6 and h)
     OPTIONS: ClassVar[dict[str, tuple[str, ...]]] = {}
     # a valid design of the type (parameter -> value), the app's first: a shipped slider's is its design for TR 1.5
@@ -174,7 +176,7 @@ class Mechanism:
     def warm_starts(cls, problem):
         """Starting designs for a synthesis problem of this type (override): a ``WarmStarts`` of
         ``qropt.mechanisms.closed_forms`` (free-parameter dicts, their kind and how they were found), or None for
-        the first of the type's ``CLOSED_FORMS`` that applies and otherwise a multi-start."""
+        the first of the type's ``SYNTHESIS.closed_forms`` that applies and otherwise a multi-start."""
         return None
 
     @classmethod

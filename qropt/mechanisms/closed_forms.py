@@ -2,7 +2,7 @@
 starts of each shipped type (``qropt.synthesis.analytic`` re-exports them).
 
 They are independent of the general numerical machinery of the types: they serve as warm starts and as test
-oracles. A type names the closed forms that give its starts in ``CLOSED_FORMS`` (``Mechanism.CLOSED_FORMS``): each is
+oracles. A type names the closed forms that give its starts in ``Mechanism.SYNTHESIS.closed_forms``: each is
 a function of a ``Context`` (what it reads of a problem) returning ``WarmStarts``, or None where it does not apply.
 Angles in radians, lengths in any consistent unit. Equation numbers refer to Podhorodeski, Nokleby and Wittchen,
 "Quick-return mechanism design and analysis projects" (2004).

@@ -3,6 +3,8 @@ through the rod PD on the slide line y = h."""
 
 from __future__ import annotations
 
+import dataclasses
+
 from qropt.errors import GrashofError
 from qropt.mechanisms.base import REQUIRED
 from qropt.mechanisms.four_bar import SHORTEST, _FourBarBase, four_bar_linkage, grashof_rules
@@ -33,8 +35,9 @@ class CouplerSlider(_FourBarBase):
     ANGLES = ("beta",)  # rad: not scaled with the lengths (Mechanism.kinds(), where the base has it)
     CLASS = ""  # crank-rocker or drag-link: the problem's 'grashof' condition (default crank-rocker)
     # B's coupler-follower angle depends on |O4A| only, extreme with the crank along the ground line: as the four-bar
-    # sliders (EXACT_TRANSMISSION), and the Grashof rules make the four-bar assemble (RULED_MARGINS), both inherited.
-    ACCEL_EXTREMES = 6  # a coupler point's path adds acceleration extremes beyond the four-bar sliders' four
+    # sliders (exact_transmission), and the Grashof rules make the four-bar assemble (ruled_margins), both inherited;
+    # a coupler point's path adds acceleration extremes beyond the four-bar sliders' four
+    SYNTHESIS = dataclasses.replace(_FourBarBase.SYNTHESIS, accel_extremes=6)
     BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
     EXAMPLE = {
         **{"r1": 1.0561, "r2": 0.0827, "r3": 0.3681, "r4": 0.9933, "r5": 1.5, "beta": -0.5201, "r6": 1.0128},

@@ -6,6 +6,7 @@ from qropt.errors import InvalidParameter
 from qropt.mechanisms import closed_forms
 from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.builder import Linkage
+from qropt.mechanisms.hints import SynthesisHints
 from qropt.mechanisms.values import Rule
 
 
@@ -32,18 +33,19 @@ class CrankShaper(Mechanism):
     Without r6 the ram is driven by a yoke and x = x_C (the lab rig of seed 001).
     """
 
-    ONE_REVERSAL = True
-
     KIND = "crank-shaper"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r4": REQUIRED, "r6": None, "h": None, "sigma_slider": 1.0}
     LENGTHS = ("r1", "r2", "r4", "r6")
-    TIES = ("r1", "r2")  # the motion depends on r2/r1 (the lever), r4, r6 and h only
     BODIES = YOKE.bodies()  # with the yoke (no rod r6): the yoke-ram moves along x with x_C
     ROD_BODIES = ROD.bodies()  # with a rod r6
     GROUND = YOKE.ground_joints()
     OUTPUT_JOINT = YOKE.output_joint()
     OPTIONS = {"rod": ("r6", "h")}
-    CLOSED_FORMS = (closed_forms.crank_shaper_starts,)
+    SYNTHESIS = SynthesisHints(
+        one_reversal=True,
+        ties=("r1", "r2"),  # the motion depends on r2/r1 (the lever), r4, r6 and h only
+        closed_forms=(closed_forms.crank_shaper_starts,),
+    )
     EXAMPLE = {"r1": 0.2178, "r2": 0.0673, "r4": 0.4854, "sigma_slider": 1.0}
 
     def bodies(self):

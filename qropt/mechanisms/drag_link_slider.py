@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 from qropt.mechanisms import closed_forms
 from qropt.mechanisms.four_bar import FourBarSlider
 
@@ -12,7 +14,10 @@ class DragLinkSlider(FourBarSlider):
     KIND = "drag-link-slider"
     CLASS = "drag-link"
     SHORTEST = "r1"
-    CLOSED_FORMS = (closed_forms.drag_link_slider_starts, closed_forms.four_bar_slider_starts)
+    SYNTHESIS = dataclasses.replace(
+        FourBarSlider.SYNTHESIS,
+        closed_forms=(closed_forms.drag_link_slider_starts, closed_forms.four_bar_slider_starts),
+    )
     # the paper's design: TR 1.5, stroke 0.3 m, r3 from eqs. (7)-(13) (the root with the larger gamma_min)
     EXAMPLE = {
         **{"r1": 0.1, "r2": 0.225, "r3": closed_forms.drag_link_r3(1.5, 0.1, 0.225, 0.275)[-1].r3, "r4": 0.275},

@@ -3,6 +3,7 @@ and the shared loop of the four-bar-driven sliders (C on ray O4->B at r5, rod CD
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from typing import ClassVar, NamedTuple
@@ -12,6 +13,7 @@ from qropt.kinematics.closures import circle_circle
 from qropt.mechanisms import closed_forms
 from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.builder import Linkage
+from qropt.mechanisms.hints import SynthesisHints
 from qropt.mechanisms.values import Rule
 
 LINKS = ("r1", "r2", "r3", "r4")
@@ -94,8 +96,10 @@ def _grashof_names(kind: str) -> tuple[tuple[str, str, str], ...]:
 class _FourBarBase(Mechanism):
     LENGTHS: ClassVar[tuple[str, ...]] = LINKS
     FOUR_BAR = True
-    EXACT_TRANSMISSION = {"B": (0.0, math.pi)}  # coupler-follower extremes with the crank along the ground line
-    RULED_MARGINS = ("four-bar closure at B",)  # the Grashof rules make it assemble
+    SYNTHESIS = SynthesisHints(
+        exact_transmission={"B": (0.0, math.pi)},  # coupler-follower extremes with the crank along the ground line
+        ruled_margins=("four-bar closure at B",),  # the Grashof rules make it assemble
+    )
 
     def grashof(self) -> Grashof:
         """Grashof class and shortest link of r1..r4."""
@@ -120,15 +124,15 @@ class FourBar(_FourBarBase):
     time ratio need a crank that turns fully and a follower that rocks.
     """
 
-    ONE_REVERSAL = True
-
     KIND = "four-bar"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "r3": REQUIRED, "r4": REQUIRED, "sigma": -1.0}
     REQUIRES_FULL_TURN = False
     OUTPUT = "follower"
     TRAVEL = "swing"
     BODIES, GROUND = FOUR_BAR.bodies(), FOUR_BAR.ground_joints()
-    CLOSED_FORMS = (closed_forms.four_bar_starts,)
+    SYNTHESIS = dataclasses.replace(
+        _FourBarBase.SYNTHESIS, one_reversal=True, closed_forms=(closed_forms.four_bar_starts,)
+    )
     EXAMPLE = {"r1": 0.3, "r2": 0.1, "r3": 0.35, "r4": 0.3, "sigma": -1.0}
     loop = staticmethod(FOUR_BAR.loop)
 
@@ -149,8 +153,6 @@ class FourBar(_FourBarBase):
 class FourBarSlider(_FourBarBase):
     """Four-bar-driven slider: C on ray O4->B at r5, rod r6 from C to D on y = h. Subclasses fix the class."""
 
-    ONE_REVERSAL = True
-
     PARAMS = {
         **{k: REQUIRED for k in ("r1", "r2", "r3", "r4", "r5", "r6")},
         "h": 0.0,
@@ -160,7 +162,8 @@ class FourBarSlider(_FourBarBase):
     LENGTHS = ("r1", "r2", "r3", "r4", "r5", "r6")
     SHORTEST: ClassVar[str] = ""
     BODIES, GROUND, OUTPUT_JOINT = SLIDER.bodies(), SLIDER.ground_joints(), SLIDER.output_joint()
-    ACCEL_EXTREMES = 4  # the four-bar adds acceleration extremes of note
+    # the four-bar adds acceleration extremes of note
+    SYNTHESIS = dataclasses.replace(_FourBarBase.SYNTHESIS, one_reversal=True, accel_extremes=4)
 
     @classmethod
     def rules(cls, xp, p, grashof=None):

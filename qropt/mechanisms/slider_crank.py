@@ -5,6 +5,7 @@ from __future__ import annotations
 from qropt.mechanisms import closed_forms
 from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.builder import Linkage
+from qropt.mechanisms.hints import SynthesisHints
 from qropt.mechanisms.values import Rule
 
 LINKAGE = Linkage()
@@ -17,13 +18,11 @@ LINKAGE.output("C")
 class SliderCrank(Mechanism):
     """Offset slider-crank (r2 crank, r3 rod, e slide-line offset); the slider is C."""
 
-    ONE_REVERSAL = True
-
     KIND = "slider-crank"
     PARAMS = {"r2": REQUIRED, "r3": REQUIRED, "e": 0.0, "sigma_slider": 1.0}
     LENGTHS = ("r2", "r3")
     BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
-    CLOSED_FORMS = (closed_forms.slider_crank_starts,)
+    SYNTHESIS = SynthesisHints(one_reversal=True, closed_forms=(closed_forms.slider_crank_starts,))
     EXAMPLE = {"r2": 0.1352, "r3": 0.2499, "e": 0.0865, "sigma_slider": 1.0}
 
     @classmethod

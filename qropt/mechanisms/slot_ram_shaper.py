@@ -6,6 +6,7 @@ from __future__ import annotations
 from qropt.mechanisms import closed_forms
 from qropt.mechanisms.base import REQUIRED, Mechanism
 from qropt.mechanisms.crank_shaper import slotted_lever
+from qropt.mechanisms.hints import SynthesisHints
 from qropt.mechanisms.values import Rule
 
 # D rides in the lever's slot O4->A (lever length max(r1 + r2, h r1 / sqrt(r1^2 - r2^2))) and on y = -r1 + h; it is
@@ -20,14 +21,15 @@ class SlotRamShaper(Mechanism):
     (``qropt.mechanisms.closed_forms``): TR = (pi + 2 asin(r2/r1)) / (pi - 2 asin(r2/r1)),
     stroke = 2 h r2 / sqrt(r1^2 - r2^2), gamma_min = acos(r2/r1) (at D, with the lever at its extremes)."""
 
-    ONE_REVERSAL = True
-
     KIND = "slot-ram-shaper"
     PARAMS = {"r1": REQUIRED, "r2": REQUIRED, "h": REQUIRED}
     LENGTHS = ("r1", "r2")  # h is the slide line's offset (positive by a rule), as the crank-shaper's
-    TIES = ("r1", "r2")  # the motion depends on r2/r1 and h only
     BODIES, GROUND, OUTPUT_JOINT = LINKAGE.bodies(), LINKAGE.ground_joints(), LINKAGE.output_joint()
-    CLOSED_FORMS = (closed_forms.slot_ram_shaper_starts,)
+    SYNTHESIS = SynthesisHints(
+        one_reversal=True,
+        ties=("r1", "r2"),  # the motion depends on r2/r1 and h only
+        closed_forms=(closed_forms.slot_ram_shaper_starts,),
+    )
     EXAMPLE = {"r1": 0.2073, "r2": 0.0641, "h": 0.4617}
 
     @classmethod

@@ -1,5 +1,5 @@
 """Closed forms: the paper's relations under their own names and the synthesis formulas that exist, and the warm
-starts of a synthesis problem from the closed forms its type names (``Mechanism.CLOSED_FORMS``).
+starts of a synthesis problem from the closed forms its type names (``Mechanism.SYNTHESIS.closed_forms``).
 
 The relations, formulas and every shipped type's closed forms are defined in ``qropt.mechanisms.closed_forms`` (below
 synthesis, so that each type can name its own) and re-exported here. They are independent of the general numerical
@@ -57,7 +57,7 @@ from qropt.mechanisms.closed_forms import (
 def warm_starts(problem) -> WarmStarts:
     """Starts from every closed form that applies to a problem (other free parameters at mid-bounds): the type's
     own ``warm_starts`` hook where it has one, else the first of the closed forms the type names
-    (``Mechanism.CLOSED_FORMS``, tried in order) that applies.
+    (``Mechanism.SYNTHESIS.closed_forms``, tried in order) that applies.
 
     Each start is verified later by the solver; a start that does not build is dropped there.
     """
@@ -65,7 +65,7 @@ def warm_starts(problem) -> WarmStarts:
     if own is not None:
         return own
     c = Context(problem)
-    for closed_form in problem.mechanism.CLOSED_FORMS:
+    for closed_form in problem.mechanism.SYNTHESIS.closed_forms:
         w = closed_form(c)
         if w is not None:
             return w

@@ -344,7 +344,7 @@ class PeakAcceleration(Criterion):
         return [("peak |d2x/dtheta2|", [s * out.a for out in outs for s in (1, -1)])]
 
     def lifts(self, f, role):  # its largest extremes (d3x/dtheta3 = 0 there), for its objective or bound
-        return f.mechanism.ACCEL_EXTREMES
+        return f.mechanism.SYNTHESIS.accel_extremes
 
     def lift_terms(self, f, k, phi, out):
         f.row("lifted acceleration extreme: stationary", out.j, 0.0, 0.0, kind="lift")

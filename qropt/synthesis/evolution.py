@@ -1,7 +1,7 @@
 """Designs on the targets without the NLP: a differential evolution over the box and descents on the exact objective.
 
 For a problem with TR and stroke targets whose lengths scale freely and whose crank length (the type's
-``Mechanism.CRANK``) is free.
+``Mechanism.SYNTHESIS.crank``) is free.
 
 - ``evolve``: SciPy's differential evolution over the unit box (lengths log-uniform, other parameters uniform).
   Each candidate is moved onto the TR target by its crank length: its TR on a crank-angle grid (the type's loop
@@ -70,7 +70,7 @@ def applies(problem) -> bool:
     return (
         bool(problem.objective)
         and {"time_ratio", "stroke"} <= set(problem.targets)
-        and problem.mechanism.CRANK in problem.free
+        and problem.mechanism.SYNTHESIS.crank in problem.free
         and not any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable)
         and all(problem.free[k][0] > 0 for k in problem.free if problem.mechanism.kinds()[k] == "length")
     )
@@ -128,7 +128,7 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
     for a user type whose loop takes one design at a time (it does not vectorise over designs)."""
     from scipy.optimize import differential_evolution  # imported here: scipy.optimize takes a while to import
 
-    names, crank = list(problem.free), problem.mechanism.CRANK
+    names, crank = list(problem.free), problem.mechanism.SYNTHESIS.crank
     others = [k for k in names if k != crank]
     branch = starts_.branches(problem)[0]
     nodes = np.linspace(0.0, 1.0, NODES)
@@ -227,7 +227,7 @@ def on_targets(problem, design: dict, bounds: tuple | None = None) -> dict | Non
     None if neither finds one. ``bounds``: the crank lengths searched (default: its box)."""
     from scipy.optimize import brentq
 
-    branch, crank = starts_.branches(problem)[0], problem.mechanism.CRANK
+    branch, crank = starts_.branches(problem)[0], problem.mechanism.SYNTHESIS.crank
     lo, hi = bounds or problem.free[crank]
     built: dict = {}  # crank length -> its mechanism, the last one only (the root's is built once)
 
@@ -266,7 +266,7 @@ def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dic
     (module docstring), of ``evals`` exact evaluations (DESCENT_EVALS): the best (value, design) met, or None."""
     from scipy.optimize import minimize
 
-    names = [k for k in problem.free if k != problem.mechanism.CRANK]
+    names = [k for k in problem.free if k != problem.mechanism.SYNTHESIS.crank]
     log = {k: problem.mechanism.kinds()[k] == "length" for k in names}
     branch = starts_.branches(problem)[0]
     best: list = [None]

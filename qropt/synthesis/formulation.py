@@ -8,9 +8,9 @@ the stroke a difference of two positions. A guarded NLP (a type whose output can
 lifts the output's turn-backs too: crank angles inside each stroke where the output velocity is stationary and
 keeps the stroke's sign. Continuous-cycle quantities enter through sample angles that are CasADi
 parameters, so the exchange loop adds angles without a rebuild; a type's exact transmission hints
-(``EXACT_TRANSMISSION``) are evaluated where they are. Parameters (named blocks too): fixed values, targets, sample
-angles, working-arc fractions, bound values and the box sides' coordinate picks. Each criterion states its own
-terms (``qropt.synthesis.criteria``).
+(``Mechanism.SYNTHESIS.exact_transmission``) are evaluated where they are. Parameters (named blocks too): fixed
+values, targets, sample angles, working-arc fractions, bound values and the box sides' coordinate picks. Each
+criterion states its own terms (``qropt.synthesis.criteria``).
 """
 
 from __future__ import annotations
@@ -194,7 +194,7 @@ class Formulation:
         self._kinematics(X, PF)
         self.dead = [self.at(TH[0]), self.at(TH[1])]  # the output's extremes
         self.sampled = [self.at(S[k]) for k in range(n)]
-        self.exact = [self.at(a) for a in sorted({a for v in cls.EXACT_TRANSMISSION.values() for a in v})]
+        self.exact = [self.at(a) for a in sorted({a for v in cls.SYNTHESIS.exact_transmission.values() for a in v})]
         self._start = TH[0] if orientation > 0 else TH[1]
         self._length = (TH[1] - TH[0]) if orientation > 0 else TWO_PI - (TH[1] - TH[0])
         self._W, self._working, self._returning, self._strokes = W, None, None, None
@@ -322,11 +322,11 @@ class Formulation:
         """The type's loop as one CasADi function of (theta2, free, fixed) with named outputs (``Kin``)."""
         cls, t = self.mechanism, casadi.SX.sym("t")
         lp = cls.loop(CASADI, t, self.params)
-        self.exact_joints = [j for j in cls.EXACT_TRANSMISSION if lp.transmission.get(j) is not RIGHT_ANGLE]
+        self.exact_joints = [j for j in cls.SYNTHESIS.exact_transmission if lp.transmission.get(j) is not RIGHT_ANGLE]
         self.sampled_joints = [
             j for j, v in lp.transmission.items() if v is not RIGHT_ANGLE and j not in self.exact_joints
         ]
-        margins = [m for what, m in lp.margins if what not in cls.RULED_MARGINS]
+        margins = [m for what, m in lp.margins if what not in cls.SYNTHESIS.ruled_margins]
         self.n_margins = len(margins)
         v = casadi.jacobian(lp.x, t)
         a = casadi.jacobian(v, t)

@@ -83,8 +83,8 @@ class Formulations:
 
     def get(self, problem, branch: dict, orientation: int, range_target=None, sense=1, guarded=None) -> Formulation:
         """guarded: with the rows that keep the output's reversals at its dead centres (default: unless its type
-        reverses once a turn by construction, ``Mechanism.ONE_REVERSAL``)."""
-        guarded = not problem.mechanism.ONE_REVERSAL if guarded is None else guarded
+        reverses once a turn by construction, ``Mechanism.SYNTHESIS.one_reversal``)."""
+        guarded = not problem.mechanism.SYNTHESIS.one_reversal if guarded is None else guarded
         c = problem.conditions
         bounds = tuple(k for k in c if k not in ("grashof", "linear", "ratio"))
         cond = (c.get("grashof"), bounds, repr(c.get("linear")), repr(c.get("ratio")))

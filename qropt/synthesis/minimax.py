@@ -88,7 +88,7 @@ class _Coordinates:
     def __init__(self, problem):
         self.problem, kinds = problem, problem.mechanism.kinds()
         self.log = {k: kinds[k] == "length" for k in problem.free}
-        first = next((k for k in problem.free if self.log[k] and k != problem.mechanism.CRANK), None)
+        first = next((k for k in problem.free if self.log[k] and k != problem.mechanism.SYNTHESIS.crank), None)
         self.names = [k for k in problem.free if k != first]
         self.all = list(problem.free)
         self.lo = np.array([self._c(k, problem.free[k][0]) for k in self.all])

@@ -1,8 +1,8 @@
-"""Where the type's optima form a continuum (``Mechanism.TIES`` free) and the objective is kinematic: of the designs
-within ``tie_tol`` of the optimum, the one of least size (the problem's size measure). Along the continuum by exact
-evaluation first (``least_along``), else min_size under a bound at the optimum, and alone (where the targets fix
-the criterion, the bound is redundant and degenerate), from the optimum first, then along the closed forms'
-family; a design is accepted within 2 ``tie_tol`` of the optimum. The optimum stands where none is."""
+"""Where the type's optima form a continuum (``Mechanism.SYNTHESIS.ties`` free) and the objective is kinematic: of
+the designs within ``tie_tol`` of the optimum, the one of least size (the problem's size measure). Along the
+continuum by exact evaluation first (``least_along``), else min_size under a bound at the optimum, and alone (where
+the targets fix the criterion, the bound is redundant and degenerate), from the optimum first, then along the
+closed forms' family; a design is accepted within 2 ``tie_tol`` of the optimum. The optimum stands where none is."""
 
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ class LeastSize(Stage):
 
     def accepts(self, problem, plan):
         c = criteria.of_problem(problem)
-        ties = list(problem.mechanism.TIES)
+        ties = list(problem.mechanism.SYNTHESIS.ties)
         return bool(ties) and set(ties) <= set(problem.free) and c is not None and not c.size and c.kinematic
 
     def run(self, problem, pool, context):
@@ -33,7 +33,7 @@ class LeastSize(Stage):
         if r is None or r.status != "optimal":  # a tie of what the certificate does not prove optimal stands
             return
         c, tol_rel = criteria.of_problem(problem), context.settings.tie_tol
-        ties = list(problem.mechanism.TIES)
+        ties = list(problem.mechanism.SYNTHESIS.ties)
         tol = tol_rel * max(1.0, abs(r.objective))
         old = problem.conditions.get(c.bound)
 
@@ -73,7 +73,7 @@ class LeastSize(Stage):
 
 def least_along(context, problem, r, ties, c, accept, tol):
     """The least-size design of the continuum through the optimum ``r``: its tied lengths scaled together by one
-    factor leave the motion, and so every kinematic criterion, the same (``Mechanism.TIES``); the size at
+    factor leave the motion, and so every kinematic criterion, the same (``Mechanism.SYNTHESIS.ties``); the size at
     ``tie_scan`` factors log-spaced over what the bounds allow (each design built, its rules, one reversal and the
     bound conditions checked), the least refined by a bounded 1-D search between its neighbours, and of designs
     that small (within ``tie_tol``) the one of the largest tied lengths, then certified by exact evaluation like any
