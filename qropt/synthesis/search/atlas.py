@@ -22,7 +22,7 @@ class AtlasStarts(Stage):
         between, floor = multistart.expected(problem, plan.atlas, pool.designs)
         how = plan.atlas.how
         done = {c.start for c in cands if c.ok}
-        if multistart.short(problem, cands, between, tol) and len(done) < len(first):  # again, with a larger iteration limit
+        if multistart.short(problem, cands, between, tol) and len(done) < len(first):  # again, a larger limit
             again = [r for i, r in enumerate(first) if i not in done]
             cands += ms.run(
                 problem,
