@@ -36,7 +36,8 @@ def test_the_kkt_functions_derivatives_are_the_finite_differences(row):
     """The gradient, the rows' Jacobian and the Lagrangian's Hessian Newton uses, at a certified optimum's NLP
     point with random multipliers, against central differences of the objective and rows (step 1e-6)."""
     p, problems = row
-    r = Solver().solve(problems[3])
+    solver = Solver()  # kept: a hint holds its formulation weakly (the Solver owns it)
+    r = solver.solve(problems[3])
     h = r.continuation
     form = h.form
     pv = form.param_vector(problems[3], problems[3].targets, h.blocks["samples"], h.blocks["fractions"])
@@ -113,7 +114,8 @@ def test_a_hint_stays_in_its_process(row):
     """A Result pickles with its hint's numbers but not its formulation: a hint that crossed a process boundary
     fits no formulation; continue_from takes a Result only."""
     p, problems = row
-    r = Solver().solve(problems[2])
+    solver = Solver()  # kept: a hint holds its formulation weakly (the Solver owns it)
+    r = solver.solve(problems[2])
     h = pickle.loads(pickle.dumps(r.continuation))
     assert h.form is None and not h.fits(r.continuation.form, {k: r.params[k] for k in p.free})
     assert np.array_equal(h.w, r.continuation.w)
