@@ -394,25 +394,11 @@ def test_what_cannot_take_them_says_so():
     """The synthesis NLP, the servo's convex problem and the dynamics figure raise, naming the load."""
     m = qropt.Whitworth(r1=0.2, r2=0.5, r5=0.5, r6=1.0)
     loads = Loads(forces=[Force("D", 100.0)])
+    task = {"free": {"r1": (0.1, 0.3)}, "fixed": {"r2": 0.5, "r5": 0.5, "r6": 1.0}, "targets": {"time_ratio": 2.0}}
     with pytest.raises(ProblemError, match="synthesis NLP.*the force at D"):
-        qropt.Problem(
-            "whitworth",
-            free={"r1": (0.1, 0.3)},
-            fixed={"r2": 0.5, "r5": 0.5, "r6": 1.0},
-            targets={"time_ratio": 2.0},
-            objective="min_peak_torque",
-            masses=Masses(density=1.0),
-            loads=loads,
-        )
+        qropt.Problem("whitworth", **task, objective="min_peak_torque", masses=Masses(density=1.0), loads=loads)
     with pytest.raises(ProblemError, match="point mass at C"):
-        qropt.Problem(
-            "whitworth",
-            free={"r1": (0.1, 0.3)},
-            fixed={"r2": 0.5, "r5": 0.5, "r6": 1.0},
-            targets={"time_ratio": 2.0},
-            objective="min_peak_torque",
-            masses=Masses(density=1.0, points={"C": 1.0}),
-        )
+        qropt.Problem("whitworth", **task, objective="min_peak_torque", masses=Masses(density=1.0, points={"C": 1.0}))
     with pytest.raises(UnsupportedLoad, match="servo.*the torque on rod"):
         qropt.speed_profile(m, omega_max=10.0, masses=Masses(density=1.0), loads=Loads(torques=[Torque("rod", 1.0)]))
     from qropt.dynamics import compiled

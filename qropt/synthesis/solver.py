@@ -25,7 +25,7 @@ from qropt.synthesis.local import Candidate, Formulations, LocalSolve
 from qropt.synthesis.multistart import MultiStart
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import Result
-from qropt.synthesis.search.settings import Settings
+from qropt.synthesis.settings import Settings
 
 TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
 RANGE_SAMPLES = 64  # designs spread over the bounds whose exact target values start a reachable range

@@ -3,7 +3,7 @@ Pool they share and the Context of one solve (``base``), one module per strategy
 
 from qropt.synthesis.search.base import STOP, Context, Phase, Pool, Stage, Strategy, run, solve
 from qropt.synthesis.search.pipeline import DEFAULT, STARTS, starts_of
-from qropt.synthesis.search.settings import Settings
+from qropt.synthesis.settings import Settings
 
 __all__ = [
     "Strategy",

@@ -23,10 +23,10 @@ STOP = "stop"  # a strategy's run returns this to end the pipeline (or the phase
 
 @runtime_checkable
 class Strategy(Protocol):
-    """One stage of a solve. ``name``: a few words for claims and tables."""
+    """One stage of a solve. ``name``: a few words for claims and tables; a class attribute ``finishing = True``
+    (optional) says it runs after a time limit too (it makes the Result of what was found, cheaply)."""
 
     name: ClassVar[str]
-    finishing: ClassVar[bool]  # runs after a time limit too (it makes the Result of what was found, cheaply)
 
     def accepts(self, problem, plan) -> bool:
         """Whether it applies to ``problem`` with this plan of starts (``starts.Plan``; None before one is made)."""
