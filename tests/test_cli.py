@@ -232,3 +232,71 @@ def test_reachable_sizes_the_adjustable_link_for_a_given_range(capsys):
         m = DragLinkSlider(r1=0.1, r2=0.225, r3=r3, r4=0.275, r5=0.15, r6=0.3)
         assert m.time_ratio() == pytest.approx(tr, abs=1e-8)
     assert cli.main(["reachable", "--adjust", "1.2", "2"]) == 2
+
+
+def _help(sub, capsys) -> str:
+    with pytest.raises(SystemExit) as e:
+        cli.main([sub, "--help"])
+    assert e.value.code == 0
+    return capsys.readouterr().out
+
+
+def _subcommands() -> list[str]:
+    p = cli.parser()
+    return [s for s in p._subparsers._group_actions[0].choices if s != "bench"]  # bench: the suite's own --help
+
+
+def _examples(sub, capsys) -> list[list[str]]:
+    import shlex
+
+    text = _help(sub, capsys)
+    lines = text[text.rindex("\nexamples") + 1 :].splitlines()[1:]
+    return [shlex.split(line) for line in lines if line.strip()]
+
+
+@pytest.mark.parametrize("sub", _subcommands())
+def test_every_help_ends_with_examples_of_its_command(sub, capsys):
+    found = _examples(sub, capsys)
+    assert 1 <= len(found) <= 2 and all(argv[:2] == ["qropt", sub] for argv in found)
+
+
+@pytest.mark.parametrize("sub", ["synth", "analyze", "reachable"])
+def test_the_examples_of_cheap_commands_run(sub, capsys, tmp_path, monkeypatch):
+    (tmp_path / "problems").symlink_to(Path(__file__).resolve().parent.parent / "problems")
+    monkeypatch.chdir(tmp_path)
+    for argv in _examples(sub, capsys):
+        assert cli.main(argv[1:]) == 0, argv
+        capsys.readouterr()
+
+
+@pytest.mark.parametrize("sub", ["analyze", "reachable", "servo", "tolerance"])
+def test_parameter_flags_name_the_types_that_take_them(sub, capsys):
+    from qropt.mechanisms import REGISTRY
+
+    p = cli.parser()
+    flags = {a.dest: a.help for a in p._subparsers._group_actions[0].choices[sub]._actions}
+    for k in cli.PARAM_NAMES:
+        takers = sorted(t for t, cls in REGISTRY.items() if k in cls.PARAMS)
+        assert takers and flags[k].partition(" of the types ")[2].split(", ") == takers, k
+    if sub == "analyze":
+        assert "default: the paper's mechanism, a drag-link-slider" in " ".join(_help(sub, capsys).split())
+
+
+@pytest.mark.parametrize("sub", ["synth", "design", "servo"])
+def test_objective_has_help(sub):
+    p = cli.parser()
+    (flag,) = [a for a in p._subparsers._group_actions[0].choices[sub]._actions if a.dest == "objective"]
+    assert flag.help and all(o in flag.help for o in flag.choices if o != "none")
+
+
+def test_synth_dxf_help_names_no_theta2_flag(capsys):
+    assert "--theta2" not in _help("synth", capsys)
+
+
+def test_pareto_json_is_strict(capsys):
+    problem = str(Path(__file__).resolve().parent.parent / "problems" / "slider_crank_size.py")
+    argv = ["pareto", problem, "--objectives", "max_gamma_min", "min_peak_accel", "--n", "3", "--json"]
+    assert cli.main(argv) == 0
+    out = json.loads(capsys.readouterr().out, parse_constant=lambda c: pytest.fail(f"not strict JSON: {c}"))
+    assert out["objectives"] == ["max_gamma_min", "min_peak_accel"] and len(out["points"]) >= 2
+    assert out["units"]["length"] == "m" and {"gamma_min", "peak_accel", "r2"} <= set(out["points"][0])

@@ -1,5 +1,6 @@
 """Command line: ``qropt analyze``, ``synth``, ``family``, ``reachable``, ``bench``, and every command module
-of this package (a module defining ``COMMAND``, ``HELP``, ``add_arguments(parser)`` and ``run(args) -> int``).
+of this package (a module defining ``COMMAND``, ``HELP``, ``EXAMPLES`` (command lines its --help ends with),
+``add_arguments(parser)`` and ``run(args) -> int``).
 Errors print one line."""
 
 from __future__ import annotations
@@ -62,6 +63,48 @@ def _param_pair(text: str) -> tuple[str, str]:
     if not sep or not name.strip() or not value.strip():
         raise argparse.ArgumentTypeError(f"--param is NAME=VALUE (e.g. r2=0.1, beta=30deg), got {text!r}")
     return name.strip(), value.strip()
+
+
+def examples(*commands: str) -> dict:
+    """add_parser keywords for a subcommand whose --help ends with these example command lines."""
+    where = " (problems/: the repository's problem files)" if any("problems/" in c for c in commands) else ""
+    return {
+        "epilog": f"examples{where}:\n" + "\n".join(f"  {c}" for c in commands),
+        "formatter_class": argparse.RawDescriptionHelpFormatter,
+    }
+
+
+def type_argument(parser, name: str = "type", more: str = "") -> None:
+    """The optional mechanism TYPE: the registered types, and the default, the paper's mechanism."""
+    from qropt.examples import paper_mechanism
+
+    parser.add_argument(
+        name,
+        nargs="?",
+        help="mechanism type: " + ", ".join(sorted(REGISTRY)) + more + f", or module:Class; default: the paper's "
+        f"mechanism, a {paper_mechanism().KIND} (qropt.examples.paper_mechanism)",
+    )
+
+
+def param_flags(parser, kind=None) -> None:
+    """--r1 ... --sigma-slider (PARAM_NAMES), each naming the registered types that take it (their PARAMS)."""
+    for k in PARAM_NAMES:
+        takers = {t: cls.kinds()[k] for t, cls in sorted(REGISTRY.items()) if k in cls.PARAMS}
+        what = " or ".join(sorted({"branch sign (+1 or -1)" if v == "branch" else v for v in takers.values()}))
+        parser.add_argument(
+            f"--{k.replace('_', '-')}",
+            dest=k,
+            type=kind or real,
+            help=f"the {what} {k} of the types " + ", ".join(takers),
+        )
+
+
+def objective_help(lead: str = "what the design optimises", more: str = "") -> str:
+    """A help text for --objective: each objective of the criteria registry and the criteria it optimises."""
+    said = {}
+    for c in criteria.CRITERIA.values():
+        said.setdefault(c.objective, []).append(c.label)
+    return f"{lead}: " + ", ".join(f"{o} ({' or '.join(w)})" for o, w in said.items()) + more
 
 
 def param_argument(parser) -> None:
@@ -141,9 +184,16 @@ def picture_path(path: str) -> str:
     return path
 
 
-def units_argument(parser, what: str = "the design's length unit") -> None:
-    """--units: one of qropt.units.LENGTH_UNITS."""
-    parser.add_argument("--units", choices=list(units_.LENGTH_UNITS), help=f"{what} (default: m)")
+def units_argument(parser, what: str = "the design's length unit", default: str | None = None) -> None:
+    """--units (or --unit): one of qropt.units.LENGTH_UNITS."""
+    parser.add_argument(
+        "--units",
+        "--unit",
+        dest="units",
+        default=default,
+        choices=list(units_.LENGTH_UNITS),
+        help=f"{what} (default: {units_.DEFAULT})",
+    )
 
 
 def stated(m: Mechanism, units: str | None, where: str) -> Mechanism:
@@ -375,9 +425,10 @@ def dynamics(args, m) -> int:
     return 0
 
 
-def _export_arguments(p):
+def _export_arguments(p, at: str):
+    """--animate, --dxf, --svg, --save; ``at``: the crank angle the drawings show."""
     p.add_argument("--animate", help="GIF file: the design over one turn (72 frames)")
-    p.add_argument("--dxf", help="DXF file: the design at --theta2 (0 for synth), one layer per kind of entity")
+    p.add_argument("--dxf", help=f"DXF file: the design {at}, one layer per kind of entity")
     p.add_argument("--svg", help="SVG file: the same drawing")
     p.add_argument("--save", help="JSON design file that qropt analyze --from reads back")
 
@@ -409,10 +460,16 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"qropt {__version__}")
     p.add_argument("--quiet", action="store_true", help="no progress bars on standard error")
     sub = p.add_subparsers(dest="command", required=True)
-    a = sub.add_parser("analyze", help="exact TR, stroke, dead centres, gamma_min and slider state")
-    a.add_argument("type", nargs="?", help="mechanism type: " + ", ".join(sorted(REGISTRY)))
-    for k in PARAM_NAMES:
-        a.add_argument(f"--{k.replace('_', '-')}", dest=k, type=real, help=f"parameter {k}")
+    a = sub.add_parser(
+        "analyze",
+        help="exact TR, stroke, dead centres, gamma_min and slider state",
+        **examples(
+            "qropt analyze --omega2 10 --theta2 60deg",
+            "qropt analyze crank-shaper --r1 160 --r2 40 --r4 240 --units mm --json",
+        ),
+    )
+    type_argument(a)
+    param_flags(a)
     param_argument(a)
     a.add_argument("--theta2", type=angle, default=math.radians(60.0), help="crank angle (deg, or 1.05rad)")
     a.add_argument("--omega2", type=real, default=1.0, help="crank speed, rad/s (sign = direction)")
@@ -438,29 +495,44 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("--gravity", type=real, default=0.0, help="gravity along -y, m/s^2 (e.g. 9.81)")
     a.add_argument("--cs", type=real, default=0.05, help="coefficient of speed fluctuation for the flywheel")
     units_argument(a, "the length unit of the parameters (a design file states its own; --units may repeat it)")
-    _export_arguments(a)
+    _export_arguments(a, "at --theta2")
     a.set_defaults(run=cmd_analyze)
-    s = sub.add_parser("synth", help="solve a synthesis problem file (build() -> Problem)")
+    s = sub.add_parser(
+        "synth",
+        help="solve a synthesis problem file (build() -> Problem)",
+        **examples("qropt synth --save best.json --svg best.svg", "qropt synth problems/paper_drag_link.py --json"),
+    )
     s.add_argument("problem", nargs="?", help="a problem file (default: the paper's design task, built in)")
-    s.add_argument("--objective", choices=[o for o in criteria.objectives() if o] + ["none"])
+    s.add_argument(
+        "--objective",
+        choices=[o for o in criteria.objectives() if o] + ["none"],
+        help=objective_help(more="; none: a feasibility problem (default: the problem file's)"),
+    )
     s.add_argument("--size", choices=["sum", "longest", "footprint"], help="size measure for min_size")
     s.add_argument("--starts", type=int, help="space-filling multi-start points (default: the solver's)")
     s.add_argument("--time-limit", dest="time_limit", type=real, help=TIME_LIMIT_HELP)
     s.add_argument("--json", action="store_true", help="print the Result as JSON")
     s.add_argument("--plot", help="PNG file: the best design over its cycle")
-    _export_arguments(s)
+    _export_arguments(s, "at theta2 = 0 (the crank along +x)")
     s.set_defaults(run=cmd_synth)
-    f = sub.add_parser("family", help="trace the one-parameter family of a problem file")
+    f = sub.add_parser(
+        "family",
+        help="trace the one-parameter family of a problem file",
+        **examples("qropt family problems/paper_family_r1_r3.py --csv family.csv --plot family.png"),
+    )
     f.add_argument("problem", help="a problem file with one more free parameter than targets")
     f.add_argument("--along", help="the parameter in which folds are counted (default: the first free one)")
     f.add_argument("--csv", help="file for every traced point with its quantities")
     f.add_argument("--plot", help="PNG file: the family coloured by gamma_min, folds, ends and the best design")
     f.add_argument("--json", action="store_true", help="print branches' ends, folds and the best design as JSON")
     f.set_defaults(run=cmd_family)
-    r = sub.add_parser("reachable", help="TR range, solution counts and adjustable-link travel of one parameter")
-    r.add_argument("type", nargs="?", help="mechanism type (default: the paper's mechanism)")
-    for k in PARAM_NAMES:
-        r.add_argument(f"--{k.replace('_', '-')}", dest=k, type=real, help=f"parameter {k}")
+    r = sub.add_parser(
+        "reachable",
+        help="TR range, solution counts and adjustable-link travel of one parameter",
+        **examples("qropt reachable --tr 1.5 --tr 2 --plot fig5.png", "qropt reachable --adjust 1.5 2.5"),
+    )
+    type_argument(r)
+    param_flags(r)
     param_argument(r)
     r.add_argument("--free", default="r3", help="the adjustable parameter (default r3)")
     r.add_argument("--bounds", nargs=2, type=real, metavar=("LOW", "HIGH"), help="its interval")
@@ -480,7 +552,7 @@ def parser() -> argparse.ArgumentParser:
     for info in pkgutil.iter_modules(__path__):
         mod = importlib.import_module(f"{__name__}.{info.name}")
         if hasattr(mod, "COMMAND"):
-            c = sub.add_parser(mod.COMMAND, help=mod.HELP)
+            c = sub.add_parser(mod.COMMAND, help=mod.HELP, **examples(*mod.EXAMPLES))
             mod.add_arguments(c)
             c.set_defaults(run=mod.run)
     return p

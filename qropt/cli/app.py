@@ -8,6 +8,7 @@ import webbrowser
 
 COMMAND = "app"
 HELP = "the web application: design, mechanism and synthesis pages in the browser (qropt[app])"
+EXAMPLES = ("qropt app --no-browser --port 8765", "qropt app problems/user_slotted_lever.py --no-browser")
 
 
 def add_arguments(p) -> None:

@@ -16,6 +16,10 @@ from qropt.units import named
 COMMAND = "chart"
 HELP = "solve a problem file over a grid of time ratios, strokes, swings or fixed parameters (a design chart)"
 MAX_VALUES = 100_000
+EXAMPLES = (
+    "qropt chart problems/chart_slider_crank.py --plot slider_crank_chart.png",
+    "qropt chart problems/chart_crank_rocker.py --x time_ratio 1.1:2.5:15 --y swing 40deg:100deg:13 --json small.json",
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

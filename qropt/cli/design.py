@@ -7,23 +7,27 @@ import math
 
 COMMAND = "design"
 HELP = "type synthesis: the task solved for every quick-return type, compared criterion by criterion"
+EXAMPLES = (
+    "qropt design --tr 1.5 --stroke 0.3 --objective min_size --gamma-min 40deg --types whitworth slider-crank",
+    "qropt design --tr 1.5 --stroke 300 --units mm --types slider-crank whitworth",
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from qropt.cli import TIME_LIMIT_HELP, real
+    from qropt.cli import TIME_LIMIT_HELP, objective_help, real, units_argument
     from qropt.studies._design import TYPES
     from qropt.synthesis import criteria
-    from qropt.units import LENGTH_UNITS
+    from qropt.units import DEFAULT
 
     parser.add_argument("--tr", type=real, required=True, help="time ratio (slow/fast, >= 1)")
     parser.add_argument("--stroke", type=real, required=True, help="slider stroke [in --units]")
+    units_argument(parser, "the length unit of the stroke, the bounds and the answer", default=DEFAULT)
     parser.add_argument(
-        "--units",
-        default="m",
-        choices=list(LENGTH_UNITS),
-        help="the length unit of the stroke, the bounds and the answer (default m)",
+        "--objective",
+        default="max_gamma_min",
+        choices=[o for o in criteria.objectives() if o],
+        help=objective_help(more=" (default max_gamma_min)"),
     )
-    parser.add_argument("--objective", default="max_gamma_min", choices=[o for o in criteria.objectives() if o])
     parser.add_argument(
         "--size",
         default="footprint",

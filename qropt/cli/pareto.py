@@ -7,10 +7,14 @@ import math
 
 COMMAND = "pareto"
 HELP = "the trade-off front between two objectives (epsilon-constraint, every point certified)"
+EXAMPLES = (
+    "qropt pareto problems/crank_rocker_slider_size.py --objectives max_gamma_min min_size --n 20 --plot front.png",
+    "qropt pareto problems/slider_crank_size.py --objectives max_gamma_min min_peak_accel --n 5 --json",
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from qropt.studies._pareto import objective_names
+    from qropt.cli import objective_help
 
     parser.add_argument("problem", help="a problem file (.py, .toml, .json)")
     parser.add_argument(
@@ -18,11 +22,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         nargs=2,
         required=True,
         metavar=("A", "B"),
-        help="two objectives: " + ", ".join(objective_names()),
+        help=objective_help("two objectives"),
     )
     parser.add_argument("--n", type=int, default=20, help="points along the front, ends included (default 20)")
     parser.add_argument("--csv", metavar="FILE", help="write the front as CSV")
     parser.add_argument("--plot", metavar="FILE", help="draw the front and designs along it (.png, .pdf, .svg)")
+    parser.add_argument("--json", action="store_true", help="print the front as JSON")
 
 
 def run(args) -> int:
@@ -33,6 +38,13 @@ def run(args) -> int:
     problem = load_problem(args.problem)
     with progress_bar("front points", total=max(args.n - 2, 0)) as bar:
         front = pareto(problem, tuple(args.objectives), n=args.n, progress=bar.update)
+    if args.csv:
+        front.to_csv(args.csv)
+    if plot:
+        front.plot(plot)
+    if args.json:
+        print(front.to_json())
+        return 0
     a, b = front.criteria
     print(
         f"{problem.name or args.problem}: {front.objectives[0]} vs {front.objectives[1]}, "
@@ -43,10 +55,8 @@ def run(args) -> int:
     for eps, why in front.removed:
         print(f"  removed (bound {eps if eps is None else format(eps, '.6g')}): {why}")
     if args.csv:
-        front.to_csv(args.csv)
         print(f"front written to {args.csv}")
     if plot:
-        front.plot(plot)
         print(f"picture written to {plot}")
     return 0
 

@@ -10,6 +10,10 @@ from pathlib import Path
 COMMAND = "project"
 HELP = "a classroom quick-return project per seed (statement or worked solution) as HTML; --count for a class set"
 MAX_COUNT = 500
+EXAMPLES = (
+    "qropt project --type whitworth --seed 7 --solution -o solution.html",
+    "qropt project --type crank-shaper --seed 100 --count 30 -o class",
+)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -6,6 +6,7 @@ import argparse
 
 COMMAND = "report"
 HELP = "one self-contained HTML report: the paper's whole project, or a problem file's design"
+EXAMPLES = ("qropt report -o report.html", "qropt report problems/whitworth_accel.py -o whitworth.html")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

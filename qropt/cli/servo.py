@@ -16,6 +16,10 @@ from qropt.validate import picture_path
 
 COMMAND = "servo"
 HELP = "fastest crank-speed profile of a servo-driven crank within speed, acceleration and torque limits"
+EXAMPLES = (
+    "qropt servo --omega-max 13 --alpha-max 200 --force 1000 --inertia 1 --torque-max 113",
+    "qropt servo slider-crank --r2 0.1 --r3 0.4 --omega-max 20 --v-cut 0.5 --a-max 40 --alpha-max 400 --v-max 2",
+)
 LIMITS = ("omega_max", "alpha_max", "v_max", "a_max", "v_cut", "force", "inertia", "torque_max")
 UNITS = {
     "omega_max": "rad/s",
@@ -32,11 +36,10 @@ UNITS = {
 
 def add_mechanism_arguments(parser: argparse.ArgumentParser) -> None:
     """TYPE (default: the paper's drag-link mechanism) and its parameters --r1 ... --sigma-slider."""
-    parser.add_argument("type", nargs="?", help="mechanism type: " + ", ".join(sorted(REGISTRY)))
-    from qropt.cli import PARAM_NAMES, param_argument
+    from qropt.cli import param_argument, param_flags, type_argument
 
-    for k in PARAM_NAMES:
-        parser.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
+    type_argument(parser)
+    param_flags(parser, float)
     param_argument(parser)
 
 
@@ -68,7 +71,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         }.get(k, "limit")
         parser.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"{what}, {UNITS[k]}")
     parser.add_argument("--cut-fraction", type=float, default=0.8, help="cut share of the working travel (0.8)")
-    parser.add_argument("--objective", choices=OBJECTIVES, default="min_cycle_time")
+    parser.add_argument(
+        "--objective",
+        choices=OBJECTIVES,
+        default=OBJECTIVES[0],
+        help=f"what the profile minimises: {' or '.join(OBJECTIVES)} (then the shortest cycle among the fastest "
+        f"returns); default {OBJECTIVES[0]}",
+    )
     parser.add_argument("--n", type=int, default=720, help="cells per turn (>= 36, default 720)")
     parser.add_argument("--plot", help="PNG file: omega2, slider v and a (and torque) against time")
     parser.add_argument("--csv", help="file for the profile, one row per node ('-': standard output)")

@@ -18,6 +18,10 @@ COMMAND = "tolerance"
 HELP = "exact sensitivities and the largest tolerances keeping TR, stroke, gamma_min within limits"
 LENGTH_UNITS = {u: units_.LENGTH_UNITS[u] for u in ("um", "mm", "cm", "m")}  # a limit's suffixes, in metres
 ANGLE_UNITS = {"deg": math.pi / 180, "rad": 1.0}
+EXAMPLES = (
+    "qropt tolerance --limit time_ratio=0.01 --limit stroke=1mm --monte-carlo 10000",
+    "qropt tolerance slider-crank --r2 100 --r3 350 --e 60 --units mm --limit stroke=0.5mm",
+)
 PAPER_UNIT = "m"  # the paper's mechanism (the default design) is given in metres
 
 
@@ -57,17 +61,14 @@ def limit(text: str) -> tuple[str, float, str | None]:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "target",
-        nargs="?",
-        help="mechanism type (" + ", ".join(sorted(REGISTRY)) + ") or a JSON file with 'type' "
-        "and 'params' (as 'qropt synth --json' or 'qropt analyze --json' print); default: the "
-        "paper's mechanism",
-    )
-    from qropt.cli import PARAM_NAMES
+    from qropt.cli import param_flags, type_argument, units_argument
 
-    for k in PARAM_NAMES:
-        parser.add_argument(f"--{k.replace('_', '-')}", dest=k, type=float, help=f"parameter {k}")
+    type_argument(
+        parser,
+        "target",
+        more=" (or a JSON file with 'type' and 'params', as 'qropt synth --json' or 'qropt analyze --json' print)",
+    )
+    param_flags(parser, float)
     parser.add_argument(
         "--limit",
         type=limit,
@@ -77,13 +78,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="allowed deviation, once per quantity: time_ratio=0.01, stroke=0.001 (the design's "
         "length unit) or stroke=1mm (a design whose unit is stated), gamma_min=1deg",
     )
-    parser.add_argument(
-        "--units",
-        "--unit",
-        dest="units",
-        choices=list(units_.LENGTH_UNITS),
-        help="the design's length unit: states it for TYPE and parameters (so that a stroke limit may carry a "
-        "unit suffix); a design file or the paper's mechanism (m) states its own, which --units may only repeat",
+    units_argument(
+        parser,
+        "the design's length unit: states it for TYPE and parameters (so that a stroke limit may carry a unit "
+        "suffix); a design file or the paper's mechanism (m) states its own, which --units may only repeat",
     )
     parser.add_argument("--params", help="toleranced parameters, comma-separated (default: lengths and offsets)")
     parser.add_argument("--rss", action="store_true", help="statistical stack-up ||S t|| <= E / k")

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import csv
 import inspect
+import json
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -17,7 +18,7 @@ import numpy as np
 from qropt.errors import ProblemError
 from qropt.synthesis import criteria
 from qropt.synthesis.problem import Problem
-from qropt.synthesis.result import SOLUTION_PRESENT, Result
+from qropt.synthesis.result import SOLUTION_PRESENT, Result, json_safe
 from qropt.units import named
 
 MAX_POINTS = 1000
@@ -53,6 +54,18 @@ class Front:
         return [
             {a: va, b: vb, "status": r.status, **r.params} for r, (va, vb) in zip(self.points, self.values, strict=True)
         ]
+
+    def to_json(self) -> str:
+        """The front as strict JSON: its points (``table``) in order along it, the sweep points removed and why;
+        "units" names each criterion's unit, "length" the length unit."""
+        d = {
+            "objectives": list(self.objectives),
+            "criteria": list(self.criteria),
+            "units": {"length": self.problem.units, **criteria.units(self.problem.units)},
+            "points": self.table(),
+            "removed": [{"bound": eps, "reason": why} for eps, why in self.removed],
+        }
+        return json.dumps(json_safe(d), indent=2, allow_nan=False)
 
     def to_csv(self, path) -> None:
         rows = self.table()
