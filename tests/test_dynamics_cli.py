@@ -67,6 +67,42 @@ def test_bad_dynamics_input_is_one_line(extra, words, capsys):
     assert len(err.splitlines()) == 1 and words in err and "Traceback" not in err
 
 
+def _peak(capsys, args) -> float:
+    assert cli.main([*args, "--json"]) == 0
+    return json.loads(capsys.readouterr().out)["peak_torque"]["value"]
+
+
+def test_gravity_as_a_vector_point_masses_and_a_loads_file(tmp_path, capsys):
+    """--gravity GX GY (one number still means along -y), --point-mass JOINT KG and --loads FILE (JSON or TOML of
+    Loads.to_dict): each the library's number; the cutting force stated as a general force in a file gives the
+    shorthand's peak."""
+    base = ["analyze", "--omega2", "10", "--dynamics", "--density", "1.57", "--ram-mass", "20"]
+    m = paper_mechanism()
+    assert _peak(capsys, [*base, "--gravity", "0", "-9.81"]) == _peak(capsys, [*base, "--gravity", "9.81"])
+    side = _peak(capsys, [*base, "--gravity", "-9.81", "0", "--point-mass", "C", "2", "--point-mass", "B", "0.5"])
+    masses = qropt.Masses.bars(1.57, 20.0, points={"C": 2.0, "B": 0.5})
+    ex = m.dynamic_extremes(10.0, masses=masses, loads=qropt.Loads(gravity=(-9.81, 0.0)))
+    assert side == pytest.approx(ex.peak_torque.value, rel=1e-12)
+    loads = qropt.Loads(forces=[qropt.Force("D", 1000.0)], gravity=(0.0, -9.81))
+    as_json, as_toml = tmp_path / "loads.json", tmp_path / "loads.toml"
+    as_json.write_text(json.dumps(loads.to_dict()))
+    import tomli_w
+
+    as_toml.write_text(tomli_w.dumps(loads.to_dict()))
+    shorthand = _peak(capsys, [*base, "--force", "1000", "--gravity", "9.81"])
+    assert _peak(capsys, [*base, "--loads", str(as_json)]) == pytest.approx(shorthand, rel=1e-12)
+    assert _peak(capsys, [*base, "--loads", str(as_toml)]) == pytest.approx(shorthand, rel=1e-12)
+    for extra, words in (
+        (["--loads", str(as_json), "--force", "5"], "not both"),
+        (["--gravity", "1", "2", "3"], "one number"),
+        (["--loads", str(tmp_path)], "not a regular file"),
+        (["--point-mass", "Z", "1"], "Z"),
+    ):
+        assert cli.main([*base, *extra]) != 0
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and words in err and "Traceback" not in err, err
+
+
 def test_the_report_states_its_assumptions_and_the_librarys_numbers():
     from qropt.io.report import FORCES, _forces
 

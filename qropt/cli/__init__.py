@@ -16,6 +16,7 @@ import sys
 import numpy as np
 
 from qropt import units as units_
+from qropt import validate
 from qropt.errors import QroptError
 from qropt.io import records
 from qropt.mechanisms import REGISTRY, Mechanism, mechanism_type, type_reference
@@ -351,20 +352,56 @@ def polygons(args, m) -> int:
     return 0
 
 
+def _loads_of(args):
+    """The loads of ``analyze --dynamics``: a loads file (--loads), or --force, --friction and --gravity."""
+    from qropt.dynamics.model import Loads
+
+    if args.loads_file is None:
+        if len(args.gravity) > 2:
+            raise CliError(f"--gravity takes one number (along -y) or two (gx gy), got {len(args.gravity)}")
+        gravity = args.gravity[0] if len(args.gravity) == 1 else tuple(args.gravity)
+        return Loads(args.force, friction=args.friction, gravity=gravity)
+    if args.force or args.friction or args.gravity != [0.0]:
+        raise CliError("give the loads in the --loads file or by --force, --friction and --gravity, not both")
+    text = validate.read_text(args.loads_file, "loads file")
+    if str(args.loads_file).lower().endswith(".toml"):
+        import tomllib
+
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as e:
+            raise CliError(f"the loads file {args.loads_file} is not TOML: {e}") from None
+    else:
+        data = validate.json_document(text, f"the loads file {args.loads_file}")
+    return Loads.from_dict(data)
+
+
+def _loads_words(loads) -> str:
+    """The loads in a few words for the header line."""
+    g = loads.gravity
+    f = loads.cutting_force
+    words = f"cutting force {f:g} N, friction " if isinstance(f, float) else "cutting force by a table, friction "
+    words += f"{loads.friction:g}, gravity " + (f"({g[0]:g}, {g[1]:g})" if isinstance(g, tuple) else f"{g:g}")
+    words += " m/s^2"
+    n = len(loads.forces) + len(loads.torques)
+    return words + (f", {n} more load{'s' * (n != 1)} (--loads)" if n else "")
+
+
 def dynamics(args, m) -> int:
     """``analyze --dynamics``: the peak and RMS crank torque, the peak force at every joint, the peak shaking
     force and moment and the flywheel for --cs, at --omega2 (SI); --plot, --csv (the turn degree by degree) and
     --json as for the kinematics."""
     from qropt.dynamics.cycle import CycleDynamics
-    from qropt.dynamics.model import Counterweight, Loads, Masses
+    from qropt.dynamics.model import Counterweight, Masses
 
     try:
         cw = None
         if args.counterweight is not None:
             mass, radius, at = args.counterweight
             cw = Counterweight(real(mass), real(radius), angle(at))
-        masses = Masses.bars(args.density, args.ram_mass, block=args.block_mass, counterweight=cw)
-        loads = Loads(args.force, friction=args.friction, gravity=args.gravity)
+        points = {joint: real(kg) for joint, kg in args.points or []}
+        masses = Masses.bars(args.density, args.ram_mass, block=args.block_mass, counterweight=cw, points=points)
+        loads = _loads_of(args)
     except (QroptError, argparse.ArgumentTypeError) as e:
         raise CliError(str(e)) from None
     cd = CycleDynamics(m, args.omega2, args.alpha2, masses, loads)
@@ -377,8 +414,8 @@ def dynamics(args, m) -> int:
     else:
         print(
             f"{type(m).__name__} at omega2 = {args.omega2:g} rad/s, alpha2 = {args.alpha2:g} rad/s^2: links "
-            f"{args.density:g} kg/m, ram {args.ram_mass:g} kg, cutting force {args.force:g} N, friction "
-            f"{args.friction:g}, gravity {args.gravity:g} m/s^2"
+            f"{args.density:g} kg/m, ram {args.ram_mass:g} kg, {_loads_words(loads)}"
+            + (f", points {', '.join(f'{k} {v:g} kg' for k, v in masses.points.items())}" if masses.points else "")
             + (f", counterweight {cw.mass:g} kg at {cw.radius:g} m, {math.degrees(cw.angle):g} deg" if cw else "")
             + " (SI)"
         )
@@ -492,7 +529,30 @@ def parser() -> argparse.ArgumentParser:
     )
     a.add_argument("--force", type=real, default=0.0, help="cutting force on the working stroke, N")
     a.add_argument("--friction", type=real, default=0.0, help="the slide's friction coefficient")
-    a.add_argument("--gravity", type=real, default=0.0, help="gravity along -y, m/s^2 (e.g. 9.81)")
+    a.add_argument(
+        "--gravity",
+        type=real,
+        nargs="+",
+        metavar="G",
+        default=[0.0],
+        help="gravity, m/s^2: one number g along -y (e.g. 9.81), or GX GY in the frame (0 -9.81; a vertical "
+        "slotter: -9.81 0)",
+    )
+    a.add_argument(
+        "--point-mass",
+        dest="points",
+        nargs=2,
+        action="append",
+        metavar=("JOINT", "KG"),
+        help="a point mass at a joint (repeatable), added to the body that carries it",
+    )
+    a.add_argument(
+        "--loads",
+        dest="loads_file",
+        metavar="FILE",
+        help="a JSON or TOML file of the loads (qropt.Loads.to_dict: forces, torques, windows, gravity, working) "
+        "instead of --force, --friction and --gravity",
+    )
     a.add_argument("--cs", type=real, default=0.05, help="coefficient of speed fluctuation for the flywheel")
     units_argument(a, "the length unit of the parameters (a design file states its own; --units may repeat it)")
     _export_arguments(a, "at --theta2")
