@@ -10,11 +10,13 @@ from qropt.convex.tolerance import Allocation, MonteCarlo, allocate, sensitiviti
 from qropt.dynamics import (
     BodyMass,
     Counterweight,
+    Drive,
     Dynamics,
     Force,
     Loads,
     Masses,
     Motor,
+    PinFriction,
     Simulation,
     Torque,
     Window,
@@ -27,6 +29,7 @@ from qropt.errors import (
     GrashofError,
     InvalidParameter,
     NoDeadCentres,
+    PinLocked,
     ProblemError,
     QroptError,
     UnsupportedLoad,
@@ -95,6 +98,8 @@ __all__ = [
     "Window",
     "Dynamics",
     "Motor",
+    "Drive",
+    "PinFriction",
     "Simulation",
     "simulate",
     # convex layer
@@ -114,4 +119,5 @@ __all__ = [
     "ProblemError",
     "ChartError",
     "UnsupportedLoad",
+    "PinLocked",
 ]

@@ -60,6 +60,15 @@ class SlideLocked(DegenerateMechanism):
         self.theta2 = theta2
 
 
+class PinLocked(DegenerateMechanism):
+    """Friction at the pins locks the linkage at crank angle ``theta2`` (rad), at pin ``joint``: the friction
+    moments could hold the linkage jammed by themselves (the joint forces grow with their own friction)."""
+
+    def __init__(self, message: str, theta2: float, joint: str):
+        super().__init__(message)
+        self.theta2, self.joint = theta2, joint
+
+
 class UnsupportedLoad(InvalidParameter):
     """A part of qropt that cannot apply a load yet was given one (a general force, torque, gravity vector, point
     mass or named working stroke in the synthesis NLP, the servo's convex problem or a picture)."""

@@ -17,7 +17,7 @@ from qropt.synthesis.criteria import objective_of
 from qropt.synthesis.search import Settings
 from qropt.synthesis.search.descended import descended
 
-SHORT = Settings(evolution_generations=20)  # a short evolution
+SHORT = Settings(evolution_generations=20, descent_evals=200)  # a short evolution, short descents
 
 KW = {"objective": "min_peak_torque", "masses": MASSES, "loads": LOADS, "omega2": OMEGA2}
 
@@ -39,7 +39,7 @@ def test_the_evolution_hands_on_designs_on_the_targets():
     values = []
     for d in found:
         tr, stroke, v = _exact(problem, d)
-        assert abs(math.log(tr / 1.3)) <= evolution.WINDOW
+        assert abs(math.log(tr / 1.3)) <= Settings().evolution_window
         assert stroke == pytest.approx(0.2, rel=1e-12)
         assert evolution.outside(problem, d) == 0.0
         values.append(v)
@@ -63,13 +63,12 @@ def test_what_the_evolution_needs():
     assert not evolution.applies(fixed)
 
 
-def test_a_solve_without_a_design_from_its_passes_starts_from_descents(monkeypatch):
+def test_a_solve_without_a_design_from_its_passes_starts_from_descents():
     """Where neither the multi-start nor its guarded pass certifies a design (here: no Sobol starts and no closed
     forms), the solve starts local runs from descents on the exact objective, certifies the design they reach and
     says so in its claim. Shortened (20 generations, 200 evaluations a descent)."""
     from qropt import Solver
 
-    monkeypatch.setattr(evolution, "DESCENT_EVALS", 200)
     problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
     r = Solver(starts_n=0, settings=SHORT).solve(problem, use_analytic=False, diagnose=False)
     assert r.status in ("optimal", "acceptable"), r.message
@@ -81,7 +80,7 @@ def test_a_solve_without_a_design_from_its_passes_starts_from_descents(monkeypat
     assert v == pytest.approx(r.objective, rel=1e-9)
 
 
-def test_a_descents_end_stands_as_a_feasible_design_where_no_start_certifies(monkeypatch):
+def test_a_descents_end_stands_as_a_feasible_design_where_no_start_certifies():
     """Where no local solve certifies a design (here IPOPT gets no iteration), the best descent's end is the
     result: status 'feasible', its targets met exactly (checked by brute force over a fine crank grid), its
     objective exact (a dense grid of the Newton-Euler torque comes within 1e-4 below it), no optimality claimed
@@ -90,7 +89,6 @@ def test_a_descents_end_stands_as_a_feasible_design_where_no_start_certifies(mon
     from qropt import Result, Solver
     from tests import brute
 
-    monkeypatch.setattr(evolution, "DESCENT_EVALS", 200)
     problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
     none = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": SHORT}
     r = Solver(**none).solve(problem, use_analytic=False, diagnose=False)
@@ -132,13 +130,12 @@ def test_the_evolution_options_are_true_or_false():
             Solver(evolutions=bad)
 
 
-def test_more_evolutions_add_their_ends_to_the_first_ones(monkeypatch):
+def test_more_evolutions_add_their_ends_to_the_first_ones():
     """``Solver(evolutions=2)`` runs the evolution from seeds 0 and 1: the first is the one evolution of a default
     solve, so with no certified design (IPOPT gets no iteration) its best end is at least as good, and better
     where the second seed's basin is; the claim names both seeds. Shortened (20 generations, 200 evaluations)."""
     from qropt import Solver
 
-    monkeypatch.setattr(evolution, "DESCENT_EVALS", 200)
     problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
     kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": SHORT}
     one = Solver(**kw).solve(problem, use_analytic=False, diagnose=False)
@@ -148,7 +145,7 @@ def test_more_evolutions_add_their_ends_to_the_first_ones(monkeypatch):
     assert one.status == r.status == "feasible", (one.message, r.message)
     assert "2 differential evolutions (seeds 0-1) of 20 generations" in r.certificate.global_claim
     assert r.objective <= one.objective * (1 + 1e-12)
-    second = descents.descended(problem, 20, 1)
+    second = descents.descended(problem, 20, 1, settings=SHORT)
     assert r.objective <= second[0].value * (1 + 1e-12)
 
 
@@ -162,10 +159,10 @@ def test_the_four_bar_driven_rows_run_four_evolutions_by_default(monkeypatch):
 
     counts = {k: evolution.count(type_problem(k, 1.6, 0.3, **KW)) for k in TYPES}
     assert counts == {k: 4 if k in ("crank-rocker-slider", "drag-link-slider", "coupler-slider") else 1 for k in TYPES}
-    monkeypatch.setattr(evolution, "DESCENT_EVALS", 50)
-    monkeypatch.setattr(minimax, "polish", lambda problem, design, steps=0: None)
+    monkeypatch.setattr(minimax, "polish", lambda problem, design, steps=None, settings=None: None)
     problem = type_problem("crank-rocker-slider", 1.6, 0.3, **KW)
-    kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": Settings(evolution_generations=5)}
+    short = Settings(evolution_generations=5, descent_evals=50)
+    kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": short}
     assert Solver(**kw).evolutions is None and Solver(**kw).evolutions_of(problem) == 4
     assert Solver(**Solver(**kw).options()).evolutions is None  # a worker's Solver decides the same way
     r = Solver(**kw).solve(problem, use_analytic=False, diagnose=False)

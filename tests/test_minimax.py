@@ -127,7 +127,7 @@ def test_the_solver_descends_the_descents_ends_again_by_the_sqp_and_counts_them(
     problem = type_problem("crank-rocker-slider", 2.017, 1.9568, **KW)
     ends = descents.descended(problem, 20, seed=0, keep=2, evals=300)
     s = qropt.Solver()
-    more, sqp = polished(problem, None, ends, s.settings.polished)
+    more, sqp = polished(problem, None, ends, s.settings)
     added = sqp["sqp_ends"]
     assert added >= 1 and len(more) == len(ends) + added
     assert [e.value for e in more] == sorted(e.value for e in more)
@@ -145,7 +145,7 @@ def test_the_solver_descends_the_descents_ends_again_by_the_sqp_and_counts_them(
     grid = np.abs(r.mechanism.dynamics(np.linspace(0, 2 * np.pi, 40_001), OMEGA2, masses=MASSES, loads=LOADS).torque)
     assert grid.max() <= r.objective * (1 + 1e-12) and grid.max() == pytest.approx(r.objective, rel=1e-6)
     kinematic = type_problem("crank-rocker-slider", 2.017, 1.9568, objective="min_peak_accel")
-    same, none = polished(kinematic, None, ends, s.settings.polished)
+    same, none = polished(kinematic, None, ends, s.settings)
     assert same == ends and none["sqp_ends"] == 0
 
 

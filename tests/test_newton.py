@@ -14,6 +14,7 @@ import qropt
 from problems import chart_crank_rocker as cr
 from qropt.studies._chart import Axis, axis_kind, problem_at
 from qropt.synthesis import newton
+from qropt.synthesis.settings import Settings
 from qropt.synthesis.solver import Solver
 
 NEWTON = "Newton on the neighbour's active set"
@@ -42,7 +43,7 @@ def test_the_kkt_functions_derivatives_are_the_finite_differences(row):
     form = h.form
     pv = form.param_vector(problems[3], problems[3].targets, h.blocks["samples"], h.blocks["fractions"])
     lam = np.random.default_rng(1).normal(size=h.lam_g.size)
-    fun = newton._functions(form)
+    fun = newton._functions(form, Settings().newton_size)
     f, df, g, J, H = newton._evaluate(fun, h.w, pv, lam)
     step = 1e-6
     for i in range(h.w.size):

@@ -18,7 +18,7 @@ import qropt
 from benchmarks.tasks import LOADS, MASSES, OMEGA2
 from qropt import ProblemError, Solver
 from qropt.studies._design import TYPES, design, type_problem
-from qropt.synthesis import criteria, evolution, minimax, search, starts
+from qropt.synthesis import criteria, minimax, search, starts
 from qropt.synthesis.search import Settings
 from qropt.synthesis.search.local_solves import LocalSolves
 from tests.toy_strategy import GridStarts
@@ -64,7 +64,7 @@ def _accepted(problem, plan) -> list[str]:
     return [s.name for s in (*search.DEFAULT, *search.STARTS) if s.accepts(problem, plan)]
 
 
-def test_a_dynamic_criterion_in_one_file_gets_the_searches_the_shipped_ones_get(monkeypatch):
+def test_a_dynamic_criterion_in_one_file_gets_the_searches_the_shipped_ones_get():
     """A user's copy of the peak torque (tests/toy_dynamic_criterion.py): every strategy that accepts the shipped
     criterion's problem accepts its problem (the guarded multi-start, the evolution, the SQP on the exact peak among
     them), and a solve by it (a shortened evolution) gives the shipped criterion's row to the last bit."""
@@ -76,8 +76,7 @@ def test_a_dynamic_criterion_in_one_file_gets_the_searches_the_shipped_ones_get(
     assert _accepted(toy, plan) == _accepted(shipped, plan)
     assert {"transmission guard", "differential evolution"} <= set(_accepted(toy, plan))
     assert minimax.applies(toy)
-    monkeypatch.setattr(evolution, "DESCENT_EVALS", 100)  # a short search, the same for both
-    solver = Solver(starts_n=2, settings=Settings(evolution_generations=5))
+    solver = Solver(starts_n=2, settings=Settings(evolution_generations=5, descent_evals=100))  # a short search
     a, b = solver.solve(shipped), solver.solve(toy)
     assert a.status == b.status and a.success, (a.message, b.message)
     assert b.objective == a.objective and b.params == a.params

@@ -11,8 +11,8 @@ One function serves every design and mass model of a type: the parameters, the b
 inertias, omega2, alpha2, gravity, the length unit and a load known beforehand (a constant cutting force, a
 follower's torque) are its inputs. A load that depends on the motion (a table of the ram's position, friction's
 iteration) is added in numpy: the superposed variant gives the unknowns per unit load too. General loads (forces,
-torques, a gravity vector: ``qropt.dynamics.applied``) are not its inputs: ``inverse`` solves them on the jets in
-numpy.
+torques, a gravity vector: ``qropt.dynamics.applied``) and pin friction are not its inputs: ``inverse`` solves them
+on the jets in numpy (``parts`` refuses them with UnsupportedLoad where it is given the loads).
 """
 
 from __future__ import annotations
@@ -85,10 +85,21 @@ def _function(m, s, superposed: bool) -> casadi.Function:
     return casadi.Function(f"dynamics_{type(m).__name__}", [z], [f(*args)], CSE)
 
 
-def parts(m, s, t, omega2, alpha2, g, k, known=None, superposed=False):
+def parts(m, s, t, omega2, alpha2, g, k, known=None, superposed=False, loads=None):
     """``elimination.Parts`` from the structure's Function (``known``: the load that does not depend on the motion,
     (n,) on the load's row, or None), or None where a row is not finite (a singular angle, which the numpy route
-    reports)."""
+    reports). ``loads``: checked where given (UnsupportedLoad for pin friction and the general loads, which
+    ``inverse`` solves on the jets in numpy)."""
+    if loads is not None and loads.pin_friction is not None:
+        raise UnsupportedLoad(
+            "the compiled dynamics kernel cannot apply pin friction (Loads.pin_friction): its moments need the "
+            "elimination per unit moment; inverse_dynamics solves it on the jets in numpy"
+        )
+    if loads is not None and loads.general:
+        raise UnsupportedLoad(
+            f"the compiled dynamics kernel cannot apply {loads.general[0]}; inverse_dynamics applies it on the jets "
+            "in numpy"
+        )
     if isinstance(g, tuple):
         raise UnsupportedLoad(
             f"the compiled dynamics kernel cannot apply gravity {g} yet (it takes a number g along -y); "

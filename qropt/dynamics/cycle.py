@@ -18,7 +18,7 @@ import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from qropt.dynamics import applied
-from qropt.dynamics.inverse import _solve, require_sense, system_of, working_way
+from qropt.dynamics.inverse import _solve, energy, pin_rest_angles, require_sense, system_of, working_way
 from qropt.dynamics.model import Loads, Masses
 from qropt.validate import LIMIT, number
 
@@ -67,6 +67,52 @@ class Flywheel:
     return_energy: float
 
 
+@dataclass(frozen=True)
+class StrokeWork:
+    """The energy over a stroke (or a turn), J: ``input`` the crank's work (the integral of T omega2 dt), ``output``
+    what the loads absorb (the cutting force, the follower's torque, the forces and torques: negative where they
+    drive on balance), ``friction`` what friction dissipates (the pins' and the slide's, >= 0), ``pins``: joint ->
+    J, each pin's share of it, ``stored`` the change of the energy the mechanism stores over it (kinetic and
+    gravity's potential, 0 over a turn at constant speed): input = output + friction + stored exactly.
+
+    ``efficiency``: the output over the input net of the stored energy, output / (output + friction), where the
+    crank drives the loads (``driven_by == "crank"``, output > 0); where the loads deliver energy on balance
+    (``driven_by == "loads"``, output < 0: a driving load) it is read the other way, the energy that reaches the
+    crank over the energy the loads deliver, (output + friction) / output, so that it is in (-inf, 1] both ways and
+    1 without friction (negative where the friction takes more than the loads deliver: the crank drives after
+    all). NaN where the loads do no work (output = 0: ``driven_by`` None)."""
+
+    input: float
+    output: float
+    friction: float
+    pins: dict
+    stored: float
+    efficiency: float
+    driven_by: str | None
+
+
+@dataclass(frozen=True)
+class Efficiency:
+    """The mechanical efficiency of the working stroke, the return stroke and the turn at a constant omega2
+    (``StrokeWork`` each; ``CycleDynamics.efficiency``)."""
+
+    working: StrokeWork
+    return_stroke: StrokeWork
+    turn: StrokeWork
+
+
+def _stroke_work(w_in: float, w_f: float, pins: dict, stored: float) -> StrokeWork:
+    out = w_in - w_f - stored
+    net = out + w_f
+    if out > 0:
+        eff, by = out / net, "crank"
+    elif out < 0:
+        eff, by = net / out, "loads"
+    else:
+        eff, by = math.nan, None
+    return StrokeWork(w_in, out, w_f, pins, stored, eff, by)
+
+
 class CycleDynamics:
     """The dynamics of one mechanism, masses and loads at omega2 and alpha2, evaluated at any crank angles."""
 
@@ -88,6 +134,8 @@ class CycleDynamics:
         self.working_pieces = (first, not first)
         self.switching = self.loads.jumps and way is not None
         self.edges = applied.edges(m, self.loads)  # a window's ends, a table's corners: the quadrature splits there
+        if self.loads.pin_friction is not None:  # and where a pin's friction moment turns with its relative rotation
+            self.edges = sorted({*self.edges, *pin_rest_angles(m, self.system, self.loads.pin_friction)})
 
     def at(self, theta2, working=None):
         """The dynamics at crank angles theta2 (rad); ``working`` forces the cutting force on or off."""
@@ -187,6 +235,14 @@ class CycleDynamics:
             peak_shaking_moment=self.peak(lambda d: np.abs(d.shaking_moment)),
         )
 
+    def efficiency(self) -> Efficiency:
+        """The mechanical efficiency of the working stroke, the return stroke and the turn (``Efficiency``,
+        ``StrokeWork``): the crank's work and the friction's (the pins' and the slide's) by Gauss-Legendre on each
+        stroke, split where the loads switch and where a pin's relative rotation turns; the loads' work from the
+        power balance, input - friction - the stored energy's change (kinetic and gravity's, exact at the
+        strokes' ends). At a constant, nonzero omega2."""
+        return _efficiency(self)
+
     def flywheel(self, cs: float) -> Flywheel:
         """See ``Flywheel``: the energy's extremes where T = T_mean, each root refined by brentq."""
         from qropt.errors import InvalidParameter
@@ -226,6 +282,69 @@ class CycleDynamics:
         return Flywheel(cs, self.omega2, delta, inertia, mean, sense * TWO_PI * mean, w, r)
 
 
+def _efficiency(cd: CycleDynamics) -> Efficiency:
+    from qropt.errors import InvalidParameter
+
+    if cd.omega2 == 0 or cd.alpha2 != 0:
+        raise InvalidParameter("the efficiency is taken at a constant, nonzero omega2 (alpha2 = 0)")
+    x, w = np.polynomial.legendre.leggauss(GAUSS)
+    rate = abs(cd.omega2)
+    sense = math.copysign(1.0, cd.omega2)
+    kinks = _kinks(cd)
+    strokes = []
+    for lo, hi in cd.pieces:
+        w_in, w_f, pins = 0.0, 0.0, {}
+        cuts = sorted(c for c in (lo + (e - lo) % TWO_PI for e in kinks) if lo < c < hi)
+        pieces = [p for a, b in zip([lo, *cuts], [*cuts, hi], strict=True) for p in cd._split(a, b)]
+        for a, b in pieces:
+            t = (0.5 * (b - a) * x + 0.5 * (b + a)) % TWO_PI
+            d = cd.at(t)
+            h = 0.5 * (b - a) * w
+            w_in += sense * float(np.dot(h, d.torque))  # T omega2 dt = sign(omega2) T dtheta2
+            lost = d.pin_friction_power
+            if "slide" in d.joint_forces and cd.loads.friction:
+                lost = lost + np.abs(d.joint_forces["slide"][:, 0] * energy(cd.m, cd.system, t, cd.omega2, cd.loads)[1])
+            w_f += float(np.dot(h, lost)) / rate  # P dt = P dtheta2 / |omega2|
+            for j, v in (d.pin_power_loss or {}).items():
+                pins[j] = pins.get(j, 0.0) + float(np.dot(h, v)) / rate
+        ends = energy(cd.m, cd.system, np.array([lo, hi]) % TWO_PI, cd.omega2, cd.loads)[0]
+        strokes.append((w_in, w_f, pins, float(ends[1] - ends[0])))
+    first, second = (_stroke_work(*v) for v in strokes)
+    turn = _stroke_work(
+        first.input + second.input,
+        first.friction + second.friction,
+        {j: first.pins[j] + second.pins[j] for j in first.pins},
+        0.0,  # a turn at constant speed stores nothing
+    )
+    working, back = (first, second) if cd.working_pieces[0] else (second, first)
+    return Efficiency(working, back, turn)
+
+
+def _kinks(cd: CycleDynamics) -> list[float]:
+    """The crank angles (rad) where a force that friction reads passes through zero (the friction's |F| has a kink
+    there: a massless block's pin force along its slot's normal, the guide's normal force), inside the strokes:
+    a grid's sign changes of F(theta) . F(theta_i), refined by brentq."""
+    if cd.loads.pin_friction is None and not cd.loads.friction:
+        return []
+    out = []
+    for lo, hi in cd.pieces:
+        t = np.linspace(lo, hi, GRID // 2 + 1)[1:-1]
+        forces = cd.at(t % TWO_PI).joint_forces
+        for name, f in forces.items():
+            if name == "slide":
+                f = f * np.array([0.0, 1.0])
+            dots = np.einsum("nd,nd->n", f[:-1], f[1:])
+            for i in np.flatnonzero(dots < 0):
+                ref = f[i]
+
+                def along(th, name=name, ref=ref):
+                    v = cd.at(np.array([th % TWO_PI])).joint_forces[name][0]
+                    return float(v[1] * ref[1] if name == "slide" else v @ ref)
+
+                out.append(brentq(along, t[i], t[i + 1], xtol=1e-13) % TWO_PI)
+    return out
+
+
 def _first_is_working(m, omega2, way=None) -> bool:
     """Whether the crank interval theta_max -> theta_min (counter-clockwise) is the working stroke (``way``: its
     direction, default the slow stroke's)."""
@@ -236,4 +355,4 @@ def _first_is_working(m, omega2, way=None) -> bool:
     return bool(_working(m, np.array([(d.theta_max + a / 2) % TWO_PI]), omega2, way)[0])
 
 
-__all__ = ["CycleDynamics", "DynamicExtremes", "Flywheel", "Peak"]
+__all__ = ["CycleDynamics", "DynamicExtremes", "Efficiency", "Flywheel", "Peak", "StrokeWork"]

@@ -52,41 +52,110 @@ def _count(what: str, v, lo: int, hi: int) -> int:
 
 @dataclass(frozen=True)
 class Motor:
-    """A motor's torque (N m) against the crank's speed (rad/s), both in the sense of rotation: the line
+    """A motor's torque (N m) against its speed (rad/s), both in the sense of rotation: the line
     ``T = stall * (1 - omega / free_speed)``; ``free_speed = inf`` is a constant torque ``stall``. Build one with
-    ``Motor.constant(torque)`` or ``Motor.line(stall, free_speed)``."""
+    ``Motor.constant(torque)``, ``Motor.line(stall, free_speed)`` or ``Motor.induction(...)``. Driving the crank
+    directly, its speed is the crank's; through a ``qropt.dynamics.drive.Drive``, the motor shaft's.
+
+    Optional ratings (keyword-only; None: not rated): ``rated_torque`` (N m, continuous: the RMS torque it may
+    carry), ``peak_torque`` (N m, >= rated: the line's torque is capped at +-peak_torque, a breakdown torque),
+    ``rated_speed`` (rad/s) and ``inertia`` (the rotor's, kg m^2, default 0; it counts through a ``Drive``)."""
 
     stall: float
     free_speed: float = math.inf
+    rated_torque: float | None = dataclasses.field(default=None, kw_only=True)
+    peak_torque: float | None = dataclasses.field(default=None, kw_only=True)
+    rated_speed: float | None = dataclasses.field(default=None, kw_only=True)
+    inertia: float = dataclasses.field(default=0.0, kw_only=True)
 
     def __post_init__(self):
         object.__setattr__(self, "stall", _real("the motor's torque (N m)", self.stall))
         fs = _real("the motor's free speed (rad/s)", self.free_speed, positive=True, allow_inf=True)
         object.__setattr__(self, "free_speed", fs)
+        for name, what in (
+            ("rated_torque", "the motor's rated_torque (N m, continuous)"),
+            ("peak_torque", "the motor's peak_torque (N m)"),
+            ("rated_speed", "the motor's rated_speed (rad/s)"),
+        ):
+            v = getattr(self, name)
+            if v is not None:
+                object.__setattr__(self, name, _real(what, v, positive=True))
+        object.__setattr__(
+            self, "inertia", _real("the motor's inertia (kg m^2, the rotor's)", self.inertia, nonneg=True)
+        )
+        if self.rated_torque is not None and self.peak_torque is not None and self.peak_torque < self.rated_torque:
+            raise InvalidParameter(
+                f"the motor's peak_torque ({self.peak_torque:g} N m) must be at least its rated_torque "
+                f"({self.rated_torque:g} N m)"
+            )
 
     @classmethod
-    def constant(cls, torque: float) -> Motor:
-        """A constant torque (N m; positive drives the crank the way it turns)."""
-        return cls(torque)
+    def constant(cls, torque: float, **ratings) -> Motor:
+        """A constant torque (N m; positive drives the crank the way it turns); ``ratings``: see the class."""
+        return cls(torque, **ratings)
 
     @classmethod
-    def line(cls, stall: float, free_speed: float) -> Motor:
+    def line(cls, stall: float, free_speed: float, **ratings) -> Motor:
         """The torque-speed line: ``stall`` (N m) at rest, zero at ``free_speed`` (rad/s, finite, > 0)."""
         if isinstance(free_speed, (int, float)) and not isinstance(free_speed, bool) and free_speed == math.inf:
             raise InvalidParameter(
                 "a line motor's free speed must be finite (use Motor.constant for a constant torque)"
             )
-        return cls(stall, free_speed)
+        return cls(stall, free_speed, **ratings)
+
+    @classmethod
+    def induction(
+        cls, rated_torque: float, rated_speed: float, synchronous_speed: float, *, peak_torque=None, inertia=0.0
+    ) -> Motor:
+        """An induction motor near its operating point: the slip line through (``rated_speed``, ``rated_torque``)
+        and zero torque at ``synchronous_speed`` (rad/s, > rated_speed), capped at ``peak_torque`` (N m) if given.
+        The line's stall torque, ``rated_torque * synchronous_speed / (synchronous_speed - rated_speed)``, is far
+        above a real motor's starting torque: cap it with the breakdown torque for a start-up."""
+        tr = _real("the motor's rated_torque (N m, continuous)", rated_torque, positive=True)
+        wr = _real("the motor's rated_speed (rad/s)", rated_speed, positive=True)
+        ws = _real("the motor's synchronous_speed (rad/s)", synchronous_speed, positive=True)
+        if not ws > wr:
+            raise InvalidParameter(
+                f"an induction motor's synchronous_speed ({ws:g} rad/s) must exceed its rated_speed ({wr:g} rad/s)"
+            )
+        return cls(tr * ws / (ws - wr), ws, rated_torque=tr, peak_torque=peak_torque, rated_speed=wr, inertia=inertia)
 
     @property
     def is_constant(self) -> bool:
         return self.free_speed == math.inf
 
     def torque(self, omega):
-        """N m at speed omega (rad/s; a number or an array), both in the sense of rotation."""
+        """N m at speed omega (rad/s; a number or an array), both in the sense of rotation; within +-peak_torque
+        when the motor has one."""
         w = np.asarray(omega, float)
         out = np.full(w.shape, self.stall) if self.is_constant else self.stall * (1.0 - w / self.free_speed)
+        if self.peak_torque is not None:
+            out = np.clip(out, -self.peak_torque, self.peak_torque)
         return float(out) if out.ndim == 0 else out
+
+
+def _torque_of(motor):
+    """The torque-speed function of a Motor or of a callable (its values checked to be finite numbers)."""
+    if isinstance(motor, Motor):
+        return motor.torque
+    if not callable(motor) or isinstance(motor, type):
+        raise InvalidParameter(
+            "motor is a qropt Motor (Motor.constant or Motor.line) or a callable torque(omega), got "
+            f"{type(motor).__name__}"
+        )
+
+    def torque(omega):
+        try:
+            out = np.asarray(motor(omega), float)
+        except (TypeError, ValueError):
+            out = np.array(math.nan)
+        if out.shape != np.shape(omega) or not np.all(np.isfinite(out)):
+            raise InvalidParameter(
+                f"the motor's torque(omega) must give a finite number per speed, got {out!r:.80} at {omega!r:.80}"
+            )
+        return float(out) if out.ndim == 0 else out
+
+    return torque
 
 
 class TurnSpeeds(NamedTuple):
@@ -178,9 +247,11 @@ def simulate(
 ) -> Simulation:
     """Integrate the crank's equation of motion (see the module) from theta2 = 0, omega2 = omega0 (rad/s, nonzero:
     its sign is the sense of rotation) over ``turns`` turns, under ``motor`` with a flywheel of ``flywheel`` kg m^2
-    on the crank; masses, loads: ``qropt.Masses`` and ``qropt.Loads`` (default massless, none)."""
-    if not isinstance(motor, Motor):
-        raise InvalidParameter(f"motor is a qropt Motor (Motor.constant or Motor.line), got {type(motor).__name__}")
+    on the crank; masses, loads: ``qropt.Masses`` and ``qropt.Loads`` (default massless, none). ``motor`` is a
+    ``Motor`` or a callable ``torque(omega)``: the torque (N m) on the crank at the crank's speed omega (rad/s),
+    both in the sense of rotation, for a number and for an array of speeds (``Drive.crank_torque``: a motor seen
+    through a gearbox)."""
+    torque_of = _torque_of(motor)
     masses = Masses() if masses is None else masses
     loads = Loads() if loads is None else loads
     if not isinstance(masses, Masses):
@@ -225,7 +296,7 @@ def simulate(
         nonlocal nfev
         nfev += 1
         w = y[1]
-        torque = sense * motor.torque(sense * w)
+        torque = sense * torque_of(sense * w)
         if system is not None:  # the slide's friction: from the Newton-Euler system (it depends on alpha2)
             return [w, crank_acceleration(m, system, y[0], w, loads, torque, fw)]
         g = gen(y[0])
@@ -278,7 +349,7 @@ def simulate(
     t, th, w = _sample(pieces, ppt, sense, end)
     if stalled:
         t, th, w = np.append(t, stall_time), np.append(th, y0[0]), np.append(w, y0[1])
-    torque = sense * motor.torque(sense * w)
+    torque = sense * torque_of(sense * w)
     return Simulation(t, th, w, np.asarray(torque, float), stalled, stall_time, turns, ppt, fw, nfev)
 
 

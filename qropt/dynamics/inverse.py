@@ -26,7 +26,7 @@ from qropt.dynamics import applied, compiled
 from qropt.dynamics.elimination import Elimination, Parts, pivots
 from qropt.dynamics.model import BodyMass, Loads, Masses, slender_bar, union
 from qropt.dynamics.rigid import body_motion, is_zero, shaking
-from qropt.errors import DegenerateMechanism, InvalidParameter, SlideLocked
+from qropt.errors import DegenerateMechanism, InvalidParameter, PinLocked, SlideLocked, UnsupportedLoad
 from qropt.kinematics.ops import JET, Jet
 from qropt.validate import LIMIT, number
 
@@ -41,7 +41,10 @@ class Dynamics:
     joint_forces: joint -> (n, 2) N, what the driven body receives across the joint ('O2' the crank's ground
     bearing; 'slide' the guide's force on the ram: its normal force and, with friction, the friction along x);
     shaking_force: (n, 2) N, ``-sum(m a_G)``; shaking_moment: (n,) N m about O2, ``-sum(r_G x m a_G + I alpha)``;
-    guide_moment: (n,) N m the yoke-ram's guide carries (None without a yoke)."""
+    guide_moment: (n,) N m the yoke-ram's guide carries (None without a yoke). With pin friction
+    (``Loads.pin_friction``): pin_moments: joint -> (n,) N m, the friction moment the driven body receives across the
+    pin (the driving body the opposite one), ``-mu r |F| sign(omega_rel)`` with omega_rel the driven body's angular
+    velocity less the driving body's; pin_power_loss: joint -> (n,) W >= 0, ``|M omega_rel|`` (None without)."""
 
     theta2: np.ndarray
     omega2: float
@@ -51,6 +54,15 @@ class Dynamics:
     shaking_force: np.ndarray
     shaking_moment: np.ndarray
     guide_moment: np.ndarray | None = None
+    pin_moments: dict | None = None
+    pin_power_loss: dict | None = None
+
+    @property
+    def pin_friction_power(self) -> np.ndarray:
+        """(n,) W >= 0, the power the pins' friction dissipates (0 without pin friction)."""
+        if not self.pin_power_loss:
+            return np.zeros(self.theta2.shape)
+        return np.sum(list(self.pin_power_loss.values()), axis=0)
 
     @property
     def power(self) -> np.ndarray:
@@ -247,9 +259,12 @@ class _System:
         conns = list(link.connections())
         block = next((b for b in bodies if b.kind == "block"), None)
         self.block_massive = block is not None and massive(block.name)
+        self.all_bodies = {b.name: b for b in bodies}
+        self.pins = [c for c in conns if c.kind == "pin"]  # every revolute joint (pin friction acts there)
+        self.block_pin = None
         if block is not None and not self.block_massive:  # crank -> lever straight along the slot's normal
             bodies = [b for b in bodies if b is not block]
-            pin = next(c for c in conns if c.receiver == block.name and c.kind == "pin")
+            pin = self.block_pin = next(c for c in conns if c.receiver == block.name and c.kind == "pin")
             conns = [
                 c._replace(giver=pin.giver) if c.giver == block.name else c
                 for c in conns
@@ -402,7 +417,7 @@ def _kinetics(m, s: _System, t, omega2, alpha2, k, rates: bool = False):
     return (pts, P, kin, vel) if rates else (P, kin, vel)
 
 
-def _loaded(m, s: _System, t, omega2, alpha2, loads, working=None) -> tuple:
+def _loaded(m, s: _System, t, omega2, alpha2, loads, working=None, keep=None) -> tuple:
     """One solve's parts with its loads at crank angles t: (parts, the load on the ram's row (an (n,) array, or
     None: it is in the parts), the guide's column where the slide has friction and the ram's velocity's sign
     there, else (None, None)). ``working`` as ``_solve``."""
@@ -422,17 +437,20 @@ def _loaded(m, s: _System, t, omega2, alpha2, loads, working=None) -> tuple:
         known = np.where(working, loads.follower_torque * way, 0.0)
     general = applied.resolve(m, s, linkage_of(m), loads) if loads.general else None
     # the compiled kernel takes the shorthands only: general loads take the jets and numpy
+    # (and pin friction, which needs the elimination itself: ``keep``)
     a = (
         None
-        if general is not None
-        else compiled.parts(m, s, t, omega2, alpha2, loads.gravity, k, known, table or sliding)
+        if general is not None or keep is not None
+        else compiled.parts(m, s, t, omega2, alpha2, loads.gravity, k, known, table or sliding, loads)
     )
     if a is None:
         ends = np.where(working, way, -way) if forced and way else None
         extra = None if general is None else (loads, general, working, ends)
-        a = _numpy_parts(m, s, t, omega2, alpha2, loads.gravity, k, known, extra)
+        a = _numpy_parts(m, s, t, omega2, alpha2, loads.gravity, k, known, extra, keep)
     # along x, through the ram's point (no moment about a yoke's centre on its line)
     load = np.where(working, loads.force_at(a.x_out), 0.0) * way if table else None
+    if keep is not None and sliding:
+        keep["sigma"] = _velocity_sign(a, working, way, forced)
     if not sliding:
         return a, load, None, None
     return a, load, guide_col, _velocity_sign(a, working, way, forced)
@@ -448,11 +466,16 @@ def _singular(m) -> DegenerateMechanism:
 def _solve(m, s: _System, t, omega2, alpha2, loads, working=None) -> Dynamics:
     """``working``: the cutting force's state at every angle (True on, False off; None: by the stroke)."""
     n = t.size
+    pf = loads.pin_friction
+    keep = {} if pf is not None else None
+    pin_out = None
     try:
-        a, load, col, sigma = _loaded(m, s, t, omega2, alpha2, loads, working)
+        a, load, col, sigma = _loaded(m, s, t, omega2, alpha2, loads, working, keep)
         x = a.solve(load)
         friction = np.zeros(n)
-        if col is not None:
+        if pf is not None:
+            x, friction, pin_out = _with_pins(m, s, t, omega2, a, x, load, col, loads, keep)
+        elif col is not None:
             x, friction = _with_friction(m, t, a, x, load, col, loads.friction, sigma)
     except np.linalg.LinAlgError:
         raise _singular(m) from None
@@ -469,7 +492,8 @@ def _solve(m, s: _System, t, omega2, alpha2, loads, working=None) -> Dynamics:
     sfx, sfy, sm = a.shaking
     gm = x[s.guide_moment_col] if s.yoke is not None else None
     sm = np.broadcast_to(sm, t.shape).astype(float)
-    return Dynamics(t, omega2, alpha2, x[0], forces, _pairs(sfx, sfy, n), sm, gm)
+    moments, losses = pin_out if pin_out is not None else (None, None)
+    return Dynamics(t, omega2, alpha2, x[0], forces, _pairs(sfx, sfy, n), sm, gm, moments, losses)
 
 
 def friction_load(xp, n0, n1, mu, sigma):
@@ -478,6 +502,255 @@ def friction_load(xp, n0, n1, mu, sigma):
     |N| = |N0| / (1 - mu sigma N1 sign(N0)), sigma the sign of the ram's velocity. The one solution while
     mu |N1| < 1 (beyond it the slide locks). xp: numpy, or casadi for the NLP's expressions."""
     return mu * sigma * xp.fabs(n0) / (1 - mu * sigma * n1 * xp.sign(n0))
+
+
+PIN_REST = 1e-12  # a pin's relative rotation below this times |omega2| (rad/s) is at rest: no friction moment
+NEWTON_STEPS = 60  # Newton's iterations on the friction moments (quadratic: a handful where it converges)
+GAIN_STEPS = 200  # power iterations on the friction loop's gain
+
+
+def pin_table(m, s: _System, pf) -> list[tuple]:
+    """The pins with friction: (joint, mu r (m), driven body, driving body, the body the driven side's moment goes
+    to in the system (None: the ground or a point ram, whose guide carries it), the driving side's, the force's
+    column in the unknowns, whether that column is a slot's normal force (the massless block's pin)). The joints
+    named in ``pf.joints`` are checked: InvalidParameter naming one that is not a pin."""
+    pins = [c.joint for c in s.pins]
+    for j in pf.joints:
+        if j not in pins:
+            what = "a slot or the ram's guide, not a pin" if any(c.joint == j for c in s.conns) else "not a joint"
+            raise InvalidParameter(
+                f"pin friction at {j}: {type(m).__name__}'s {j} is {what}; its pins (revolute joints): {pins}"
+            )
+    held = {b.name: b.kind for b in s.bodies}
+
+    def row_of(body):
+        return None if body not in held or held[body] == "ram" else body
+
+    out = []
+    for c in s.pins:
+        mu, r = pf.at(c.joint)
+        if mu * r == 0:
+            continue
+        if c is s.block_pin:  # the massless block passes the pin's force and moment on to the lever
+            slot = next(q for q, _, _ in s.cols if q.kind == "slot" and q.joint == c.joint and q.giver == c.giver)
+            col = next(k for q, k, _ in s.cols if q is slot)
+            out.append((c.joint, mu * r, c.receiver, c.giver, row_of(slot.receiver), row_of(c.giver), col, True))
+        else:
+            col = next(k for q, k, _ in s.cols if q is c)
+            out.append((c.joint, mu * r, c.receiver, c.giver, row_of(c.receiver), row_of(c.giver), col, False))
+    return out
+
+
+def pin_spins(s: _System, table, pts) -> list:
+    """Each pin's relative angular velocity (rad/s, or per unit crank angle): the driven body's less the driving
+    body's (``rigid.frame``; the ground's and a ram's are 0)."""
+    from qropt.dynamics.rigid import frame
+
+    def spin(body):
+        if body == "ground":
+            return 0.0
+        return frame(s.all_bodies[body], pts)[1][2]
+
+    return [spin(p[2]) - spin(p[3]) for p in table]
+
+
+def _with_pins(m, s: _System, t, omega2, a: Parts, x, load, col, loads, keep) -> tuple:
+    """The unknowns with Coulomb friction at the pins (and the slide's, if any), solved exactly: every unknown is
+    affine in the friction moments z_j (and the slide's friction load), x = x0 + sum z_j u_j (u_j the unknowns
+    per unit moment, from the same elimination), and z_j = -mu_j r_j |F_j(x)| sign(omega_rel_j) (the slide's
+    e = mu sigma |N(x)|). Newton on G(z) = z + c |F(x0 + U z)| from z = 0 (the frictionless solution) to machine
+    precision, all angles at once. Where a pin is at rest relative to its bodies (|omega_rel| <= PIN_REST |omega2|,
+    or omega2 = 0) its moment is 0 (kinetic friction only: a pin at rest may hold any moment up to mu r |F|).
+    PinLocked (SlideLocked for the slide alone) where the friction loop's gain (``_gain``) reaches 1, or where
+    Newton finds no solution. Returns (x, the slide's friction along x, (pin_moments, pin_power_loss))."""
+    n = t.size
+    table = pin_table(m, s, loads.pin_friction)
+    spins = [np.broadcast_to(np.asarray(w, float), (n,)) for w in pin_spins(s, table, keep["pts"])]
+    elim = keep["elim"]
+    c, F0, names, units = [], [], [], []
+    rest = PIN_REST * abs(omega2)
+    for (joint, mur, _, _, recv, giver, k, slot), w in zip(table, spins, strict=True):
+        c.append(mur * np.where(np.abs(w) > rest, np.sign(w), 0.0))
+        rhs = {}
+        if recv is not None:
+            rhs[s.rows[recv] + 2] = -1.0  # a unit moment on the driven body leaves its row's right-hand side
+        if giver is not None:
+            rhs[s.rows[giver] + 2] = 1.0
+        units.append(elim.solve(rhs) if rhs else [0.0] * s.n)
+        F0.append(_force(x, k, slot, a, joint, n))
+        names.append(joint)
+    sliding = col is not None and loads.friction
+    if sliding:
+        sigma = keep["sigma"]
+        unit = _per_newton(a, x, load)
+        n1 = unit[col]
+        locked = (loads.friction * np.abs(n1) >= 1.0) & (sigma != 0)
+        if locked.any():
+            i = int(np.flatnonzero(locked)[0])
+            raise _locked(m, loads.friction, n1[i], t[i])
+        c.append(-loads.friction * sigma)
+        F0.append(_scalar_force(x[col], n))
+        names.append("the slide")
+        units.append(unit)
+    p = len(c)
+    if p == 0:  # no pin has friction (mu r = 0 at every pin) and the slide has none
+        zeros = {c_.joint: np.zeros(n) for c_ in s.pins}
+        return x, np.zeros(n), (zeros, {j: v.copy() for j, v in zeros.items()})
+    cols = [(p_[6], p_[7]) for p_ in table] + ([(col, None)] if sliding else [])
+    # Uf[j, k]: (2, n), the force at entry j per unit of entry k
+    Uf = np.empty((p, p, 2, n))
+    for k_ in range(p):
+        for j, (kc, slot) in enumerate(cols):
+            if slot is None:
+                Uf[j, k_] = _scalar_force(units[k_][kc], n)
+            else:
+                Uf[j, k_] = _force(units[k_], kc, slot, a, names[j], n)
+    C = np.array(c)  # (p, n)
+    F0 = np.array(F0)  # (p, 2, n)
+    gain, share = _gain(C, Uf)
+    locked = gain >= 1.0
+    if locked.any():
+        i = int(np.flatnonzero(locked)[0])
+        raise _pin_locked(m, t[i], names[int(np.argmax(share[:, i]))], float(gain[i]), "jam")
+    z = np.zeros((p, n))
+    eye = np.eye(p)[:, :, None]
+    for _ in range(NEWTON_STEPS):
+        F = F0 + np.einsum("jkdn,kn->jdn", Uf, z)
+        norm = np.hypot(F[:, 0], F[:, 1])
+        G = z + C * norm
+        hat = F / np.where(norm > 0, norm, 1.0)[:, None, :]
+        J = eye + C[:, None, :] * np.einsum("jdn,jkdn->jkn", hat, Uf)
+        try:
+            step = np.linalg.solve(J.transpose(2, 0, 1), G.T[:, :, None])[:, :, 0].T
+        except np.linalg.LinAlgError:  # a singular Newton step: no solution found where it is
+            i = int(np.flatnonzero(np.abs(np.linalg.det(J.transpose(2, 0, 1))) <= 1e-300)[:1].sum())
+            raise _pin_locked(m, t[i], names[int(np.argmax(share[:, i]))], float(gain[i]), "none") from None
+        z = z - step
+        scale = np.abs(z).max(axis=0) + np.abs(C * np.hypot(F0[:, 0], F0[:, 1])).max(axis=0) + 1e-300
+        done = np.abs(step).max(axis=0) <= 1e-14 * scale
+        if done.all():
+            break
+    F = F0 + np.einsum("jkdn,kn->jdn", Uf, z)
+    norm = np.hypot(F[:, 0], F[:, 1])
+    resid = np.abs(z + C * norm)
+    scale = np.abs(z).max(axis=0) + np.abs(C * norm).max(axis=0) + 1e-300
+    bad = ~np.isfinite(resid).all(axis=0) | (resid.max(axis=0) > 1e-11 * scale)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise _pin_locked(m, t[i], names[int(np.nanargmax(resid[:, i]))], float(gain[i]), "none")
+    out = [xi + sum(z[k_] * units[k_][i_] for k_ in range(p)) for i_, xi in enumerate(x)]
+    friction = -z[-1] if sliding else np.zeros(n)
+    moments = {names[j]: z[j].copy() for j in range(len(table))}
+    losses = {names[j]: np.abs(z[j] * spins[j]) for j in range(len(table))}
+    for c_ in s.pins:  # the pins without friction: no moment, no loss
+        moments.setdefault(c_.joint, np.zeros(n))
+        losses.setdefault(c_.joint, np.zeros(n))
+    return out, friction, (moments, losses)
+
+
+def _force(x, k: int, slot: bool, a: Parts, joint: str, n: int) -> np.ndarray:
+    """(2, n): a pin's force from the unknowns x (its two columns from k; a massless block's pin: the slot's
+    normal force times its normal)."""
+    out = np.empty((2, n))
+    if slot:
+        nx, ny = a.normals[joint]
+        out[0], out[1] = x[k] * nx, x[k] * ny
+    else:
+        out[0], out[1] = x[k], x[k + 1]
+    return out
+
+
+def _scalar_force(v, n: int) -> np.ndarray:
+    out = np.zeros((2, n))
+    out[0] = v
+    return out
+
+
+def _gain(C, Uf) -> tuple:
+    """The friction loop's gain at each angle and the entries' shares in it (the eigenvector's entries times how
+    much each moves the forces: a ground pivot's moment on the crank, which the torque takes, has none): the largest
+    lambda with
+    H(z) = lambda z, z != 0, for the homogeneous map H(z)_j = -c_j |sum_k z_k U_jk| (what the friction moments do
+    to themselves with no load at all), by power iteration on the cone z_k = -sign(c_k) w_k, w >= 0 (H maps into
+    it). lambda >= 1: friction could hold a self-stressed jam within its limits (|z_j| <= mu_j r_j |F_j|), as the
+    slide locks where mu |dN/dF| >= 1 (for one pin, or pins whose moments drive one force, it is exactly
+    |sum c| |u|, the friction-circle condition)."""
+    p, n = C.shape
+    S = -np.sign(C)
+    A = np.abs(C)
+    V = Uf * S[None, :, None, :]  # the force per unit w_k
+    w = np.ones((p, n)) * (A > 0)
+    lam = np.zeros(n)
+    for _ in range(GAIN_STEPS):
+        F = np.einsum("jkdn,kn->jdn", V, w)
+        Tw = A * np.hypot(F[:, 0], F[:, 1])
+        top = Tw.max(axis=0)
+        new = np.where(top > 0, top, 0.0)
+        w_next = Tw / np.where(top > 0, top, 1.0)
+        converged = np.abs(new - lam) <= 1e-13 * np.maximum(new, 1e-300)
+        lam, w = new, w_next
+        if converged.all():
+            break
+    feed = np.sqrt(np.einsum("jkdn,jkdn->kn", V, V))  # how much each entry's moment moves the forces
+    return lam, w * feed
+
+
+def _pin_locked(m, theta: float, joint: str, gain: float, why: str) -> PinLocked:
+    what = (
+        f"the friction moments could hold the linkage jammed by themselves (the friction loop's gain "
+        f"{gain:.4g} >= 1: the joint forces grow with their own friction)"
+        if why == "jam"
+        else "the joint forces have no solution with the friction moments (Newton on them does not converge)"
+    )
+    return PinLocked(
+        f"{m!r}: pin friction locks the linkage at crank angle {math.degrees(theta) % 360:.6g} deg, at pin {joint}: "
+        f"{what}",
+        float(theta % (2 * math.pi)),
+        joint,
+    )
+
+
+def energy(m, s: _System, t, omega2: float, loads) -> tuple:
+    """(E, v) at crank angles t (rad), speed omega2 (rad/s): E (n,) J, the energy the mechanism stores, kinetic
+    (sum m v_G^2 / 2 + I omega^2 / 2) and gravity's potential (-sum m g . r_G); v (n,) m/s, the ram's (or yoke's)
+    velocity along x (zeros without one)."""
+    k = units_.to_metres(m.units)
+    pts = _triples(m.evaluate(JET, Jet.seed(t, omega2, 0.0)), k)
+    gx, gy = loads.gravity_vector
+    E = np.zeros(t.shape)
+    v_out = np.zeros(t.shape)
+    for b in s.bodies:
+        bm = s.props[b.name]
+        G, v, _, ph = body_motion(b, bm.com, pts)
+        E = E + 0.5 * bm.mass * (v[0] ** 2 + v[1] ** 2) + 0.5 * bm.inertia * ph[2] ** 2
+        E = E - bm.mass * (gx * G[0] + gy * G[1])
+        if b.kind in ("ram", "yoke"):
+            v_out = v_out + v[0]
+    return np.broadcast_to(E, t.shape).astype(float), np.broadcast_to(v_out, t.shape).astype(float)
+
+
+def pin_rest_angles(m, s: _System, pf) -> list[float]:
+    """The crank angles (rad, in [0, 2 pi)) where a pin with friction stops turning relative to its bodies: its
+    moment turns there (a quadrature splits its pieces at them). A grid's sign changes refined by brentq."""
+    from scipy.optimize import brentq
+
+    table = pin_table(m, s, pf)
+    if not table:
+        return []
+    k = units_.to_metres(m.units)
+
+    def spins(th):
+        return pin_spins(s, table, _triples(m.evaluate(JET, Jet.seed(np.atleast_1d(th), 1.0, 0.0)), k))
+
+    t = np.linspace(0.0, 2 * math.pi, LENGTH_GRID + 1)
+    out = set()
+    for i, w in enumerate(spins(t)):
+        w = np.broadcast_to(w, t.shape)
+        for j in np.flatnonzero(w[:-1] * w[1:] < 0):
+            root = brentq(lambda th, i=i: float(np.ravel(spins(th)[i])[0]), t[j], t[j + 1], xtol=1e-14)
+            out.add(root % (2 * math.pi))
+        out.update(float(t[j]) % (2 * math.pi) for j in np.flatnonzero(w == 0))
+    return sorted(out)
 
 
 def _velocity_sign(a: Parts, working, way: float, forced: bool) -> np.ndarray:
@@ -523,6 +796,11 @@ def crank_acceleration(m, s: _System, theta: float, omega2: float, loads, torque
     N(alpha2) = N0 + alpha2 dN, piecewise linear in alpha2 with its kink where N vanishes. The balance
     T(alpha2) + I_fw alpha2 = torque is solved on each side of the kink; the answer is the one that lies on its
     own side (DegenerateMechanism where none or two do: friction makes the motion undetermined)."""
+    if loads.pin_friction is not None:
+        raise UnsupportedLoad(
+            "the crank's acceleration under a motor cannot apply pin friction yet (Loads.pin_friction: its moments "
+            "depend on the acceleration through the joint forces); inverse_dynamics applies it"
+        )
     t = np.array([float(theta)])
     try:
         a0, load, col, sigma = _loaded(m, s, t, omega2, 0.0, loads)
@@ -558,7 +836,7 @@ def crank_acceleration(m, s: _System, theta: float, omega2: float, loads, torque
     return found[0]
 
 
-def _numpy_parts(m, s: _System, t, omega2, alpha2, g, k, known=None, general=None) -> Parts:
+def _numpy_parts(m, s: _System, t, omega2, alpha2, g, k, known=None, general=None, keep=None) -> Parts:
     """``Parts`` from the jets and the elimination in numpy (``known``: the load that does not depend on the
     motion, (n,) on the load's row, or None; ``general``: (loads, their ``applied.resolve``, the working stroke's
     mask, the output's way along each closed stroke or None: ``applied.evaluate``'s ends) for the forces, torques
@@ -583,6 +861,8 @@ def _numpy_parts(m, s: _System, t, omega2, alpha2, g, k, known=None, general=Non
         x_out = P[m.output_joint()][0] / k if m.output_joint() else kin[out_body.name][0][0] / k
         v_out = vel[out_body.name][0]
     normals = {c.joint: s.normal(c, P, np.sqrt) for c, _, _ in s.cols if c.kind == "slot"}
+    if keep is not None:  # pin friction: the elimination (for its unit moments) and the joints' rates
+        keep.update(elim=elim, pts=pts)
     return Parts(solve, x_out, v_out, normals, shaking(kin))
 
 
@@ -636,6 +916,11 @@ def generalised(m, theta2, *, masses=None, loads=None, sense: float = 1.0) -> Ge
     loads = Loads() if loads is None else loads
     if loads.friction:
         raise InvalidParameter("friction depends on the speed: it has no place in the generalised load Q")
+    if loads.pin_friction is not None:
+        raise UnsupportedLoad(
+            "pin friction depends on the joint forces (the speed and the acceleration): it has no place in the "
+            "generalised load Q, so simulate and the servo's problem cannot apply it yet; inverse_dynamics does"
+        )
     t = m._angles(theta2)
     s = system_of(m, masses)
     k = units_.to_metres(m.units)
@@ -709,4 +994,4 @@ def _working(m, t, omega2, way=None) -> np.ndarray:
     return decreasing if way == "-x" else ~decreasing
 
 
-__all__ = ["Dynamics", "Generalised", "inverse_dynamics", "generalised", "body_masses", "linkage_of"]
+__all__ = ["Dynamics", "Generalised", "PinLocked", "inverse_dynamics", "generalised", "body_masses", "linkage_of"]

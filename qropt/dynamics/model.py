@@ -451,6 +451,76 @@ def _many(what, kind, v) -> tuple:
     return tuple(out)
 
 
+def _friction_pair(what, v) -> tuple:
+    """(mu, radius) of one pin: a radius (m) with the common mu, or a pair (mu, radius)."""
+    if isinstance(v, dict):
+        v = _keys(what, v, ("mu", "radius"), ())
+        v = (v["mu"], v["radius"])
+    if isinstance(v, (tuple, list)):
+        if len(v) != 2:
+            raise InvalidParameter(f"{what} is a radius (m) or a pair (mu, radius), got {v!r:.80}")
+        return (_real(f"{what}: mu", v[0], nonneg=True), _real(f"{what}: its radius (m)", v[1], positive=True))
+    return None, _real(f"{what}: its radius (m)", v, positive=True)
+
+
+@dataclass(frozen=True)
+class PinFriction:
+    """Coulomb friction at the pins: at a pin of radius r (m) with coefficient mu, a friction moment
+    ``mu * r * |F|`` (F the pin's force) opposing the relative rotation of the two bodies it joins, equal and
+    opposite on them. ``mu`` and ``radius`` hold for every pin (every revolute joint between two bodies, the ground
+    pivots and the crank-pin block's pin included); ``joints``: joint name -> its own radius (m) with the common mu,
+    or a pair (mu, radius) (a joint's mu = 0 takes that pin out). ``radius=None``: only the joints named have
+    friction. Slots (a block or pin sliding in a slot, the yoke's slot) are not pins: their friction is not
+    modelled (the ram's guide has its own, ``Loads.friction``); a joint named here that is not a pin is an error."""
+
+    mu: float = 0.0
+    radius: float | None = None
+    joints: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        object.__setattr__(self, "mu", _real("pin friction: mu (a coefficient)", self.mu, nonneg=True))
+        if self.radius is not None:
+            object.__setattr__(self, "radius", _real("pin friction: the pins' radius (m)", self.radius, positive=True))
+        if not isinstance(self.joints, dict):
+            raise InvalidParameter(
+                f"pin friction: joints is a dict of joint name -> radius or (mu, radius), got {self.joints!r:.120}"
+            )
+        joints = {}
+        for k, v in self.joints.items():
+            if not isinstance(k, str) or not k:
+                raise InvalidParameter(f"pin friction: a pin is named by its joint (a string), got {k!r:.60}")
+            mu, r = _friction_pair(f"pin friction at {k}", v)
+            joints[k] = (self.mu if mu is None else mu, r)
+        object.__setattr__(self, "joints", joints)
+        if self.radius is None and not joints:
+            raise InvalidParameter("pin friction needs a radius for every pin or the joints it acts at, got neither")
+
+    def at(self, joint: str) -> tuple:
+        """(mu, radius) at a pin; (0, 0) where it has no friction."""
+        if joint in self.joints:
+            return self.joints[joint]
+        return (self.mu, self.radius) if self.radius is not None else (0.0, 0.0)
+
+    @property
+    def active(self) -> bool:
+        """Whether some pin has a friction moment (mu r > 0)."""
+        return (self.radius is not None and self.mu > 0) or any(mu > 0 for mu, _ in self.joints.values())
+
+    def to_dict(self) -> dict:
+        return {
+            "mu": self.mu,
+            **({} if self.radius is None else {"radius": self.radius}),
+            **({"joints": {k: list(v) for k, v in self.joints.items()}} if self.joints else {}),
+        }
+
+    @classmethod
+    def from_dict(cls, d) -> PinFriction:
+        if isinstance(d, PinFriction):
+            return d
+        d = _keys("pin friction", d, ("mu",), ("radius", "joints"))
+        return cls(d["mu"], d.get("radius"), dict(d.get("joints") or {}))
+
+
 @dataclass(frozen=True)
 class Loads:
     """What the mechanism works against. ``cutting_force`` (N) resists the ram's motion on the working (slow)
@@ -468,6 +538,7 @@ class Loads:
     forces: tuple = ()
     torques: tuple = ()
     working: str | None = None
+    pin_friction: PinFriction | None = None
 
     def __post_init__(self):
         f = self.cutting_force
@@ -493,6 +564,11 @@ class Loads:
         object.__setattr__(self, "torques", _many("torques", Torque, self.torques))
         if self.working is not None and self.working not in WAYS:
             raise InvalidParameter(f"working is the working stroke's direction, '+x' or '-x', got {self.working!r:.60}")
+        pf = self.pin_friction
+        if pf is not None and not isinstance(pf, PinFriction):
+            if not isinstance(pf, dict):
+                raise InvalidParameter(f"pin_friction is a qropt.PinFriction, its dict or None, got {pf!r:.80}")
+            object.__setattr__(self, "pin_friction", PinFriction.from_dict(pf))
 
     @property
     def gravity_vector(self) -> tuple:
@@ -519,6 +595,12 @@ class Loads:
         from qropt.errors import UnsupportedLoad
 
         named = self.general + ([f"the named working stroke ({self.working})"] if self.working else [])
+        if not named and self.pin_friction is not None:
+            raise UnsupportedLoad(
+                f"{what} cannot apply pin friction (Loads.pin_friction) yet: its friction moments depend on the joint "
+                "forces, which it does not solve for exactly; inverse_dynamics, the cycle's extremes, the flywheel "
+                "and the efficiency apply it"
+            )
         if named:
             raise UnsupportedLoad(
                 f"{what} cannot apply {named[0]} yet (it takes the cutting force, friction, gravity along -y and the "
@@ -552,11 +634,21 @@ class Loads:
             **({"forces": [v.to_dict() for v in self.forces]} if self.forces else {}),
             **({"torques": [v.to_dict() for v in self.torques]} if self.torques else {}),
             **({"working": self.working} if self.working is not None else {}),
+            **({"pin_friction": self.pin_friction.to_dict()} if self.pin_friction is not None else {}),
         }
 
     @classmethod
     def from_dict(cls, d) -> Loads:
-        keys = {"cutting_force", "friction", "gravity", "follower_torque", "forces", "torques", "working"}
+        keys = {
+            "cutting_force",
+            "friction",
+            "gravity",
+            "follower_torque",
+            "forces",
+            "torques",
+            "working",
+            "pin_friction",
+        }
         if not isinstance(d, dict) or set(d) - keys:
             raise InvalidParameter(f"loads take {sorted(keys)}, got {d!r}")
         return cls(**d)
@@ -567,6 +659,7 @@ __all__ = [
     "Counterweight",
     "Masses",
     "Loads",
+    "PinFriction",
     "Force",
     "Torque",
     "Window",

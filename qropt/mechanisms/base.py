@@ -207,6 +207,23 @@ class Mechanism:
 
         return CycleDynamics(self, omega2, 0.0, masses, loads).flywheel(cs)
 
+    def efficiency(self, omega2: float, *, masses=None, loads=None):
+        """The work over the working stroke, the return stroke and the turn at constant crank speed omega2: the
+        crank's input, what the loads absorb, what friction dissipates (the slide's and, with
+        ``Loads(pin_friction=...)``, the pins'), and the mechanical efficiency
+        (``qropt.dynamics.cycle.Efficiency``)."""
+        from qropt.dynamics.cycle import CycleDynamics
+
+        return CycleDynamics(self, omega2, 0.0, masses, loads).efficiency()
+
+    def drive_check(self, drive, omega2: float, *, masses=None, loads=None, flywheel: float = 0.0, cs=None):
+        """A motor and gearbox (``qropt.dynamics.drive.Drive``) at crank speed omega2: the torque, RMS, peak and
+        power at the motor, the reflected inertia, and the steady motion under the motor's line with a flywheel
+        (given, or sized for ``cs``) confirmed by ``simulate`` (``qropt.dynamics.drive.DriveCheck``)."""
+        from qropt.dynamics.drive import drive_check
+
+        return drive_check(self, drive, omega2, masses=masses, loads=loads, flywheel=flywheel, cs=cs)
+
     def body_masses(self, masses) -> dict:
         """Every moving body's mass, centre of mass (body frame, m) and inertia (kg m^2) under ``masses``."""
         from qropt.dynamics.inverse import body_masses

@@ -4,11 +4,12 @@ For a problem with TR and stroke targets whose lengths scale freely and whose cr
 ``Mechanism.SYNTHESIS.crank``) is free.
 
 - ``evolve``: SciPy's differential evolution over the unit box (lengths log-uniform, other parameters uniform).
-  Each candidate is moved onto the TR target by its crank length: its TR on a crank-angle grid (the type's loop
-  in numpy, vectorised over candidates x NODES crank lengths x GRID angles, extremes refined by the grid
-  parabola), the crossing of the target nearest the candidate's own crank gene interpolated. It is then built,
-  scaled to the stroke and, within WINDOW of the TR exactly and inside the box, valued by the exact objective
-  (minimised); off the targets its value is INFEASIBLE plus how far off, so the evolution moves toward them first.
+  Each candidate is moved onto the TR target by its crank length: its TR on a crank-angle grid (the type's loop in
+  numpy, vectorised over candidates x ``evolution_nodes`` crank lengths x ``evolution_grid`` angles, extremes refined by
+  the grid parabola), the crossing of the target nearest the candidate's own crank gene interpolated. It is then built,
+  scaled to the stroke and, within ``evolution_window`` of the TR exactly and inside the box, valued by the exact
+  objective (minimised); off the targets its value is INFEASIBLE plus how far off, so the evolution moves toward them
+  first.
 - ``on_targets``: a design with its crank length moved until the exact TR meets the target (secant steps from
   its own, else Brent's root search in a bracket grown from 0.2 % to 30 %), then scaled to the stroke.
 - ``descend``: Nelder-Mead on the exact objective over every free parameter but the crank, each point put on the
@@ -32,26 +33,20 @@ import numpy as np
 from qropt.errors import QroptError
 from qropt.synthesis import criteria
 from qropt.synthesis import starts as starts_
+from qropt.synthesis.settings import DEFAULT, Settings
 
-NODES = 48  # crank lengths (uniform in log over its bounds) at which a candidate's grid TR is read
-GRID = 64  # crank angles of that grid
-WINDOW = 0.01  # relative: a candidate whose exact TR is this near the target competes on its objective
-POPULATION = 15  # candidates per free parameter (SciPy's popsize)
-KEEP = 4  # distinct designs an evolution hands on
-DISTINCT = 0.05  # designs differ when some parameter differs by this much (in log, or of its range)
-DESCENT_EVALS = 1000  # exact evaluations of a Nelder-Mead descent
 INFEASIBLE = 1e12  # the value of a candidate off the targets (plus how far off)
 SECANT_STEP, SECANT_STEPS, SECANT_TOL = 1e-4, 8, 1e-14  # ``on_targets``'s secant steps: first step (relative),
-SECANT_REACH = 0.05  # most steps, |log TR ratio| that ends them, and how far (relative) they may take the crank
+# most steps and the |log TR ratio| that ends them
 DESCENT_LOCAL = "none: the end of a Nelder-Mead descent on the exact objective, every point on the targets"
-MANY_FREE, MANY = 7, 4  # a problem with this many free parameters or more runs MANY evolutions by default (``count``)
 
 
-def count(problem) -> int:
-    """The evolutions a solve runs by default: MANY where the problem has MANY_FREE free parameters or more (the
+def count(problem, settings: Settings = DEFAULT) -> int:
+    """The evolutions a solve runs by default: ``many_evolutions`` where the problem has ``many_free`` free
+    parameters or more (the
     four-bar-driven types), else one: each evolution reaches its own basins at the cost of its own run, which
     pays where the free parameters are many; with fewer, one evolution's basins already hold the best design."""
-    return MANY if len(problem.free) >= MANY_FREE else 1
+    return settings.many_evolutions if len(problem.free) >= settings.many_free else 1
 
 
 @dataclass(frozen=True)
@@ -108,11 +103,12 @@ def _to_stroke(problem, design: dict, stroke: float) -> dict:
     return starts_.scaled(problem, design, problem.targets["stroke"] / stroke)
 
 
-def _grid_miss(problem, cols: dict) -> np.ndarray:
-    """log(TR / target) of designs given as columns (free parameter -> array) on the GRID, first branch; nan
+def _grid_miss(problem, cols: dict, grid: int) -> np.ndarray:
+    """log(TR / target) of designs given as columns (free parameter -> array) on a grid of ``grid`` crank angles,
+    first branch; nan
     where a design breaks the type's rules, does not close everywhere or does not reverse exactly twice."""
     n = next(iter(cols.values())).size
-    theta = np.linspace(0.0, 2 * np.pi, GRID, endpoint=False)
+    theta = np.linspace(0.0, 2 * np.pi, grid, endpoint=False)
     miss = np.full(n, np.nan)
     with np.errstate(all="ignore"):
         for i, part, loop, x in starts_.grid_loops(problem, cols, theta):
@@ -122,16 +118,18 @@ def _grid_miss(problem, cols: dict) -> np.ndarray:
     return miss
 
 
-def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]:
-    """Up to ``keep`` distinct designs (free-parameter dicts) of an evolution of ``generations`` (module
-    docstring), exact objective best first; each within WINDOW of the TR, at the stroke, inside the box. None
-    for a user type whose loop takes one design at a time (it does not vectorise over designs)."""
+def evolve(problem, generations: int, seed: int, keep: int | None = None, settings: Settings = DEFAULT) -> list[dict]:
+    """Up to ``keep`` (``settings.evolution_keep``) distinct designs (free-parameter dicts) of an evolution of
+    ``generations`` (module docstring), exact objective best first; each within ``evolution_window`` of the TR, at the
+    stroke, inside the box. None for a user type whose loop takes one design at a time (it does not vectorise over
+    designs)."""
     from scipy.optimize import differential_evolution  # imported here: scipy.optimize takes a while to import
 
     names, crank = list(problem.free), problem.mechanism.SYNTHESIS.crank
     others = [k for k in names if k != crank]
     branch = starts_.branches(problem)[0]
-    nodes = np.linspace(0.0, 1.0, NODES)
+    s, keep = settings, keep or settings.evolution_keep
+    nodes = np.linspace(0.0, 1.0, s.evolution_nodes)
     found: list[tuple[float, dict]] = []
 
     def candidate(row: np.ndarray, gene: float, d: dict) -> float:
@@ -139,7 +137,7 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
         if ends.size == 0:  # no crank length meets the TR: how near the nearest comes
             near = np.abs(row[np.isfinite(row)])
             return INFEASIBLE * (3.0 + (float(near.min()) if near.size else 10.0))
-        c = ends[np.argmin(np.abs(ends + 0.5 - gene * (NODES - 1)))]  # the crossing nearest the crank gene
+        c = ends[np.argmin(np.abs(ends + 0.5 - gene * (s.evolution_nodes - 1)))]  # the crossing nearest the crank gene
         u = nodes[c] + row[c] / (row[c] - row[c + 1]) * (nodes[c + 1] - nodes[c])
         d = d | {crank: float(starts_.from_unit(problem, crank, u))}
         try:
@@ -149,7 +147,7 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
         except (QroptError, ValueError, ZeroDivisionError):
             return INFEASIBLE * 2.0
         off = outside(problem, d)
-        if off > 0 or miss > WINDOW:
+        if off > 0 or miss > s.evolution_window:
             return INFEASIBLE * (1.0 + off + miss)
         v = value(problem, d, branch)
         if v is None:
@@ -159,22 +157,25 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
 
     def values(u: np.ndarray) -> np.ndarray:  # u: (parameters, candidates), SciPy's vectorised call
         n = u.shape[1]
-        cols = {k: np.repeat(starts_.from_unit(problem, k, u[names.index(k)]), NODES) for k in others}
+        cols = {k: np.repeat(starts_.from_unit(problem, k, u[names.index(k)]), s.evolution_nodes) for k in others}
         cols[crank] = np.tile(starts_.from_unit(problem, crank, nodes), n)
-        miss = _grid_miss(problem, cols).reshape(n, NODES)
+        miss = _grid_miss(problem, cols, s.evolution_grid).reshape(n, s.evolution_nodes)
         gene = u[names.index(crank)]
         return np.array(
-            [candidate(miss[i], float(gene[i]), {k: float(cols[k][i * NODES]) for k in others}) for i in range(n)]
+            [
+                candidate(miss[i], float(gene[i]), {k: float(cols[k][i * s.evolution_nodes]) for k in others})
+                for i in range(n)
+            ]
         )
 
     try:  # one small vectorised call first
-        _grid_miss(problem, {k: np.full(2, starts_.from_unit(problem, k, 0.5)) for k in names})
+        _grid_miss(problem, {k: np.full(2, starts_.from_unit(problem, k, 0.5)) for k in names}, s.evolution_grid)
     except (TypeError, ValueError, IndexError):  # a user type's loop that takes one design at a time
         return []
     differential_evolution(
         values,
         [(0.0, 1.0)] * len(names),
-        popsize=POPULATION,
+        popsize=s.evolution_population,
         maxiter=generations,
         seed=seed,
         tol=0.0,
@@ -186,26 +187,27 @@ def evolve(problem, generations: int, seed: int, keep: int = KEEP) -> list[dict]
     found.sort(key=lambda f: f[0])
     chosen: list[dict] = []
     for _, d in found:
-        if all(apart(problem, d, c) for c in chosen):
+        if all(apart(problem, d, c, s) for c in chosen):
             chosen.append(d)
             if len(chosen) == keep:
                 break
     return chosen
 
 
-def apart(problem, a: dict, b: dict) -> bool:
-    """Whether two designs differ by DISTINCT in some free parameter (in log for lengths, of its range else)."""
+def apart(problem, a: dict, b: dict, settings: Settings = DEFAULT) -> bool:
+    """Whether two designs differ by ``evolution_distinct`` in some free parameter (in log for lengths, of its range
+    else)."""
     kinds = problem.mechanism.kinds()
     for k, (lo, hi) in problem.free.items():
         log = kinds[k] == "length"
-        if (abs(math.log(a[k] / b[k])) if log else abs(a[k] - b[k]) / (hi - lo)) > DISTINCT:
+        if (abs(math.log(a[k] / b[k])) if log else abs(a[k] - b[k]) / (hi - lo)) > settings.evolution_distinct:
             return True
     return False
 
 
-def _secant(miss, c0: float, e0: float, lo: float, hi: float) -> float | None:
+def _secant(miss, c0: float, e0: float, lo: float, hi: float, reach: float) -> float | None:
     """The crank length where ``miss`` (the log TR ratio) is zero by secant steps from c0 (e0 = miss(c0)):
-    converged to SECANT_TOL, or None (then the bracket and Brent's search)."""
+    converged to SECANT_TOL and at most ``reach`` (relative) from c0, or None (then the bracket and Brent's search)."""
     a, fa, b = c0, e0, c0 * (1.0 + SECANT_STEP)
     fb = miss(b)
     for _ in range(SECANT_STEPS):
@@ -214,14 +216,14 @@ def _secant(miss, c0: float, e0: float, lo: float, hi: float) -> float | None:
         if abs(fb) <= SECANT_TOL:
             return b
         c = b - fb * (b - a) / (fb - fa)
-        if not lo <= c <= hi or abs(c - c0) > SECANT_REACH * c0:
+        if not lo <= c <= hi or abs(c - c0) > reach * c0:
             return None
         a, fa, b = b, fb, c
         fb = miss(b)
     return None
 
 
-def on_targets(problem, design: dict, bounds: tuple | None = None) -> dict | None:
+def on_targets(problem, design: dict, bounds: tuple | None = None, settings: Settings = DEFAULT) -> dict | None:
     """The design with its crank length moved to one whose exact TR meets the target (by secant steps from its
     own, else the nearest by Brent's search in a growing bracket) and scaled to the stroke (module docstring);
     None if neither finds one. ``bounds``: the crank lengths searched (default: its box)."""
@@ -243,7 +245,7 @@ def on_targets(problem, design: dict, bounds: tuple | None = None) -> dict | Non
     e0 = miss(c0)
     if not math.isfinite(e0):
         return None
-    root = c0 if e0 == 0.0 else _secant(miss, c0, e0, lo, hi)
+    root = c0 if e0 == 0.0 else _secant(miss, c0, e0, lo, hi, settings.secant_reach)
     for step in (1.002, 1.01, 1.03, 1.1, 1.3):
         for c1 in (c0 * step, c0 / step):
             e1 = miss(c1) if root is None and lo <= c1 <= hi else math.nan
@@ -261,9 +263,9 @@ def on_targets(problem, design: dict, bounds: tuple | None = None) -> dict | Non
         return None
 
 
-def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dict] | None:
-    """A Nelder-Mead descent from a design on the exact objective (minimised) with every point on the targets
-    (module docstring), of ``evals`` exact evaluations (DESCENT_EVALS): the best (value, design) met, or None."""
+def descend(problem, design: dict, evals: int | None = None, settings: Settings = DEFAULT) -> tuple[float, dict] | None:
+    """A Nelder-Mead descent from a design on the exact objective (minimised) with every point on the targets (module
+    docstring), of ``evals`` exact evaluations (``settings.descent_evals``): the best (value, design) met, or None."""
     from scipy.optimize import minimize
 
     names = [k for k in problem.free if k != problem.mechanism.SYNTHESIS.crank]
@@ -272,7 +274,8 @@ def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dic
     best: list = [None]
 
     def cost(z: np.ndarray) -> float:
-        d = on_targets(problem, design | {k: math.exp(x) if log[k] else x for k, x in zip(names, z, strict=True)})
+        moved = {k: math.exp(x) if log[k] else x for k, x in zip(names, z, strict=True)}
+        d = on_targets(problem, design | moved, settings=settings)
         f = None if d is None or outside(problem, d) > 0 else value(problem, d, branch)
         if f is None:
             return math.inf
@@ -281,7 +284,7 @@ def descend(problem, design: dict, evals: int | None = None) -> tuple[float, dic
         return f
 
     z0 = np.array([math.log(design[k]) if log[k] else design[k] for k in names])
-    opts = {"maxfev": evals or DESCENT_EVALS, "xatol": 1e-9, "fatol": 1e-12, "adaptive": True}
+    opts = {"maxfev": evals or settings.descent_evals, "xatol": 1e-9, "fatol": 1e-12, "adaptive": True}
     minimize(cost, z0, method="Nelder-Mead", options=opts)
     return best[0]
 
@@ -296,5 +299,4 @@ __all__ = [
     "apart",
     "outside",
     "value",
-    "WINDOW",
 ]

@@ -19,11 +19,8 @@ from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import CONVERGED, Status
 from qropt.synthesis.certificate import Designs, certify, residuals, target_values
 from qropt.synthesis.formulation import TWO_PI, Formulation
+from qropt.synthesis.settings import DEFAULT
 
-STUCK = 3  # exchange rounds that end alike, in a row, after which the loop stops (``_stuck``)
-RESTARTS = 2  # runs continued from their last iterate when they hit the iteration limit near a design
-RELIFTS = 2  # runs of a dynamic objective continued, their extremes lifted anew, after the iteration limit
-RESTART_VIOLATION = 1e-6  # ... that is, with no constraint violated by more than this
 MEMO = 64  # problems a solver keeps derived problems of (a chart's tiles bring thousands)
 
 
@@ -117,9 +114,9 @@ class LocalSolve:
     start given with a nearby problem's optimum at its design (a chart's neighbour) is first continued by Newton on
     that optimum's active set (``newton``), the backend running only where that is not verified."""
 
-    def __init__(self, formulations: Formulations, backend, tolerances: dict, max_rounds: int):
+    def __init__(self, formulations: Formulations, backend, tolerances: dict, max_rounds: int, settings=DEFAULT):
         self.formulations, self.backend = formulations, backend
-        self.tolerances, self.max_rounds = tolerances, max_rounds
+        self.tolerances, self.max_rounds, self.settings = tolerances, max_rounds, settings
 
     def run(
         self,
@@ -224,8 +221,8 @@ class LocalSolve:
                     last = None
                     break
                 polish = None
-            close = range_target or max(form.violations(g).values(), default=0.0) <= RESTART_VIOLATION
-            if run.status in (Status.ITERATION_LIMIT, Status.STALLED) and restarts < RESTARTS and close:
+            close = range_target or max(form.violations(g).values(), default=0.0) <= self.settings.restart_violation
+            if run.status in (Status.ITERATION_LIMIT, Status.STALLED) and restarts < self.settings.restarts and close:
                 restarts += 1  # the iteration budget ran out, or the steps stalled, near a design: go on from there
                 continue
             # a dynamic objective's run that ran out of iterations far from a design: the torque's extremes move,
@@ -234,7 +231,7 @@ class LocalSolve:
             # extreme of the design it reached (``lifted_start``)
             if (
                 run.status is Status.ITERATION_LIMIT
-                and relifts < RELIFTS
+                and relifts < self.settings.relifts
                 and form.n_lift
                 and objective is not None
                 and not objective.kinematic
@@ -268,8 +265,8 @@ class LocalSolve:
                 c.pruned = True  # more samples only raise this basin's NLP value: it cannot beat the incumbent
                 break
             rounds.append((info.get("ok"), info.get("reason"), run.f, np.sort(add), np.sort(frac)))
-            if _stuck(rounds):
-                break  # the same design and the same angles to add, STUCK rounds running: the next ones are too
+            if _stuck(rounds, self.settings.exchange_stuck):
+                break  # the same design and angles to add, ``exchange_stuck`` rounds running: the next ones are too
             used = place(samples, used, add, TWO_PI, 0.05, form.n_base)
             used_f = place(fractions, used_f, frac, 1.0, 0.01, form.n_base)
             if form.n_box and m is not None:  # each box side lifted at the coordinate that reaches it now
@@ -295,7 +292,7 @@ class LocalSolve:
         base = form.p_blocks.split(form.param_vector(problem, targets, *form.base_samples()))
         p = form.p_blocks.join(**{**base, **hint.blocks})
         lbx, ubx = form.bounds(problem)
-        run = newton.correct(form, hint, p, lbx, ubx)
+        run = newton.correct(form, hint, p, lbx, ubx, self.settings)
         return None if run is None else (form, p, run)
 
     def _feasibility(self, problem):
@@ -389,14 +386,14 @@ def _meets(problem, values, branch, targets, build, tol: float = 1e-9) -> bool:
     return all(abs(got[k] - v) <= tol * max(1.0, abs(v)) for k, v in targets.items() if k in got)
 
 
-def _stuck(rounds) -> bool:
-    """Whether the exchange loop's last STUCK rounds ended alike: the same verdict and reason, NLP values within
+def _stuck(rounds, stuck: int) -> bool:
+    """Whether the exchange loop's last ``stuck`` rounds ended alike: the same verdict and reason, NLP values within
     1e-9 (relative) and the same angles and fractions to add (to 1e-9): the loop goes round without moving (at a
     design whose dead centres are local, say)."""
-    if len(rounds) < STUCK:
+    if len(rounds) < stuck:
         return False
     ok, why, f, add, frac = rounds[-1]
-    for ok2, why2, f2, add2, frac2 in rounds[-STUCK:-1]:
+    for ok2, why2, f2, add2, frac2 in rounds[-stuck:-1]:
         if (ok2, why2) != (ok, why) or abs(f2 - f) > 1e-9 * max(1.0, abs(f)):
             return False
         if add2.shape != add.shape or frac2.shape != frac.shape:

@@ -32,16 +32,15 @@ import numpy as np
 from qropt.errors import QroptError
 from qropt.synthesis import criteria, evolution
 from qropt.synthesis import starts as starts_
+from qropt.synthesis.settings import DEFAULT, Settings
 
 PEAKS, NEAR = 8, 0.3  # the extremes the QP bounds: at most this many, within this fraction of the largest
 STEP, CURVE, ANGLE = 1e-6, 1e-4, 1e-5  # finite-difference steps: gradients, curvatures (log or range units), rad
 DELTA, DELTA_LEAST = 0.02, 1e-9  # the trust region's first and least radius (infinity norm, z's units)
 RHO_TAKE, RHO_GROW, RHO_SHRINK = 0.01, 0.75, 0.25  # actual / predicted decrease: take, grow, shrink the region
-STATIONARY = 1e-8  # relative: a step's predicted decrease below this ends the SQP
 CHECK, FIRST_ORDER = 1e-3, 1e-5  # the end is stationary where its linear model predicts a decrease below
 # FIRST_ORDER (relative) within a step of CHECK: a slope below 1 % of the peak per unit of z (near a toggle an
 # extreme's own slope can be many times the peak; the derivatives are differences)
-STEPS = 150  # most SQP steps
 CLIP = 1e-6  # the Hessian's eigenvalues at least this times its largest (a convex QP)
 MARGIN = 1e-9  # the QP keeps the coordinates this far inside the box (its rows miss by higher-order terms)
 TR_TOL, RESTORE = 1e-13, 12  # |log(TR / target)| a design on the targets meets; most restoration steps
@@ -273,9 +272,9 @@ def _matched(angles: np.ndarray, to: np.ndarray) -> list[int]:
     return [int(np.argmin(np.abs((to - a + math.pi) % (2 * math.pi) - math.pi))) for a in angles]
 
 
-def polish(problem, design: dict, steps: int = STEPS) -> Polished | None:
-    """The SQP of the module docstring from a design on the targets (free parameters); None where it does not
-    apply (``applies``) or the design has no exact value."""
+def polish(problem, design: dict, steps: int | None = None, settings: Settings = DEFAULT) -> Polished | None:
+    """The SQP of the module docstring from a design on the targets (free parameters), of ``steps`` steps at most
+    (``settings.sqp_steps``); None where it does not apply (``applies``) or the design has no exact value."""
     if not applies(problem):
         return None
     c, xy = criteria.of_problem(problem), _Coordinates(problem)
@@ -284,7 +283,7 @@ def polish(problem, design: dict, steps: int = STEPS) -> Polished | None:
         return None
     d, delta, lam, fresh, taken = design, DELTA, None, True, 0
     count, last, mu = 0, None, 0.0
-    for _ in range(steps):
+    for _ in range(steps or settings.sqp_steps):
         if fresh:
             try:
                 angles, _ = _extremes(problem, c, d, xy.branch)
@@ -305,7 +304,7 @@ def polish(problem, design: dict, steps: int = STEPS) -> Polished | None:
         if got is None:
             break
         s, new_lam, mu, pred = got
-        if pred <= STATIONARY:
+        if pred <= settings.sqp_stationary:
             if lam is not None and np.allclose(lam, new_lam, atol=1e-3):
                 break
             lam = new_lam

@@ -22,13 +22,10 @@ import numpy as np
 
 from qropt.kinematics.kernel import CSE, Batched
 from qropt.synthesis.backends import Run, Status
+from qropt.synthesis.settings import DEFAULT, Settings
 
-ITERATIONS = 8  # Newton steps at most (a converging corrector needs a few from a neighbour)
 TOL = 1e-11  # KKT residuals relative to their terms' scale; rows and bounds met to this, relative, at least 1
 ACTIVE = 1e-7  # a multiplier counts (its row held) above this, relative to the largest
-NLP_LIMIT = 2_000  # NLPs (objective and rows) of at most this many instructions are continued by Newton: their
-# KKT function (exact Hessian) builds fast enough to pay; a larger NLP's (a dynamic objective's) costs more to
-# build than the corrector saves
 CURVED = 1e-10  # an eigenvalue of the KKT matrix counts as nonzero above this, relative to the largest
 
 
@@ -89,16 +86,16 @@ class _Compiled(Batched):
     # the compile (then cached on disk), a front's few points stay on CasADi's VM
 
 
-def _functions(form):
+def _functions(form, size_limit: int):
     """(f, grad f, g, dg/dw, the Lagrangian's Hessian) at z = (w, p, lam_g) as one dense row, built once per
     formulation and evaluated like the cycle kernels (``Batched``: buffers, machine code once it is used often),
-    with the offsets of its parts; None for an NLP of more than NLP_LIMIT instructions (its exact Hessian would
-    take longer to build than the continuation saves)."""
+    with the offsets of its parts; None for an NLP of more than ``size_limit`` instructions (its exact Hessian
+    would take longer to build than the continuation saves)."""
     f = getattr(form, "_newton_kkt", False)
     if f is False:
         w, obj, g = form.w_sym, form.f_sym, form.g_sym
         size = casadi.Function("nlp", [w, form.p_sym], [obj, g]).n_instructions()
-        if size > NLP_LIMIT:
+        if size > size_limit:
             form._newton_kkt = None
             return None
         lam = casadi.SX.sym("lam", g.numel())
@@ -122,8 +119,9 @@ def _evaluate(fun, w, p, lam) -> tuple:
     return out[0], out[i[0] : i[1]], out[i[1] : i[2]], J, out[i[3] :].reshape((n, n), order="F")
 
 
-def correct(form, hint: Hint, p, lbx, ubx) -> Run | None:
-    """The optimum at parameters p on the hint's active set, verified (module docstring); None otherwise."""
+def correct(form, hint: Hint, p, lbx, ubx, settings: Settings = DEFAULT) -> Run | None:
+    """The optimum at parameters p on the hint's active set, verified (module docstring), in ``newton_steps`` steps
+    at most, for an NLP of ``newton_size`` instructions at most; None otherwise."""
     t0 = time.perf_counter()
     lbg, ubg = form.lbg, form.ubg
     lam_scale = max(_largest(hint.lam_g), _largest(hint.lam_x), 1e-300)
@@ -139,12 +137,12 @@ def correct(form, hint: Hint, p, lbx, ubx) -> Run | None:
     pick = (rows, free) if on.any() else (rows, slice(None))  # every variable free: plain row slices
     lam = np.zeros(lbg.size)
     lam[rows] = hint.lam_g[rows]
-    fun = _functions(form)
+    fun = _functions(form, settings.newton_size)
     n, k = free.size, rows.size
     if fun is None or k > n:
         return None
     side_scale = max(1.0, _largest(side))
-    for it in range(1, ITERATIONS + 1):
+    for it in range(1, settings.newton_steps + 1):
         f, df, g, J, H = _evaluate(fun, w, p, lam)
         JA, Hf = J[rows][:, pick[1]], H[free][:, pick[1]]
         grad = df[free] + JA.T @ lam[rows]

@@ -28,7 +28,6 @@ from qropt.synthesis.result import Result
 from qropt.synthesis.settings import Settings
 
 TOLERANCES = {"feasibility": 1e-8, "gap": 1e-8}
-RANGE_SAMPLES = 64  # designs spread over the bounds whose exact target values start a reachable range
 RANGE_FREE = (RowKind.DEAD_CENTRE, RowKind.ORIENTATION, RowKind.TARGET)  # rows a range's designs need not meet
 
 
@@ -110,7 +109,7 @@ class Solver:
         self.starts = search.starts_of(self.pipeline)
         self.backend = backend or Ipopt(self.ipopt_options)
         self._formulations = Formulations(samples, extra)
-        self.local_solve = LocalSolve(self._formulations, self.backend, tol, max_rounds)
+        self.local_solve = LocalSolve(self._formulations, self.backend, tol, max_rounds, self.settings)
         self.multistart = MultiStart(self.local_solve, self.settings)
 
     def __repr__(self):
@@ -138,7 +137,7 @@ class Solver:
 
     def evolutions_of(self, problem: Problem) -> int:
         """The evolutions a solve of ``problem`` runs where they apply: the Solver's, else ``evolution.count``."""
-        return self.evolutions if self.evolutions is not None else evolution.count(problem)
+        return self.evolutions if self.evolutions is not None else evolution.count(problem, self.settings)
 
     # ---- formulations ----------------------------------------------------------------------------
     def formulation(self, problem: Problem, branch: dict, orientation: int, range_target=None, sense=1) -> Formulation:
@@ -236,22 +235,22 @@ class Solver:
         self, problem, targets, names, *, starts_n=None, seed=None, solves: int | None = None, toward: bool = False
     ):
         """{target: (low, high)} over the free bounds and conditions, each target alone: the exact values of
-        RANGE_SAMPLES designs spread over the bounds (with the corners of the bounds and the closed forms' points),
-        built once for every target
-        (or the closed form's range where the plan has one),
-        then at most ``solves`` local solves per target that push it down and up from the samples nearest each
-        end (``toward``: only for a target outside the samples' range). Every value is that
-        of a design found, not a proof of an end; (nan, nan) where no design turns."""
+        ``settings.range_samples`` designs spread over the bounds (with the corners of the bounds and the closed forms'
+        points), built once for every target (or the closed form's range where the plan has one), then at most
+        ``solves`` local solves per target that push it down and up from the samples nearest each end (``toward``: only
+        for a target outside the samples' range). Every value is that of a design found, not a proof of an end; (nan,
+        nan) where no design turns."""
         starts_n = self.starts_n if starts_n is None else starts_n
         seed = self.seed if seed is None else seed
-        solves = self.settings.range_solves if solves is None else solves
+        s = self.settings
+        solves = s.range_solves if solves is None else solves
         plan = starts_.plan(problem)
         exact = {k: plan.ranges[k] for k in names if k in plan.ranges}  # the closed form's own, where it has one
         names = [k for k in names if k not in exact]
         pts = (
             list(plan.analytic)
-            + starts_.corners(problem)
-            + starts_.rule_points(problem, max(RANGE_SAMPLES, starts_n), seed)
+            + starts_.corners(problem, s)
+            + starts_.rule_points(problem, max(s.range_samples, starts_n), seed, settings=s)
         )
         pts = pts if names else []
         seen = []  # (mechanism, start values, branch)
@@ -262,7 +261,7 @@ class Solver:
                     if m.dead_centres().reversals == 1:
                         seen.append((m, v, br))
         if pts and not seen:  # none of the samples turns: a grid screen of many more finds some that do
-            for v in starts_.turning_points(problem, max(RANGE_SAMPLES, starts_n), seed):
+            for v in starts_.turning_points(problem, max(s.range_samples, starts_n), seed, s):
                 for br in starts_.branches(problem):
                     with contextlib.suppress(QroptError):
                         m = problem.build(v, br)

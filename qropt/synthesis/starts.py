@@ -17,6 +17,7 @@ from qropt.kinematics.ops import NUMPY
 from qropt.synthesis import analytic, criteria
 from qropt.synthesis import atlas as atlas_
 from qropt.synthesis.formulation import slow_interval
+from qropt.synthesis.settings import DEFAULT, Settings
 
 
 @dataclass(frozen=True)
@@ -79,17 +80,11 @@ def _from_atlas(problem, use: bool) -> dict:
     return {"atlas": atlas_.starts(problem), "related": atlas_.related(problem)}
 
 
-POOL = 64  # Sobol points drawn per start wanted: the type's rules (one vectorised check) thin them first
-
-
-RULE_DRAWS = 2**17  # Sobol points a rule_points call draws at most
-
-
-def rule_points(problem, n: int, seed: int, least: int = 1) -> list[dict]:
+def rule_points(problem, n: int, seed: int, least: int = 1, settings: Settings = DEFAULT) -> list[dict]:
     """Scrambled-Sobol points over the free bounds (log-spaced for lengths), a power of two of them at least n,
     with the points that break the type's rules (Grashof class, crank shorter than the centres and the like)
     dropped in one vectorised check; none is built. While fewer than ``least`` pass, four times as many more are
-    drawn (RULE_DRAWS in all at most). If none passes, the first n points as they are."""
+    drawn (``settings.rule_draws`` in all at most). If none passes, the first n points as they are."""
     from scipy.stats import qmc  # imported here: scipy.stats is slow to import
 
     names = list(problem.free)
@@ -97,14 +92,14 @@ def rule_points(problem, n: int, seed: int, least: int = 1) -> list[dict]:
     kept: list[dict] = []
     first: list[dict] = []
     draw, drawn = 1 << max(0, n - 1).bit_length(), 0
-    while drawn < RULE_DRAWS and (not drawn or len(kept) < least):
+    while drawn < settings.rule_draws and (not drawn or len(kept) < least):
         u = sampler.random(draw)
         drawn += draw
         cols = {k: from_unit(problem, k, u[:, j]) for j, k in enumerate(names)}
         ok = rules_kept(problem, cols)
         kept += [{k: float(cols[k][i]) for k in names} for i in np.flatnonzero(ok).tolist()]
         first = first or [{k: float(cols[k][i]) for k in names} for i in range(min(n, u.shape[0]))]
-        draw = min(4 * draw, RULE_DRAWS - drawn)
+        draw = min(4 * draw, settings.rule_draws - drawn)
     return kept or first
 
 
@@ -124,13 +119,10 @@ def rules_kept(problem, cols: dict) -> np.ndarray:
     return ok
 
 
-MAX_CORNERS = 64  # the corners of the free bounds tried as designs (every one up to six free parameters)
-
-
-def corners(problem) -> list[dict]:
-    """The corners of the free bounds (where extremes of a target often lie), at most MAX_CORNERS of them."""
+def corners(problem, settings: Settings = DEFAULT) -> list[dict]:
+    """The corners of the free bounds (where extremes of a target often lie), at most ``settings.max_corners``."""
     names = list(problem.free)
-    if 2 ** len(names) > MAX_CORNERS:
+    if 2 ** len(names) > settings.max_corners:
         return []
     return [
         {k: problem.free[k][bit] for k, bit in zip(names, bits, strict=True)}
@@ -138,21 +130,21 @@ def corners(problem) -> list[dict]:
     ]
 
 
-def sobol(problem, n: int, seed: int, build=None) -> list[dict]:
-    """Up to n of the ``rule_points`` whose mechanism turns fully on the first branch; if none does, the first n
-    points as they are. With a time-ratio target and no closed form that enumerates or walks every design (only
-    starting points, or none), ``screen`` chooses them (POOL * n points and at least SCREEN, evaluated at once).
-    Where every length and offset is free, each point is scaled to meet the stroke target (TR and angles do not
+def sobol(problem, n: int, seed: int, build=None, settings: Settings = DEFAULT) -> list[dict]:
+    """Up to n of the ``rule_points`` whose mechanism turns fully on the first branch; if none does, the first n points
+    as they are. With a time-ratio target and no closed form that enumerates or walks every design (only starting
+    points, or none), ``screen`` chooses them (``start_pool`` * n points and at least ``screen_points``, evaluated at
+    once). Where every length and offset is free, each point is scaled to meet the stroke target (TR and angles do not
     change with scale) when the scaled point stays inside the bounds."""
     if n <= 0:
         return []
     branch = branches(problem)[0]
     build = build or _build
     if "time_ratio" in problem.targets and plan(problem).kind in ("none", "partial"):  # screen
-        chosen = screen(problem, n, seed, build)
+        chosen = screen(problem, n, seed, build, settings)
         if chosen:
             return chosen
-    pts = rule_points(problem, POOL * n, seed)
+    pts = rule_points(problem, settings.start_pool * n, seed, settings=settings)
     kept = []
     for v in pts:
         if orientation(problem, v, branch, build) is not None:
@@ -168,22 +160,20 @@ def grown(n: int, problem, plan: Plan) -> int:
     return n * max(1, len(problem.free) // 2) if plan.kind in ("none", "partial") else n
 
 
-SCREEN = 4096  # rule points a screen draws at least
-SCREEN_GRID = 180  # crank angles of a screen's grid
-SCREEN_KEEP = 4  # designs per start wanted evaluated exactly, nearest the TR target first
 SCREEN_CHUNK = 512  # designs per vectorised pass (memory: chunk * grid numbers per intermediate)
 
 
-def screen(problem, n: int, seed: int, build) -> list[dict]:
+def screen(problem, n: int, seed: int, build, settings: Settings = DEFAULT) -> list[dict]:
     """n starts near the targets: rule points evaluated on a crank-angle grid in vectorised passes (no
     mechanism built), those that close everywhere with one output reversal a turn scaled to the stroke target
-    where scaling is free, the SCREEN_KEEP * n nearest the TR target built and evaluated exactly, and of those
-    in turn the nearest and the best by the objective among the ones within TR_NEAR of the target. [] if none
+    where scaling is free, the ``screen_keep`` * n nearest the TR target built and evaluated exactly, and of those
+    in turn the nearest and the best by the objective among the ones within ``screen_tr_near`` of the target. [] if none
     turns fully."""
     branch = branches(problem)[0]
-    pts = rule_points(problem, max(SCREEN, POOL * n), seed, least=SCREEN // 8)
+    many = max(settings.screen_points, settings.start_pool * n)
+    pts = rule_points(problem, many, seed, least=settings.screen_points // 8, settings=settings)
     try:
-        tr, stroke = grid_cycle(problem, pts)
+        tr, stroke = grid_cycle(problem, pts, settings.screen_grid)
     except (TypeError, ValueError, IndexError):  # a user type's loop that takes one design at a time
         return []
     good = np.flatnonzero(np.isfinite(tr))
@@ -198,7 +188,7 @@ def screen(problem, n: int, seed: int, build) -> list[dict]:
             x = np.array([pts[i][name] for i in good.tolist()]) * (k if name in scalable else 1.0)
             fits &= (x >= lo) & (x <= hi)
         good = good[fits] if fits.any() else good
-    near = good[np.argsort(np.abs(np.log(tr[good] / problem.targets["time_ratio"])))][: SCREEN_KEEP * n]
+    near = good[np.argsort(np.abs(np.log(tr[good] / problem.targets["time_ratio"])))][: settings.screen_keep * n]
     from qropt.synthesis import criteria  # here: criteria imports the formulation this module imports
 
     scored = []
@@ -212,7 +202,7 @@ def screen(problem, n: int, seed: int, build) -> list[dict]:
             continue
         scored.append((miss, f, v))
     maximise = bool(problem.objective) and criteria.maximises(problem.objective)
-    best = sorted((s for s in scored if s[0] <= TR_NEAR), key=lambda s: -s[1] if maximise else s[1])
+    best = sorted((s for s in scored if s[0] <= settings.screen_tr_near), key=lambda s: -s[1] if maximise else s[1])
     nearest = sorted(scored, key=lambda s: s[0])
     chosen: list[dict] = []
     for pair in itertools.zip_longest(nearest, best):  # the nearest and the best in turn
@@ -222,14 +212,14 @@ def screen(problem, n: int, seed: int, build) -> list[dict]:
     return chosen
 
 
-def grid_cycle(problem, pts: list[dict]) -> tuple[np.ndarray, np.ndarray]:
-    """(TR, stroke) of designs (free-parameter dicts, first branch) on a SCREEN_GRID crank-angle grid, in
+def grid_cycle(problem, pts: list[dict], grid: int) -> tuple[np.ndarray, np.ndarray]:
+    """(TR, stroke) of designs (free-parameter dicts, first branch) on a crank-angle grid of ``grid`` points, in
     vectorised passes with no mechanism built; nan where a design does not close everywhere or its output does
     not reverse exactly once a turn. Grid values: starts and samples, not results."""
     tr, stroke = np.full(len(pts), np.nan), np.full(len(pts), np.nan)
     if not pts:
         return tr, stroke
-    theta = np.linspace(0.0, 2 * np.pi, SCREEN_GRID, endpoint=False)
+    theta = np.linspace(0.0, 2 * np.pi, grid, endpoint=False)
     with np.errstate(all="ignore"):
         for i, _, loop, x in grid_loops(problem, _columns(problem, pts), theta):
             rows = x.shape[0]
@@ -242,29 +232,23 @@ def grid_cycle(problem, pts: list[dict]) -> tuple[np.ndarray, np.ndarray]:
     return tr, stroke
 
 
-def turning_points(problem, n: int, seed: int) -> list[dict]:
-    """Up to n rule points (SCREEN drawn at least) that turn fully with one output reversal on the grid."""
-    pts = rule_points(problem, max(SCREEN, n), seed, least=n)
+def turning_points(problem, n: int, seed: int, settings: Settings = DEFAULT) -> list[dict]:
+    """Up to n rule points (``screen_points`` drawn at least) that turn fully with one output reversal on the grid."""
+    pts = rule_points(problem, max(settings.screen_points, n), seed, least=n, settings=settings)
     try:
-        tr, _ = grid_cycle(problem, pts)
+        tr, _ = grid_cycle(problem, pts, settings.screen_grid)
     except (TypeError, ValueError, IndexError):  # a user type's loop that takes one design at a time
         return pts[:n]
     return [pts[i] for i in np.flatnonzero(np.isfinite(tr))[:n].tolist()]
 
 
-SHAPES = 32768  # rule points a shape search draws
-SHAPES_GRID = 64  # its crank angles (dead centres refined by the grid parabola)
-SHAPES_WINDOW = 0.02  # relative: shapes this near the TR target compete on their objective
-SHAPES_KEEP = 4  # starts a shape search gives, best by the grid objective first
-
-
-def shapes(problem, n: int, seed: int) -> list[dict]:
-    """Up to n starts chosen by the objective: SHAPES rule points on a SHAPES_GRID grid in vectorised passes
-    (no mechanism built), those that close everywhere with one output reversal, scaled to the stroke target
-    (TR, gamma_min and the shape do not change with scale) and inside the bounds, within SHAPES_WINDOW of the TR
-    target, best first by the objective's grid value (gamma_min, the peak acceleration at omega2 or the
-    footprint). [] where scaling is not free or the objective has no grid value here. Grid values choose starts;
-    results come from the local solves."""
+def shapes(problem, n: int, seed: int, settings: Settings = DEFAULT) -> list[dict]:
+    """Up to n starts chosen by the objective: ``shape_points`` rule points on a ``shape_grid`` grid in vectorised
+    passes (no mechanism built), those that close everywhere with one output reversal, scaled to the stroke target (TR,
+    gamma_min and the shape do not change with scale) and inside the bounds, within ``shape_window`` of the TR target,
+    best first by the objective's grid value (gamma_min, the peak acceleration at omega2 or the footprint). [] where
+    scaling is not free or the objective has no grid value here. Grid values choose starts; results come from the local
+    solves."""
     scalable = list(problem.mechanism.scalable())
     c = criteria.grid_criterion(problem)
     target = problem.targets.get("stroke")
@@ -273,8 +257,8 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
     if any(k in problem.fixed and problem.fixed[k] != 0.0 for k in scalable):
         return []
     names = list(problem.free)
-    pts = rule_points(problem, SHAPES, seed, least=SHAPES // 8)
-    theta = np.linspace(0.0, 2 * np.pi, SHAPES_GRID, endpoint=False)
+    pts = rule_points(problem, settings.shape_points, seed, least=settings.shape_points // 8, settings=settings)
+    theta = np.linspace(0.0, 2 * np.pi, settings.shape_grid, endpoint=False)
     tr_target, found = problem.targets["time_ratio"], []
     chunks = grid_loops(problem, _columns(problem, pts), theta)
     with np.errstate(all="ignore"):
@@ -289,7 +273,7 @@ def shapes(problem, n: int, seed: int) -> list[dict]:
             ok = turns(loop, x)
             tr, stroke = refined_cycle(x)
             scale = target / stroke
-            ok &= np.abs(tr / tr_target - 1.0) <= SHAPES_WINDOW
+            ok &= np.abs(tr / tr_target - 1.0) <= settings.shape_window
             for k in names:
                 lo, hi = problem.free[k]
                 v = cols[k] * (scale if k in scalable else 1.0)
@@ -354,9 +338,6 @@ def turns(loop, x) -> np.ndarray:
     dx = np.diff(x, axis=1, append=x[:, :1])
     ok &= np.count_nonzero(np.sign(dx) != np.sign(np.roll(dx, 1, axis=1)), axis=1) == 2
     return ok
-
-
-TR_NEAR = 0.05  # a screened design within 5 % of the TR target (in log) competes on its objective
 
 
 def _to_stroke(problem, values, branch, build, stroke: float | None = None) -> dict:

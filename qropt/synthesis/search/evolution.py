@@ -30,8 +30,14 @@ class Evolution(Stage):
         for i in range(count):
             if context.out_of_time():
                 break
-            each.append(descents.descended(problem, generations, seed + i, sqp=solver.sqp, deadline=context.deadline))
-        runs = [("evolution", e.design) for ends in each for e in ends[: evolution_.KEEP]]  # the best distinct ends
+            each.append(
+                descents.descended(
+                    problem, generations, seed + i, sqp=solver.sqp, deadline=context.deadline, settings=context.settings
+                )
+            )
+        runs = [
+            ("evolution", e.design) for ends in each for e in ends[: context.settings.evolution_keep]
+        ]  # the best distinct ends
         out = solver.multistart.run(
             problem, runs, context.targets, context.max_rounds, pool.designs, False, deadline=context.deadline
         )

@@ -6,7 +6,6 @@ from __future__ import annotations
 import time
 
 from qropt.synthesis import criteria
-from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import Status
 from qropt.synthesis.certificate import Certificate, objective_value, quantities
 from qropt.synthesis.multistart import distinct
@@ -92,7 +91,7 @@ def best(solver, problem, cands, claim, plan, t0, guard: str = "") -> Result:
     if not claim:
         shaped = sum(c.origin == "shape" for c in cands)
         related = sum(c.origin == "related" for c in cands)
-        how = [f"{shaped} chosen by the objective among {starts_.SHAPES} grid shapes"] if shaped else []
+        how = [f"{shaped} chosen by the objective among {solver.settings.shape_points} grid shapes"] if shaped else []
         how += [f"{related} the atlas's optima of this shape by kinematic objectives"] if related else []
         how = f" ({'; '.join(how)})" if how else ""
         started = sum(c.origin not in ("guard", "wrapped") for c in cands)

@@ -14,4 +14,6 @@ class Shapes(Stage):
         return plan is not None and plan.spread and plan.searching and criteria.grid_criterion(problem) is not None
 
     def run(self, problem, pool, context):
-        pool.runs += [("shape", v) for v in starts.shapes(problem, starts.SHAPES_KEEP, context.seed)]
+        pool.runs += [
+            ("shape", v) for v in starts.shapes(problem, context.settings.shape_keep, context.seed, context.settings)
+        ]

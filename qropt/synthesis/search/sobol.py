@@ -14,4 +14,7 @@ class Sobol(Stage):
         return plan is not None and plan.spread
 
     def run(self, problem, pool, context):
-        pool.runs += [("multistart", v) for v in starts.sobol(problem, context.starts_n, context.seed, pool.designs)]
+        pool.runs += [
+            ("multistart", v)
+            for v in starts.sobol(problem, context.starts_n, context.seed, pool.designs, context.settings)
+        ]

@@ -12,20 +12,20 @@ from qropt.synthesis import evolution, minimax
 from qropt.synthesis.search.base import Stage
 
 
-def polished(problem, r, ends: list, count: int, deadline: float | None = None) -> tuple[list, dict]:
-    """``ends`` with the SQP's ends from the ``count`` best certified designs of ``r`` (or None) and from each of
-    ``ends``, best first; and {'sqp_ends': how many were added, 't_sqp': the time taken, s}. deadline: no SQP
+def polished(problem, r, ends: list, settings, deadline: float | None = None) -> tuple[list, dict]:
+    """``ends`` with the SQP's ends from the ``settings.polished`` best certified designs of ``r`` (or None) and from
+    each of ``ends``, best first; and {'sqp_ends': how many were added, 't_sqp': the time taken, s}. deadline: no SQP
     starts after it (perf_counter s)."""
     t0 = time.perf_counter()
     if not minimax.applies(problem):
         return ends, {"sqp_ends": 0, "t_sqp": time.perf_counter() - t0}
-    certified = [r, *(r.local_optima or ())[1:]][:count] if r is not None else []
+    certified = [r, *(r.local_optima or ())[1:]][: settings.polished] if r is not None else []
     seeds = [{k: x.params[k] for k in problem.free} for x in certified] + [e.design for e in ends]
     added = []
     for d in seeds:
         if deadline is not None and time.perf_counter() >= deadline:
             break
-        p = minimax.polish(problem, d)
+        p = minimax.polish(problem, d, settings=settings)
         if p is not None and p.steps:
             added.append(evolution.End(p.value, p.design, p.local))
     spent = {"sqp_ends": len(added), "t_sqp": time.perf_counter() - t0}
@@ -41,5 +41,5 @@ class PeakSQP(Stage):
     def run(self, problem, pool, context):
         if pool.result is None and not pool.ends:
             return
-        pool.ends, spent = polished(problem, pool.result, pool.ends, context.settings.polished, context.deadline)
+        pool.ends, spent = polished(problem, pool.result, pool.ends, context.settings, context.deadline)
         pool.spent.update(spent)
