@@ -209,6 +209,99 @@ def test_design_equals_the_library(client):
         assert r.status_code == 400 and words in r.get_json()["error"], (bad, r.get_json())
 
 
+USER = "problems.user_watt_sixbar:WattSixBarShaper"
+MASSES = {"density": 1.57, "ram": 20.0, "block": 0.0, "bodies": {}}
+LOADS = {"cutting_force": 1000.0, "friction": 0.0, "gravity": 9.81, "follower_torque": 0.0}
+
+
+def test_design_options_come_from_the_registries(client):
+    """The Design page's choices: every objective of the criteria registry (the dynamic ones marked), design's
+    eight built-in rows and the served user type, and the longest budget a job may have."""
+    from qropt.studies._design import TYPES as ROWS
+    from qropt.synthesis import criteria
+
+    o = client.get("/api/design/options").get_json()
+    assert [x["criterion"] for x in o["objectives"]] == list(criteria.CRITERIA)
+    by = {x["criterion"]: x for x in o["objectives"]}
+    assert by["peak_torque"]["objective"] == "min_peak_torque" and by["peak_torque"]["dynamic"]
+    assert by["footprint"] == {**by["footprint"], "objective": "min_size", "size": "footprint", "dynamic": False}
+    assert [t["type"] for t in o["types"] if t["built_in"]] == list(ROWS)
+    (user,) = [t for t in o["types"] if t["type"] == USER]  # other tests of this process may register types too
+    assert user == {"name": "watt-sixbar-shaper", "type": USER, "class": "WattSixBarShaper", "built_in": False}
+    assert o["time_limit"] == 120
+
+
+def test_design_job_dynamic_objective_with_masses_loads_and_budget(client):
+    """min_peak_torque with a mass model, loads, omega2 and a 3 s budget: the job ends near the budget, with
+    progress per row, the certificate's claim naming what the budget left out, and the row's peak torque the exact
+    one of its design."""
+    body = {"time_ratio": 1.5, "stroke": 0.3, "objective": "min_peak_torque", "omega2": 10.0, "types": ["whitworth"]}
+    body |= {"masses": MASSES, "loads": LOADS, "time_limit": 3}
+    r = client.post("/api/jobs", json={"kind": "design", "input": body})
+    assert r.status_code == 202, r.get_json()
+    s = _wait(client, r.get_json()["id"])
+    assert s["state"] == "done" and s["progress"] == {"done": 1, "total": 1}, s
+    assert s["seconds"] < 3 + 10  # the budget holds (a margin for a loaded machine)
+    c = s["result"]
+    assert c["objective"] == "min_peak_torque" and c["omega2"] == 10.0 and c["units"]["peak_torque"] == "N m"
+    (row,) = c["rows"]
+    said = row["claim"] or row["reason"]
+    assert "the time limit (" in said and "left out:" in said, said
+    if row["mechanism"]:  # a design within the budget: its numbers are its design's exact ones
+        m = mechanism_type(row["mechanism"])(**row["params"])
+        assert m.time_ratio() == pytest.approx(1.5, abs=1e-6) and m.stroke() == pytest.approx(0.3, abs=1e-6)
+        cd = CycleDynamics(m, 10.0, 0.0, Masses.from_dict(MASSES), Loads.from_dict(LOADS))
+        assert row["peak_torque"] == pytest.approx(cd.extremes().peak_torque.value, rel=1e-6)
+        assert row["objective"] == pytest.approx(row["peak_torque"], rel=1e-12)
+
+
+def test_design_types_filter_with_a_user_type(client):
+    """types names a built-in row and the served user type (by its module:Class name): one row each, every design
+    meeting the task; a budget keeps it short."""
+    body = {"time_ratio": 1.4, "stroke": 0.5, "types": ["crank-shaper", USER], "time_limit": 5}
+    r = client.post("/api/design", json=body)
+    assert r.status_code == 200, r.get_json()
+    rows = r.get_json()["rows"]
+    assert sorted(x["type"] for x in rows) == ["crank-shaper", "watt-sixbar-shaper"]
+    for x in rows:
+        assert x["mechanism"] in ("crank-shaper", USER), x
+        m = mechanism_type(x["mechanism"])(**x["params"])
+        assert m.time_ratio() == pytest.approx(1.4, abs=1e-6) and m.stroke() == pytest.approx(0.5, abs=1e-6)
+
+
+GOOD_TASK = {"time_ratio": 1.5, "stroke": 0.3, "types": ["slider-crank"]}
+
+
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        ({"time_limit": -1}, "time_limit must lie"),
+        ({"time_limit": "soon"}, "time_limit is a finite number"),
+        ({"time_limit": 1e6}, "at most 120 s"),
+        ({"objective": "min_peak_torque"}, "needs masses or loads"),
+        ({"objective": "min_happiness"}, "objective is one of max_gamma_min"),
+        ({"masses": {"density": -1}, "objective": "min_peak_torque"}, "density (kg/m) must be zero or positive"),
+        ({"masses": MASSES, "loads": {"cutting_force": "x"}}, "cutting_force (N) must be a number"),
+        ({"masses": MASSES, "loads": {"cutting_force": 1.0, "zz": 1}}, "loads take"),
+        ({"masses": MASSES, "omega2": 0, "objective": "min_rms_torque"}, "omega2"),
+        ({"types": []}, "choose at least one type"),
+        ({"types": ["four-bar"]}, "FourBar has no slider"),
+        ({"types": ["os:system"]}, "load a type of your own"),
+        ({"types": [USER], "objective": "min_peak_torque", "masses": MASSES}, "min_peak_torque does not apply"),
+    ],
+)
+def test_bad_design_input_is_a_400_with_a_reason(client, extra, words):
+    for path, body in (
+        ("/api/design", {**GOOD_TASK, **extra}),
+        ("/api/jobs", {"kind": "design", "input": {**GOOD_TASK, **extra}}),
+    ):
+        r = client.post(path, json=body)
+        assert r.status_code == 400, (path, r.get_json())
+        err = r.get_json()["error"]
+        assert words in err and "\n" not in err, err
+    assert client.get("/api/health").status_code == 200  # still serving
+
+
 def test_jobs_progress_and_cancel(client):
     r = client.post("/api/jobs", json={"kind": "design", "input": {"time_ratio": 1.6, "stroke": 0.4}})
     assert r.status_code == 202

@@ -388,12 +388,12 @@ def test_an_exchange_loop_that_goes_round_without_moving_stops():
     from qropt.synthesis.local import _stuck
 
     same = (False, "the NLP's dead centres are local", -0.5484, np.array([3.1267]), np.zeros(0))
-    assert _stuck([same] * 3) and not _stuck([same] * 2)
+    assert _stuck([same] * 3, 3) and not _stuck([same] * 2, 3)
     moved = (False, same[1], -0.5484 + 1e-6, same[3], same[4])
     other = (False, same[1], same[2], np.array([3.1267 + 1e-6]), same[4])
     why = (False, "the output reverses 2 times a turn", *same[2:])
     for odd in (moved, other, why):
-        assert not _stuck([same, odd, same]) and not _stuck([odd, same, same])
+        assert not _stuck([same, odd, same], 3) and not _stuck([odd, same, same], 3)
 
 
 def _touching(par, t_max, t_min):

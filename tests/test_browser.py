@@ -156,9 +156,15 @@ def test_type_change_and_export(page, tmp_path):
 
 
 def test_design_page(page, tmp_path):
+    from qropt.studies._design import TYPES as ROWS
+
     page.click("#tab-design")
     page.fill("#d-tr", "1.5")
     page.fill("#d-stroke", "0.3")
+    boxes = page.locator("#d-types input").all()
+    assert all(b.is_checked() for b in boxes)  # every type at first
+    for b in boxes:  # design's built-in rows, as qropt.design(1.5, 0.3) (a user type another test loaded: out)
+        b.set_checked(b.get_attribute("value") in ROWS)
     page.click("#d-run")
     page.wait_for_selector("#d-table tr.pick", timeout=120_000)
     page.wait_for_function("document.querySelectorAll('#d-pictures .card svg line').length >= 8")
@@ -174,6 +180,57 @@ def test_design_page(page, tmp_path):
     page.wait_for_timeout(200)
     p = page.evaluate("window.qropt.params")
     assert p == pytest.approx(want.rows[2].result.params), (want.rows[2].type, want.rows[2].result.message)
+
+
+def test_design_page_dynamic_objective_and_stale_results(page, tmp_path):
+    """A dynamic objective from the registry's list brings the mass model and a 30 s budget; with a 3 s budget and one
+    type the row comes with its exact peak torque; new inputs mark the rows stale, and a refused request says why."""
+    from qropt.dynamics.cycle import CycleDynamics
+    from qropt.dynamics.model import Loads, Masses
+
+    page.click("#tab-design")
+    assert page.locator("#d-objective option[value='peak_torque']").count() == 1
+    page.select_option("#d-objective", "peak_torque")
+    assert page.is_checked("#d-dyn") and page.input_value("#d-budget") == "30"
+    page.fill("#d-budget", "3")
+    for box in page.locator("#d-types input").all():
+        box.set_checked(box.get_attribute("value") == "slider-crank")
+    page.click("#d-run")
+    page.wait_for_selector("#d-table tr.pick", timeout=60_000)
+    assert "of a 3 s budget" in page.inner_text("#d-progress")
+    (row,) = page.evaluate("window.qropt.designRows")
+    m = mechanism_type("slider-crank")(**row["params"])
+    masses, loads = Masses(1.57, 20.0), Loads(1000.0, gravity=9.81)  # the panel's defaults
+    want = CycleDynamics(m, 10.0, 0.0, masses, loads).extremes().peak_torque.value
+    cells = page.locator("#d-table tr.pick td")
+    assert float(cells.nth(6).inner_text()) == pytest.approx(want, rel=1e-3)  # "peak crank torque [N m]"
+    assert page.locator("#d-table.stale").count() == 0
+    _shot(page, tmp_path, "design_dynamic")
+    page.fill("#d-tr", "1.8")  # new inputs: the rows are the old task's
+    page.wait_for_selector("#d-table.stale")
+    assert "Results for TR = 1.5" in page.inner_text("#design-note")
+    page.locator("#d-types input[value='slider-crank']").uncheck()
+    page.click("#d-run")
+    page.wait_for_function("document.getElementById('design-note').textContent.includes('choose at least one type')")
+    assert page.locator("#d-pictures.stale").count() == 1
+
+
+def test_a_bad_r3_marks_the_results_stale(page, tmp_path):
+    """r3 past where the drag-link assembles: the numbers, drawing, curves and polygons are dimmed and say the r3
+    they belong to; a good r3 clears the mark."""
+    r3 = page.evaluate("window.qropt.params.r3")
+    page.fill("#n-r3", "0.6")
+    page.dispatch_event("#n-r3", "change")
+    page.wait_for_function("document.getElementById('m-error').textContent.includes('GrashofError')")
+    note = page.inner_text("#m-error")
+    assert f"Results for r3 = {float(f'{r3:.6g}'):g}" in note and "r3 = 0.6" in note, note
+    for panel in ("m-numbers", "m-svg", "m-plot", "m-vpoly", "m-apoly"):
+        assert "stale" in page.get_attribute(f"#{panel}", "class"), panel
+    _shot(page, tmp_path, "stale")
+    page.fill("#n-r3", str(r3))
+    page.dispatch_event("#n-r3", "change")
+    page.wait_for_function("document.getElementById('m-error').textContent.length === 0")
+    assert page.locator(".stale").count() == 0
 
 
 def test_synthesis_page(page, tmp_path):

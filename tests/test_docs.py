@@ -61,12 +61,12 @@ class Shown:
 
 def expected(comment: str):
     """The value a comment states (numbers as ``Shown``), or None when the comment is prose: the longest start
-    of the comment, ending where prose may begin (' (', ': ', '; ', ' -- ', two spaces) or at its end, that
-    reads as a value."""
+    of the comment, ending at a space, a ': ' or a '; ' (where a unit or prose may begin: ``88.709 N m``,
+    ``(163.45..., 86.67...) N m, deg``) or at its end, that reads as a value."""
     text = comment.strip()
     if not re.match(r"""[-+\d.'"(\[]""", text):
         return None
-    ends = [m.start() for m in re.finditer(r"\s\(|:\s|;\s|\s--\s|\s{2,}", text)] + [len(text)]
+    ends = [m.start() for m in re.finditer(r"\s|:\s|;\s", text)] + [len(text)]
     for end in sorted(ends, reverse=True):
         value = _value(text[:end].strip().rstrip(",;"))
         if value is not None:
@@ -242,6 +242,12 @@ def test_make_images_draws_every_image_shown():
         (" 'by enumeration: eqs. (7)-(13) give every r3'", "by enumeration: eqs. (7)-(13) give every r3", True),
         (" '-x' (for omega2 > 0)", "-x", True),
         (" [0.529649]", np.array([0.52964869]), True),
+        (" 88.709 N m", 88.7091, True),
+        (" 88.709 N m", 90.2, False),
+        (" (163.451..., 86.673...) N m, deg", (163.4512, 86.6731), True),
+        (" (163.451..., 86.673...) N m, deg", (163.4512, 86.6631), False),
+        (" ('optimal', 114.694...) N m: the smallest lever", ("optimal", 114.6949), True),
+        (" (22, 180) kg, deg", (22, 181), False),
     ],
 )
 def test_the_checker_reads_stated_values(comment, actual, ok):

@@ -22,7 +22,6 @@ from qropt.mechanisms import REGISTRY, Mechanism, mechanism_type, type_reference
 
 SAMPLES = 181  # crank angles of the cycle curves (every 2 deg)
 MAX_FRAMES = 360  # frames of an animation in one answer
-OBJECTIVES = ("max_gamma_min", "min_size", "min_peak_accel", "min_peak_torque", "min_rms_torque")
 
 
 class ApiError(QroptError):
@@ -69,6 +68,63 @@ def report_input(payload) -> dict:
     if out["omega2"] == 0.0:
         raise ApiError("omega2 must be nonzero (rad/s; its sign is the crank's sense of rotation)")
     return out
+
+
+def objectives() -> list[dict]:
+    """Every objective of the criteria registry (``qropt.synthesis.criteria.CRITERIA``, a user's registered ones
+    included), one entry per criterion: its ``objective`` and, for ``min_size``, the ``size`` measure; the
+    criterion's name, label and unit; ``dynamic`` where it needs a mass model or loads (and a time budget helps)."""
+    from qropt.synthesis import criteria
+
+    return [
+        {
+            "objective": c.objective,
+            "size": c.size,
+            "criterion": c.name,
+            "label": c.label,
+            "unit": c.unit,
+            "maximise": c.maximise,
+            "dynamic": c.needs_masses,
+        }
+        for c in criteria.CRITERIA.values()
+    ]
+
+
+def objective_names() -> tuple:
+    """The objective names a request may give (``criteria.objectives()`` without None)."""
+    from qropt.synthesis import criteria
+
+    return tuple(o for o in criteria.objectives() if o)
+
+
+def design_types() -> list[dict]:
+    """The rows the Design page offers: ``design``'s built-in rows (every shipped slider type and its options)
+    and every other slider type the app serves (a user's, from ``qropt app PROBLEM_FILE``), each its row name,
+    the name a request gives for it (``type``), its class and whether it is built in (``design`` runs the built-in
+    rows when a request names no ``types``)."""
+    from qropt.mechanisms import TYPES as SHIPPED
+    from qropt.studies._design import TYPES
+
+    out = [{"name": k, "type": k, "class": mechanism_type(v[0]).__name__, "built_in": True} for k, v in TYPES.items()]
+    for name in types():
+        cls = known_type(name)
+        if cls.TRAVEL != "stroke" or cls in SHIPPED:
+            continue
+        row = cls.__dict__.get("KIND") or cls.__name__
+        out.append({"name": row, "type": name, "class": cls.__name__, "built_in": False})
+    return out
+
+
+def design_type(name) -> str:
+    """A type a design request names: a row of ``design_types`` or a served slider type (never imported)."""
+    from qropt.studies._design import TYPES
+
+    if isinstance(name, str) and name in TYPES:
+        return name
+    cls = known_type(name)
+    if cls.TRAVEL != "stroke":
+        raise ApiError(f"{cls.__name__} has no slider (its output is a {cls.TRAVEL}): design compares strokes")
+    return name
 
 
 def known_type(name) -> type[Mechanism]:

@@ -32,8 +32,9 @@ def _solve(payload: dict, progress) -> dict:
 
 
 def _design(payload: dict, progress) -> dict:
-    """``design``'s arguments (masses and loads as dicts): the Comparison's JSON, each row with the type its
-    design opens as ("mechanism")."""
+    """``design``'s arguments (masses and loads as dicts; ``time_limit`` the budget of the whole comparison): the
+    Comparison's JSON, each row with the type its design opens as ("mechanism") and its certificate's global claim
+    ("claim": with a budget, it names the strategies the budget left out)."""
     import json
 
     from qropt.dynamics.model import Loads, Masses
@@ -55,8 +56,9 @@ def _design(payload: dict, progress) -> dict:
     c = design(progress=step, **args)
     out = json.loads(c.to_json())
     for row, r in zip(out["rows"], c.rows, strict=True):
-        m = r.result.mechanism
+        m, cert = r.result.mechanism, r.result.certificate
         row["mechanism"] = None if m is None else type_reference(type(m))
+        row["claim"] = cert.global_claim if cert is not None else None
     return out
 
 

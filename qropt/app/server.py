@@ -6,8 +6,10 @@ in one line; nothing a request sends stops the server.
   ``GET /api/problems`` (the problem files the app was started with)
 - ``POST /api/analyze``: ``{type, params, theta2, omega2}`` -> the analysis (``qropt.app.api.analyze``)
 - ``POST /api/solve``: a problem (``Problem.to_dict``'s form) -> the Result (``Result.to_dict``'s form)
-- ``POST /api/design``: ``{time_ratio, stroke, objective}`` (optional ``bounds``, ``conditions``, ``types``)
-  -> the Comparison (``Comparison.to_json``'s form)
+- ``GET /api/design/options``: what a design may ask for: the objectives (the criteria registry's), the types
+  (``design``'s rows and the served user types) and the longest time budget
+- ``POST /api/design``: ``{time_ratio, stroke, objective}`` (optional ``bounds``, ``conditions``, ``types``,
+  ``omega2``, ``masses``, ``loads``, ``time_limit``) -> the Comparison (``Comparison.to_json``'s form)
 - ``POST /api/jobs``: ``{kind: solve | design | report, input}`` -> 202 and the job; ``GET /api/jobs/<id>``
   its state, progress and result; ``DELETE /api/jobs/<id>`` cancels it
 - ``POST /api/export/<dxf|svg|json>``: ``{type, params, units?, theta2?}`` -> the file
@@ -44,25 +46,43 @@ def _problem(payload):
     return Problem.from_dict(d)
 
 
-_DESIGN_FIELDS = ("bounds", "conditions", "types", "objective", "omega2", "size", "units", "masses", "loads")
+_DESIGN_FIELDS = (
+    "bounds",
+    "conditions",
+    "types",
+    "objective",
+    "omega2",
+    "size",
+    "units",
+    "masses",
+    "loads",
+    "time_limit",
+)
 
 
-def _design_input(payload) -> dict:
-    """``design``'s arguments from a request, checked as far as they can be before a worker runs them."""
+def _design_input(payload, max_time: float = math.inf) -> dict:
+    """``design``'s arguments from a request, checked as far as they can be before a worker runs them;
+    ``time_limit`` (s, the budget of the whole comparison) at most ``max_time``, the app's limit of a job."""
     d = api.fields(payload, ("time_ratio", "stroke"), _DESIGN_FIELDS)
     out = {"time_ratio": api.number(d, "time_ratio", low=1.0 + 1e-9, high=50.0)}
     out["stroke"] = api.number(d, "stroke", low=1e-9, high=1e6)
     if "objective" in d:
-        if d["objective"] not in api.OBJECTIVES:
-            raise api.ApiError(f"objective is one of {', '.join(api.OBJECTIVES)}, got {d['objective']!r:.60}")
+        names = api.objective_names()
+        if d["objective"] not in names:
+            raise api.ApiError(f"objective is one of {', '.join(names)}, got {d['objective']!r:.60}")
         out["objective"] = d["objective"]
     if "types" in d:
         t = d["types"]
         if not isinstance(t, list) or not t or not all(isinstance(x, str) for x in t):
-            raise api.ApiError("types is a non-empty list of type names")
-        for x in t:
-            api.known_type(x)
-        out["types"] = t
+            raise api.ApiError("types is a non-empty list of type names (choose at least one type)")
+        out["types"] = [api.design_type(x) for x in t]
+    if d.get("time_limit") is not None:
+        t = api.number(d, "time_limit", low=0.1)
+        if t > max_time:
+            raise api.ApiError(
+                f"time_limit is at most {max_time:g} s, the app's limit of a job (qropt app --time-limit)"
+            )
+        out["time_limit"] = t
     for k in ("bounds", "conditions", "masses", "loads"):
         if d.get(k) is not None:
             if not isinstance(d[k], dict):
@@ -78,7 +98,7 @@ def _design_input(payload) -> dict:
     if "bounds" in out:
         out["bounds"] = {k: tuple(v) if isinstance(v, list) else v for k, v in out["bounds"].items()}
     task_problems(  # every argument checked here, before a job is queued
-        **{k: v for k, v in out.items() if k not in ("masses", "loads")},
+        **{k: v for k, v in out.items() if k not in ("masses", "loads", "time_limit")},
         masses=Masses.from_dict(out["masses"]) if "masses" in out else None,
         loads=Loads.from_dict(out["loads"]) if "loads" in out else None,
     )
@@ -181,7 +201,11 @@ def create_app(files=(), workers: int = 1, queue_size: int = 8, time_limit: floa
 
     @app.post("/api/design")
     def design():
-        return jsonify(run("design", _design_input(body())))
+        return jsonify(run("design", _design_input(body(), jobs.time_limit)))
+
+    @app.get("/api/design/options")
+    def design_options():
+        return jsonify(objectives=api.objectives(), types=api.design_types(), time_limit=jobs.time_limit)
 
     @app.post("/api/jobs")
     def submit():
@@ -190,14 +214,14 @@ def create_app(files=(), workers: int = 1, queue_size: int = 8, time_limit: floa
         if kind == "solve":
             payload = _problem(payload).to_dict()
         elif kind == "design":
-            payload = _design_input(payload)
+            payload = _design_input(payload, jobs.time_limit)
         elif kind == "pareto":
             p = api.fields(payload, ("problem", "objectives"), ("n",))
             prob = _problem(p["problem"])
             n = p.get("n", 9)
             ok = isinstance(p["objectives"], list) and len(p["objectives"]) == 2
-            if not ok or not all(o in api.OBJECTIVES for o in p["objectives"]):
-                raise api.ApiError(f"objectives are two of {', '.join(api.OBJECTIVES)}")
+            if not ok or not all(o in api.objective_names() for o in p["objectives"]):
+                raise api.ApiError(f"objectives are two of {', '.join(api.objective_names())}")
             if isinstance(n, bool) or not isinstance(n, int) or not 2 <= n <= 50:
                 raise api.ApiError(f"n (points of the front) is an integer from 2 to 50, got {n!r:.20}")
             payload = {"problem": prob.to_dict(), "objectives": p["objectives"], "n": n}

@@ -100,7 +100,7 @@ def quantities(problem, m) -> dict:
     the travel (stroke or swing), gamma_min; for a slider peak_accel at the problem's omega2 over its
     ``accel_over`` span, peak_velocity at omega2 over the working stroke and the peak crank torque per newton of
     cutting force; grashof, size by the problem's measure, working_direction; and every other registered
-    criterion that applies to the type."""
+    criterion that applies to the type (one not ``reported`` where the problem uses it alone)."""
     slider = m.OUTPUT == "slider"
     q = {"time_ratio": m.time_ratio(), "gamma_min": m.gamma_min().value, m.TRAVEL: m.stroke()}
     q["peak_accel"] = m.peak_acceleration(problem.omega2, problem.accel_over).value if slider else None
@@ -111,8 +111,10 @@ def quantities(problem, m) -> dict:
     q["size"] = m.size(problem.size)
     q["working_direction"] = m.working_direction(problem.omega2)
     dynamic = problem.masses is not None or problem.loads is not None
+    used = {criteria.of_problem(problem)} | {c for k, c in criteria.bounds().items() if k in problem.conditions}
     for name, c in criteria.CRITERIA.items():
         wanted = dynamic if c.needs_masses else name not in criteria.BUILT_IN  # the others are computed above
+        wanted = (wanted and c.reported) or (c in used and not c.reported)
         if wanted and c.applies(type(m)):
             q[name] = c.value(problem, m)
     return q

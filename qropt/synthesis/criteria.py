@@ -17,6 +17,9 @@ peak_accel     min_peak_accel          max_peak_accel                  length/s^
 peak_velocity  min_peak_velocity       max_peak_velocity               length/s at omega2
 =============  ======================  ==============================  =====================
 
+The dynamic criteria are in ``qropt.synthesis.dynamic``; the cut window's speed variation (objective
+``min_cut_speed_variation``, bound ``max_cut_speed_variation``, dimensionless) in ``qropt.synthesis.cut``.
+
 Peak acceleration is over the problem's ``accel_over`` span ('cycle' or 'working'); peak velocity over the
 working (slow) stroke, where it is also the peak crank torque per newton of a constant cutting force. The NLP
 works at omega2 = 1: it states accelerations per omega2^2, velocities per |omega2| and gamma_min by its cosine.
@@ -77,6 +80,8 @@ class Criterion:
     guard: ClassVar[float | None] = None  # rad: a transmission angle below which the NLP does not see the criterion
     # well, so its landscape needs a global search: the guarded multi-start (gamma_min >= guard, its designs
     # continued to the problem) and, on a problem with free scale and crank, the differential evolution
+    reported: ClassVar[bool] = True  # in every Result's quantities where it applies; False: in those of a problem
+    # that uses it alone (its objective or a bound), e.g. a criterion with a parameter of the problem's own
     quantity = None  # a peak over the turn: the quantity of the cycle's dynamics whose peak it is (the SQP on the
     # exact peak descends it, ``minimax``); None for any other criterion
 
@@ -131,6 +136,11 @@ class Criterion:
     def from_nlp(self, y: float, omega2: float) -> float:
         """The inverse of ``to_nlp``."""
         return -y if self.maximise else y
+
+    def baked(self, problem) -> tuple:
+        """What of a problem's numbers its NLP states as constants (the NLP is built once per problem structure
+        and these): () for none, the default."""
+        return ()
 
     def check(self, problem) -> str | None:
         """Why a problem cannot use this criterion (None: it can)."""

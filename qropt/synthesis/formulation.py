@@ -169,6 +169,7 @@ class Formulation:
         self.guarded = guarded  # with rows that keep the output's reversals at its dead centres (``_guard_rows``)
         self.branch, self.orientation = dict(branch), orientation
         self.range_target, self.sense, self.accel_over = range_target, sense, problem.accel_over
+        self.ccw = problem.omega2 > 0  # the crank's sense: a criterion that reads it says so (``Criterion.baked``)
         self.free, self.fixed = list(problem.free), list(problem.fixed)
         self.targets = [k for k in problem.targets if k != range_target]
         self.lengths = [k for k in cls.LENGTHS if k in problem.free or k in problem.fixed]
@@ -234,6 +235,18 @@ class Formulation:
                 )
                 k += len(exprs)
         self._capped = casadi.vertcat(*[e for exprs in capped for e in exprs])
+        # lifted extremes, like the dead centres: crank angles of a criterion's worst values that move with the design
+        # faster than samples follow them (each criterion says how many, and their rows); made before the epigraph
+        # groups, which may use them (``lifted``: criterion name -> its lifted angles)
+        self.lifts = []
+        for c in used:
+            role = Role.OBJECTIVE if c is self.objective else Role.BOUND
+            if not any(l0 is c for l0, _ in self.lifts):
+                self.lifts += [(c, k) for k in range(c.lifts(self, role))]
+        PHI = casadi.SX.sym("phi", len(self.lifts))
+        self.lifted = {}
+        for i, (c, _) in enumerate(self.lifts):
+            self.lifted.setdefault(c.name, []).append(PHI[i])
         # the criteria: the objective's epigraph group first, then each bound's (each criterion's group once)
         self.z_names, self._z_of = list(aux), {}
         epi = [(i, e) for i, (exprs, _, _) in enumerate(aux.values()) for e in exprs]
@@ -245,14 +258,6 @@ class Formulation:
                     epi += [(len(self.z_names), e) for e in exprs]
                     self.z_names.append(name)
         Z = casadi.vertcat(ZA, casadi.SX.sym("z", len(self.z_names) - len(aux)))
-        # lifted extremes, like the dead centres: crank angles of a criterion's worst values that move with the design
-        # faster than samples follow them (each criterion says how many, and their rows)
-        self.lifts = []
-        for c in used:
-            role = Role.OBJECTIVE if c is self.objective else Role.BOUND
-            if not any(l0 is c for l0, _ in self.lifts):
-                self.lifts += [(c, k) for k in range(c.lifts(self, role))]
-        PHI = casadi.SX.sym("phi", len(self.lifts))
         for i, (c, k) in enumerate(self.lifts):
             exprs = c.lift_terms(self, k, PHI[i], self.at(PHI[i]))
             epi += [(self._z_of[c.name][0], e) for e in exprs]
@@ -315,6 +320,7 @@ class Formulation:
             self._strokes,
             self.aux,
             self._capped,
+            self.lifted,
         )  # the build's
 
     # ---- the build -----------------------------------------------------------------------------------
@@ -384,6 +390,14 @@ class Formulation:
                 out += [(self.at(lo + 0.5 * arc * (1 + x)), w, arc) for x, w in zip(*nodes, strict=True)]
             self._strokes = out
         return self._strokes
+
+    def working_arc(self):
+        """(counter-clockwise start, length) of the working arc: expressions of the dead centres."""
+        return self._start, self._length
+
+    def fractions(self) -> list:
+        """The working-arc fractions (parameters): a criterion may read them as fractions of its own span."""
+        return [self._W[k] for k in range(self.n_samples)]
 
     def in_working(self, phi):
         """A lifted angle's place in the working stroke (0..1 inside it)."""

@@ -62,11 +62,14 @@ class Candidate:
 
 
 def _dynamic_key(problem) -> tuple:
-    """What a dynamic criterion bakes into its NLP: the masses, the loads and omega2 (nothing otherwise)."""
+    """What a criterion bakes into its NLP: a dynamic one the masses, the loads and omega2; any one what its
+    ``baked`` says (nothing otherwise)."""
     used = [criteria.of_problem(problem)] + [c for k, c in criteria.bounds().items() if k in problem.conditions]
-    if not any(c is not None and c.needs_masses for c in used):
-        return ()
-    return (repr(problem.masses), repr(problem.loads), problem.omega2)
+    used = [c for c in used if c is not None]
+    baked = tuple(b for c in used for b in c.baked(problem))
+    if not any(c.needs_masses for c in used):
+        return baked
+    return (repr(problem.masses), repr(problem.loads), problem.omega2, *baked)
 
 
 class Formulations:

@@ -12,6 +12,7 @@ const WORK = "#2e7d32", RET = "#e65100";
 const state = {
   types: {}, type: null, params: {}, units: "m", analysis: null, frames: null, playing: false,
   inflight: false, pending: false, updates: 0, answers: 0, designRows: [], selected: null, result: null, job: null,
+  objectives: {}, results: {},
 };
 window.qropt = state;
 
@@ -32,7 +33,66 @@ async function call(method, url, body) {
 
 function say(text) { $("status").textContent = text || ""; }
 
-async function runJob(kind, input, progressEl, cancelBtn) {
+// ---- results and the inputs they belong to ----------------------------------------------------------------
+// Every page's results are a group: its panels, a note above them and a function giving the page's inputs
+// (name -> the value as shown). A new result is fresh(group, inputs it was asked with). When a request fails, or
+// (on a page that does not recompute as one types) the inputs change after a result, the panels are dimmed and
+// the note says which inputs they belong to; the next result clears both. Before any result the note shows the
+// error alone.
+function resultGroup(name, { panels, inputs, note, watch, live }) {
+  const g = { name, panels: panels.map((id) => $(id)), inputs, shown: null, live: !!live, stale: false };
+  g.note = note ? $(note) : document.createElement("div");
+  if (!note) (g.panels[0].closest(".scroll") || g.panels[0]).before(g.note);
+  g.note.classList.add("stale-note");
+  g.note.id = g.note.id || `${name}-note`;
+  if (!g.live) {
+    for (const w of watch || []) for (const ev of ["input", "change"]) $(w).addEventListener(ev, () => inputsChanged(name));
+  }
+  state.results[name] = g;
+  return g;
+}
+
+function changes(was, now) {
+  return Object.keys({ ...was, ...now }).filter((k) => was[k] !== now[k]);
+}
+const FEW = 3;  // changed inputs named one by one; more are counted
+function listed(values, keys) {
+  const one = (k) => (values[k] === undefined ? `no ${k}` : `${k} = ${values[k]}`);
+  if (keys.length <= FEW) return keys.map(one).join(", ");
+  return `${keys.slice(0, 2).map(one).join(", ")} and ${keys.length - 2} other inputs since changed`;
+}
+// One line: the inputs the results belong to ("Results for r3 = 0.25"), then what the inputs now give.
+function belongs(was, now, keys, gives) {
+  const current = keys.length <= FEW ? ` (${listed(now, keys)})` : "";
+  return `Results for ${listed(was, keys)}; the inputs now${current} ${gives}`;
+}
+function markStale(g, text) {
+  g.stale = !!text;
+  for (const p of g.panels) p.classList.toggle("stale", g.stale);
+  g.note.textContent = text || "";
+}
+function fresh(name, inputs) {
+  const g = state.results[name];
+  g.shown = inputs || g.inputs();
+  markStale(g, "");
+  if (!g.live) inputsChanged(name);  // the inputs may have moved on while it was computed
+}
+function stale(name, why) {
+  const g = state.results[name];
+  if (!g.shown) { markStale(g, ""); g.note.textContent = why; return; }
+  const now = g.inputs(), keys = changes(g.shown, now);
+  markStale(g, keys.length ? belongs(g.shown, now, keys, `give: ${why}`)
+    : `Results for the inputs shown, which now give: ${why}`);
+}
+function inputsChanged(name) {
+  const g = state.results[name];
+  if (!g.shown) return;
+  const now = g.inputs(), keys = changes(g.shown, now);
+  markStale(g, keys.length ? belongs(g.shown, now, keys, "have no results yet") : "");
+}
+const shownNumber = (v) => (typeof v === "number" ? String(+v.toPrecision(6)) : String(v));
+
+async function runJob(kind, input, progressEl, cancelBtn, note = "") {
   const job = await call("POST", "/api/jobs", { kind, input });
   state.job = job.id;
   const t0 = performance.now();
@@ -45,7 +105,7 @@ async function runJob(kind, input, progressEl, cancelBtn) {
       const s = await call("GET", `/api/jobs/${job.id}`);
       const p = s.progress, secs = ((performance.now() - t0) / 1000).toFixed(1);
       if (progressEl) {
-        progressEl.textContent = `${kind}: ${s.state}` + (p.total ? `, ${p.done} of ${p.total}` : "") + ` (${secs} s)`;
+        progressEl.textContent = `${kind}: ${s.state}` + (p.total ? `, ${p.done} of ${p.total}` : "") + ` (${secs} s${note})`;
       }
       if (s.state === "done") return s.result;
       if (["failed", "cancelled", "timeout"].includes(s.state)) throw new Error(`${kind} ${s.state}: ${s.error}`);
@@ -296,11 +356,41 @@ function showParams(type, params) {
   analyze();
 }
 
-function masses() {
-  if (!$("m-dyn").checked) return null;
-  return { masses: { density: Number($("m-density").value), ram: Number($("m-ram").value), block: 0, bodies: {} },
-    loads: { cutting_force: Number($("m-force").value), friction: 0, gravity: Number($("m-gravity").value),
-      follower_torque: 0 } };
+// The mass model and load: one panel, built into every <div class="mass-model" data-prefix="P"> (the Mechanism
+// and Design pages), its inputs P-dyn (ticked: used), P-density, P-ram, P-force and P-gravity.
+const MASS_FIELDS = [["density", "links [kg/m]", 1.57, 0.1], ["ram", "ram [kg]", 20, 1],
+  ["force", "cutting force [N]", 1000, 100], ["gravity", "gravity [m/s²]", 9.81, 0.1]];
+function massPanel(div) {
+  const p = div.dataset.prefix, fs = document.createElement("fieldset");
+  fs.innerHTML = `<legend><label><input id="${p}-dyn" type="checkbox"> mass model and load</label></legend>`;
+  for (const [k, text, value, step] of MASS_FIELDS) {
+    const label = document.createElement("label"), input = document.createElement("input");
+    Object.assign(input, { id: `${p}-${k}`, type: "number", value, step, className: "num" });
+    label.append(`${text} `, input);
+    fs.appendChild(label);
+  }
+  div.appendChild(fs);
+}
+// The panel's masses and loads (Masses.to_dict and Loads.to_dict forms), or null when not ticked.
+function massModel(p) {
+  if (!$(`${p}-dyn`).checked) return null;
+  const v = (k) => Number($(`${p}-${k}`).value);
+  return { masses: { density: v("density"), ram: v("ram"), block: 0, bodies: {} },
+    loads: { cutting_force: v("force"), friction: 0, gravity: v("gravity"), follower_torque: 0 } };
+}
+function massInputs(p) {
+  if (!$(`${p}-dyn`).checked) return {};
+  return Object.fromEntries(MASS_FIELDS.map(([k, text]) => [text.split(" [")[0], $(`${p}-${k}`).value]));
+}
+
+// The Mechanism page's inputs as shown (lengths in the unit, angles in degrees).
+function mechanismInputs() {
+  const out = { type: state.type };
+  const kinds = (state.types[state.type] || {}).kinds || {};
+  for (const [k, v] of Object.entries(state.params)) out[k] = shownNumber(kinds[k] === "angle" ? v / DEG : v);
+  out.theta2 = `${$("m-theta").value} deg`;
+  out.omega2 = $("m-omega").value;
+  return { ...out, ...massInputs("m") };
 }
 
 // The live request (frames 0: no animation, no exact extremes) and the settled one (the turn's frames and,
@@ -308,7 +398,7 @@ function masses() {
 function request(frames) {
   const body = { type: state.type, params: state.params, theta2: Number($("m-theta").value) * DEG,
     omega2: Number($("m-omega").value), units: state.units, frames, polygons: frames === 0, extremes: frames > 0 };
-  const dyn = masses();
+  const dyn = massModel("m");
   if (dyn) Object.assign(body, dyn);
   return body;
 }
@@ -319,16 +409,17 @@ async function analyze() {
   state.inflight = true;
   state.pending = false;
   stopAnimation();
+  const asked = mechanismInputs();
   try {
     const a = await call("POST", "/api/analyze", request(0));
     state.analysis = a;
     state.updates += 1;
     state.answers += 1;
-    $("m-error").textContent = "";
     showAnalysis(a);
+    fresh("mechanism", asked);
   } catch (e) {
     state.answers += 1;
-    $("m-error").textContent = e.message;
+    stale("mechanism", e.message);
   } finally {
     state.inflight = false;
     if (state.pending) analyze();
@@ -433,41 +524,106 @@ function openDesign(type, params) {
   showParams(type, params);
 }
 
-// Design: the task solved for every type in a worker, the rows ranked, each with its picture.
+// Design: the task solved for every chosen type in a worker (a dynamic objective with the mass model and load,
+// within a time budget), the rows ranked, each with its picture.
+function objectiveOptions(select, entries) {
+  for (const o of entries) {
+    const text = o.objective + (o.size ? ` (${o.size})` : "") + ` — ${o.label}` + (o.dynamic ? ", mass model" : "");
+    const opt = new Option(text, o.criterion);
+    opt.dataset.dynamic = o.dynamic ? "1" : "";
+    select.add(opt);
+  }
+  select.value = "gamma_min";
+}
+
+function chosenObjective(select) {
+  const o = state.objectives[select.value];
+  return o.size ? { objective: o.objective, size: o.size } : { objective: o.objective };
+}
+
+// A dynamic objective needs the mass model and gets a time budget (30 s) unless one was typed; a kinematic one none.
+function designObjectiveChanged() {
+  const o = state.objectives[$("d-objective").value], b = $("d-budget");
+  if (o.dynamic) $("d-dyn").checked = true;
+  if (!b.dataset.typed) b.value = o.dynamic ? 30 : "";
+}
+
+function designTypes(types) {
+  const box = $("d-types");
+  for (const t of types) {
+    const label = document.createElement("label"), box1 = document.createElement("input");
+    Object.assign(box1, { type: "checkbox", checked: true, value: t.type, id: `d-type-${t.name}` });
+    box1.dataset.name = t.name;
+    label.title = `${t.class}` + (t.built_in ? "" : ` (${t.type}, served from its problem file)`);
+    label.append(box1, ` ${t.name}`);
+    box.appendChild(label);
+  }
+}
+
+function designInput() {
+  const input = { time_ratio: Number($("d-tr").value), stroke: Number($("d-stroke").value),
+    ...chosenObjective($("d-objective")), omega2: Number($("d-omega").value),
+    types: [...document.querySelectorAll("#d-types input:checked")].map((b) => b.value) };
+  if ($("d-gamma").value !== "") input.conditions = { gamma_min: Number($("d-gamma").value) * DEG };
+  if ($("d-budget").value !== "") input.time_limit = Number($("d-budget").value);
+  const dyn = massModel("d");
+  if (dyn) Object.assign(input, dyn);
+  return input;
+}
+
+function designInputs() {
+  const types = [...document.querySelectorAll("#d-types input:checked")].map((b) => b.dataset.name);
+  return { TR: $("d-tr").value, stroke: $("d-stroke").value, objective: $("d-objective").value,
+    "gamma_min at least": $("d-gamma").value || "none", omega2: $("d-omega").value,
+    budget: $("d-budget").value ? `${$("d-budget").value} s` : "none", types: types.join(" ") || "none",
+    ...massInputs("d") };
+}
+
 async function runDesign(ev) {
   ev.preventDefault();
-  const input = { time_ratio: Number($("d-tr").value), stroke: Number($("d-stroke").value),
-    objective: $("d-objective").value };
-  if ($("d-gamma").value !== "") input.conditions = { gamma_min: Number($("d-gamma").value) * DEG };
+  const asked = designInputs();
   $("d-run").disabled = true;
-  $("d-table").innerHTML = "";
-  $("d-pictures").innerHTML = "";
   try {
-    const c = await runJob("design", input, $("d-progress"), $("d-cancel"));
+    const input = designInput();
+    const budget = input.time_limit ? ` of a ${input.time_limit} s budget` : "";
+    const c = await runJob("design", input, $("d-progress"), $("d-cancel"), budget);
     state.designRows = c.rows;
-    const u = c.units.length;
-    table($("d-table"), ["#", "type", "status", "gamma_min [deg]", `footprint [${u}²]`, `peak accel [${u}/s²]`, "reason"],
-      c.rows.map((r, i) => [i + 1, r.type, r.status, r.gamma_min === null ? "-" : fmt(r.gamma_min / DEG, 4),
-        fmt(r.footprint), fmt(r.peak_accel), r.reason || ""]),
-      (i) => c.rows[i].mechanism && openDesign(c.rows[i].mechanism, c.rows[i].params));
-    const ok = c.rows.filter((r) => r.mechanism);
-    state.selected = ok.length ? { type: ok[0].mechanism, params: ok[0].params } : null;
-    for (const r of ok) {
-      const card = document.createElement("div");
-      card.className = "card";
-      card.innerHTML = `<strong></strong><br><span></span>`;
-      card.querySelector("strong").textContent = r.type;
-      card.querySelector("span").textContent = `gamma_min ${fmt(r.gamma_min / DEG, 4)} deg, ${r.status}`;
-      const svg = el("svg", { role: "img" }, card);
-      card.addEventListener("click", () => openDesign(r.mechanism, r.params));
-      $("d-pictures").appendChild(card);
-      call("POST", "/api/analyze", { type: r.mechanism, params: r.params, theta2: 0, omega2: 1, polygons: false })
-        .then((a) => drawMechanism(svg, a.drawing, a.drawing.shapes)).catch((e) => { card.title = e.message; });
-    }
+    showDesign(c, input);
+    fresh("design", asked);
   } catch (e) {
-    $("d-progress").textContent = e.message;
+    $("d-progress").textContent = "";
+    stale("design", e.message);
   } finally {
     $("d-run").disabled = false;
+  }
+}
+
+function showDesign(c, input) {
+  const u = c.units, length = u.length, obj = state.objectives[$("d-objective").value];
+  const cols = [["gamma_min", "gamma_min [deg]", (v) => fmt(v / DEG, 4)], ["footprint", `footprint [${length}²]`],
+    ["peak_accel", `peak accel [${length}/s²]`]];
+  if (!cols.some((col) => col[0] === obj.criterion)) cols.push([obj.criterion, `${obj.label} [${u[obj.criterion]}]`]);
+  if (input.masses && obj.criterion !== "peak_torque") cols.push(["peak_torque", `peak torque [${u.peak_torque}]`]);
+  table($("d-table"), ["#", "type", "status", ...cols.map((col) => col[1]), "certificate or reason"],
+    c.rows.map((r, i) => [i + 1, r.type, r.status,
+      ...cols.map(([k, , f]) => (r[k] === null || r[k] === undefined ? "-" : (f || fmt)(r[k]))),
+      r.reason || r.claim || ""]),
+    (i) => c.rows[i].mechanism && openDesign(c.rows[i].mechanism, c.rows[i].params));
+  const ok = c.rows.filter((r) => r.mechanism);
+  state.selected = ok.length ? { type: ok[0].mechanism, params: ok[0].params } : null;
+  $("d-pictures").innerHTML = "";
+  for (const r of ok) {
+    const card = document.createElement("div");
+    card.className = "card";
+    card.innerHTML = `<strong></strong><br><span></span>`;
+    card.querySelector("strong").textContent = r.type;
+    card.querySelector("span").textContent = `${obj.label} ${fmt(obj.unit === "rad" ? r[obj.criterion] / DEG : r[obj.criterion], 4)}`
+      + `${obj.unit === "rad" ? " deg" : " " + u[obj.criterion]}, ${r.status}`;
+    const svg = el("svg", { role: "img" }, card);
+    card.addEventListener("click", () => openDesign(r.mechanism, r.params));
+    $("d-pictures").appendChild(card);
+    call("POST", "/api/analyze", { type: r.mechanism, params: r.params, theta2: 0, omega2: 1, polygons: false })
+      .then((a) => drawMechanism(svg, a.drawing, a.drawing.shapes)).catch((e) => { card.title = e.message; });
   }
 }
 
@@ -511,7 +667,21 @@ function formProblem() {
     else fixed[k] = Number($(`s-v-${k}`).value);
   }
   return { mechanism: type, fixed, free, targets: { time_ratio: Number($("s-tr").value), stroke: Number($("s-stroke").value) },
-    objective: $("s-objective").value };
+    ...chosenObjective($("s-objective")) };
+}
+
+// The Synthesis page's inputs: the problem's JSON, flattened (targets.time_ratio = 1.5).
+function synthesisInputs() {
+  let p;
+  try { p = JSON.parse($("s-json").value); } catch (e) { return { problem: "not JSON" }; }
+  const out = {};
+  const walk = (v, path) => {
+    if (v && typeof v === "object" && !Array.isArray(v)) {
+      for (const [k, x] of Object.entries(v)) walk(x, path ? `${path}.${k}` : k);
+    } else out[path || "problem"] = Array.isArray(v) ? JSON.stringify(v) : shownNumber(v);
+  };
+  walk(p, "");
+  return out;
 }
 
 function problemText() {
@@ -520,13 +690,13 @@ function problemText() {
 
 async function runSolve() {
   $("s-solve").disabled = true;
-  $("s-result").innerHTML = "";
-  $("s-optima").innerHTML = "";
+  const asked = synthesisInputs();
   try {
     const problem = problemText();
     const r = await runJob("solve", problem, $("s-progress"), $("s-cancel"));
     state.result = { problem, result: r };
     const div = $("s-result");
+    div.innerHTML = "";
     const h = document.createElement("p");
     h.innerHTML = `<span class="status-${r.status}"></span> <span></span>`;
     h.children[0].textContent = r.status;
@@ -546,8 +716,10 @@ async function runSolve() {
         o.quantities && o.quantities.gamma_min !== undefined ? fmt(o.quantities.gamma_min / DEG, 5) : "-", fmt(o.objective, 6)]),
       (i) => openDesign(type, opt[i].params));
     if (r.params && Object.keys(r.params).length) state.selected = { type, params: r.params };
+    fresh("solve", asked);
   } catch (e) {
-    $("s-progress").textContent = e.message;
+    $("s-progress").textContent = "";
+    stale("solve", e.message);
   } finally {
     $("s-solve").disabled = false;
   }
@@ -555,6 +727,7 @@ async function runSolve() {
 
 async function runFront() {
   $("s-front").disabled = true;
+  const asked = synthesisInputs();
   try {
     const problem = problemText();
     const f = await runJob("pareto", { problem, objectives: ["max_gamma_min", "min_peak_accel"], n: 7 },
@@ -563,8 +736,10 @@ async function runFront() {
     scatter($("s-front-svg"), f.values.map((v) => [a === "gamma_min" ? v[0] / DEG : v[0], v[1]]),
       a === "gamma_min" ? "gamma_min [deg]" : a, `${b} [${f.units}/s²]`,
       (i) => openDesign(problem.mechanism, f.points[i].params));
+    fresh("front", asked);
   } catch (e) {
-    $("s-progress").textContent = e.message;
+    $("s-progress").textContent = "";
+    stale("front", e.message);
   } finally {
     $("s-front").disabled = false;
   }
@@ -615,7 +790,20 @@ function exportBar(div) {
 async function start() {
   window.addEventListener("hashchange", route);
   route();
-  const info = await call("GET", "/api/types");
+  document.querySelectorAll(".mass-model").forEach(massPanel);
+  const [info, options] = await Promise.all([call("GET", "/api/types"), call("GET", "/api/design/options")]);
+  for (const o of options.objectives) state.objectives[o.criterion] = o;
+  objectiveOptions($("d-objective"), options.objectives);
+  objectiveOptions($("s-objective"), options.objectives.filter((o) => !o.dynamic));  // the form has no masses
+  designTypes(options.types);
+  $("d-budget").max = options.time_limit;
+  $("d-objective").addEventListener("change", designObjectiveChanged);
+  $("d-budget").addEventListener("input", () => { $("d-budget").dataset.typed = "1"; });
+  resultGroup("mechanism", { panels: ["m-numbers", "m-svg", "m-plot", "m-vpoly", "m-apoly", "m-torque", "m-forces"],
+    inputs: mechanismInputs, note: "m-error", live: true });
+  resultGroup("design", { panels: ["d-table", "d-pictures"], inputs: designInputs, watch: ["design-form"] });
+  resultGroup("solve", { panels: ["s-result", "s-optima"], inputs: synthesisInputs, watch: ["s-json"] });
+  resultGroup("front", { panels: ["s-front-svg"], inputs: synthesisInputs, watch: ["s-json"] });
   for (const t of info) {
     state.types[t.type] = t;
     $("m-type").add(new Option(`${t.class} (${t.type})`, t.type));
@@ -628,12 +816,13 @@ async function start() {
   $("m-play").addEventListener("click", play);
   $("design-form").addEventListener("submit", runDesign);
   $("s-type").addEventListener("change", () => synthesisForm($("s-type").value));
-  $("s-to-json").addEventListener("click", () => { $("s-json").value = JSON.stringify(formProblem(), null, 2); });
+  const problemSet = (text) => { $("s-json").value = text; inputsChanged("solve"); inputsChanged("front"); };
+  $("s-to-json").addEventListener("click", () => problemSet(JSON.stringify(formProblem(), null, 2)));
   $("s-solve").addEventListener("click", runSolve);
   $("s-front").addEventListener("click", runFront);
   $("s-file").addEventListener("change", async () => {
     const f = $("s-file").files[0];
-    if (f) $("s-json").value = await f.text();
+    if (f) problemSet(await f.text());
   });
   document.querySelectorAll(".export").forEach(exportBar);
   const first = info.find((t) => t.type === "drag-link-slider") || info[0];
