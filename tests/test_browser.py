@@ -99,6 +99,8 @@ def test_mechanism_page_drag_a_slider(page, tmp_path):
     m = mechanism_type("drag-link-slider")(**state["params"])
     assert _shown(page)["timeRatio"] == pytest.approx(m.time_ratio(), rel=1e-12)
     assert page.locator("#m-svg line[data-part='link']").count() >= 4  # the links drawn
+    names = sorted(page.locator("#m-svg text.joint-name").all_text_contents())  # every joint named, as the tables
+    assert names == ["A", "B", "C", "D", "O2", "O4"], names
     assert page.locator("#m-svg .path-working").count() >= 1 and page.locator("#m-svg .path-return").count() >= 1
     assert page.locator("#m-vpoly line").count() >= 4 and page.locator("#m-plot polyline").count() == 3
     # the forces appear with a mass model, the exact peaks once the inputs rest

@@ -171,3 +171,16 @@ def test_bad_windows_and_uses_are_refused_by_name():
     assert r.status != "optimal"
     with pytest.raises(ProblemError):
         criteria.unregister("cut_speed_variation")  # built in
+
+
+def test_a_window_that_does_not_fit_every_design_stays_out_of_other_problems_results():
+    """A window of distances registered in this process (longer than the task's stroke here) is reported only by
+    the problems that use it: a design and a solve by other objectives neither compute nor fail on it."""
+    from qropt.studies._design import type_problem
+
+    long = cut.window(qropt.Window(x=(0.03, 5.0), stroke="working"))
+    row = qropt.design(1.5, 0.3, types=["slider-crank"]).rows[0]
+    assert row.result.success and row.criteria[long.name] is None
+    assert row.criteria["cut_speed_variation"] is not None  # the registered fractions fit every design
+    r = qropt.solve(type_problem("slider-crank", 1.5, 0.3, objective="max_gamma_min"))
+    assert r.success and long.name not in r.quantities and "cut_speed_variation" in r.quantities

@@ -396,8 +396,8 @@ def _row(kind, problem, r: Result) -> Row:
     dynamic = problem.masses is not None or problem.loads is not None  # the dynamic criteria need them
     problem = problem.settled(r)  # with the counterweight the solve chose, where it was free
     values = {
-        name: c.value(problem, r.mechanism)
-        for name, c in criteria.CRITERIA.items()
+        c.name: c.value(problem, r.mechanism)
+        for c in criteria.reported(problem)
         if c.applies(problem.mechanism) and (dynamic or not c.needs_masses)
     }
     values["torque_per_newton"] = r.quantities["torque_per_newton"]

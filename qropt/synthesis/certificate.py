@@ -111,12 +111,10 @@ def quantities(problem, m) -> dict:
     q["size"] = m.size(problem.size)
     q["working_direction"] = m.working_direction(problem.omega2)
     dynamic = problem.masses is not None or problem.loads is not None
-    used = {criteria.of_problem(problem)} | {c for k, c in criteria.bounds().items() if k in problem.conditions}
-    for name, c in criteria.CRITERIA.items():
-        wanted = dynamic if c.needs_masses else name not in criteria.BUILT_IN  # the others are computed above
-        wanted = (wanted and c.reported) or (c in used and not c.reported)
-        if wanted and c.applies(type(m)):
-            q[name] = c.value(problem, m)
+    for c in criteria.reported(problem):
+        done = c.name in q or c.name in criteria.SIZES  # above (the size by the problem's measure)
+        if not done and (dynamic or not c.needs_masses) and c.applies(type(m)):
+            q[c.name] = c.value(problem, m)
     return q
 
 

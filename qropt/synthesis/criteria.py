@@ -514,6 +514,13 @@ def of_problem(problem) -> Criterion | None:
     return of(problem.objective, problem.size) if problem.objective else None
 
 
+def reported(problem) -> list[Criterion]:
+    """The registered criteria a problem's results report: every ``reported`` one, and one that is not where the
+    problem's objective or a bound of its conditions uses it."""
+    used = {of_problem(problem)} | {c for k, c in bounds().items() if k in problem.conditions}
+    return [c for c in CRITERIA.values() if c.reported or c in used]
+
+
 def grid_criterion(problem) -> Criterion | None:
     """The problem's objective criterion where a grid screen can value it (``Criterion.grid_value``), else None."""
     c = of_problem(problem)

@@ -83,10 +83,10 @@ class CutSpeedVariation(Criterion):
     both measured along the working direction from the working stroke's start dead centre (module docstring)."""
 
     unit, label, slider_only = "1", "cut speed variation", True
-    reported = False  # a window of distances may not fit every design: in the quantities of its own problems
 
     def __init__(self, cut=DEFAULT_CUT, name: str = NAME):
         self.kind, self.lo, self.hi = _cut(cut)
+        self.reported = self.kind == "fraction"  # a window of distances may not fit every design: only its problems
         if not isinstance(name, str) or not name.isidentifier():
             raise InvalidParameter(f"a criterion's name is an identifier, got {name!r:.60}")
         self.name = name

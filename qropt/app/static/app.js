@@ -180,6 +180,13 @@ function drawMechanism(svg, drawing, shapes, label) {
   if (label) {
     const fs = unitsPerPixel(svg, w + 2 * pad, h + 2 * pad, 13);
     el("text", { x: x - pad + fs * 0.5, y: -(y + h) - pad + fs * 1.2, "font-size": fs, fill: "#333" }, svg, label);
+    const js = unitsPerPixel(svg, w + 2 * pad, h + 2 * pad, 13);  // each joint's name, as the tables name it
+    for (const s of shapes) {
+      if (s.part !== "pivot" && s.part !== "joint") continue;
+      const [jx, jy] = s.points[0];
+      el("text", { x: jx + 0.5 * js, y: -jy - 0.5 * js, "font-size": js, fill: "#1a237e", stroke: "#fff",
+        "stroke-width": 0.25 * js, "paint-order": "stroke", "font-weight": "bold", class: "joint-name" }, svg, s.name);
+    }
   }
 }
 
