@@ -449,3 +449,23 @@ def test_a_synthesis_hint_by_its_old_name_is_refused_with_the_new_spelling(old, 
         assert getattr(hinted.SYNTHESIS, field) == value and dataclasses.is_dataclass(hinted.SYNTHESIS)
     finally:
         REGISTRY.pop("new-hints", None)
+
+
+def test_a_criterion_that_does_not_apply_says_why():
+    """A dynamic objective of a type whose loop is hand-written (its bodies declared, its linkage not built with
+    the builder) names the builder; a slider's criterion on a four-bar names the missing slider."""
+    shaper = _slotted().BentLeverShaper
+    kw = {"masses": qropt.Masses.bars(2.0, 5.0), "loads": qropt.Loads(100.0)}
+    with pytest.raises(
+        ProblemError,
+        match=r"BentLeverShaper is not declared with the linkage builder .*: "
+        r"min_peak_torque does not apply",
+    ):
+        type_problem(shaper, 1.5, 0.3, objective="min_peak_torque", **kw)
+    with pytest.raises(ProblemError, match="FourBar has no slider: min_peak_accel does not apply"):
+        Problem(
+            mechanism="four-bar",
+            free={"r1": (1, 2), "r2": (0.1, 0.5), "r3": (1, 3), "r4": (1, 3)},
+            targets={"time_ratio": 1.2},
+            objective="min_peak_accel",
+        )

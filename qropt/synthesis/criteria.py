@@ -113,6 +113,10 @@ class Criterion:
         """Whether a mechanism type has this criterion."""
         return not (self.slider_only and cls.OUTPUT != "slider")
 
+    def why_not(self, cls) -> str:
+        """Why a type this criterion does not apply to (``applies`` False) lacks it, in a clause."""
+        return f"{cls.__name__} has no slider"
+
     def better(self, a, b) -> bool:
         """a beats b (None loses)."""
         if b is None:

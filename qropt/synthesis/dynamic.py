@@ -387,6 +387,12 @@ class _Dynamic(Criterion):
     def applies(self, cls) -> bool:  # a type declared with the builder (its bodies and joints are known)
         return cls.linkage(dict(cls.PARAMS)) is not None
 
+    def why_not(self, cls) -> str:
+        return (
+            f"{cls.__name__} is not declared with the linkage builder (qropt.mechanisms.builder), so its bodies and "
+            "joints, which the dynamics need, are unknown"
+        )
+
     def check(self, problem) -> str | None:
         return _problem_check(self, problem)
 

@@ -228,7 +228,7 @@ class Problem:
                 if c[k] > MAGNITUDE**2 or c[k] < MAGNITUDE**-2:  # footprints are length^2; MAGNITUDE^2 is finite
                     raise self._err(f"{k} = {c[k]:g} is out of range")
             if k in c and not crit.applies(self.mechanism):
-                raise self._err(f"{self.mechanism.__name__} has no slider: {k} does not apply")
+                raise self._err(f"{crit.why_not(self.mechanism)}: {k} does not apply")
         linear = []
         for row in c.get("linear", ()):
             if not (
@@ -281,7 +281,8 @@ class Problem:
         if abs(self.omega2) > MAX_OMEGA2:
             raise self._err(f"omega2 = {self.omega2:g} rad/s is out of range (|omega2| <= {MAX_OMEGA2:g} rad/s)")
         if self.objective and not criteria.of(self.objective, self.size).applies(self.mechanism):
-            raise self._err(f"{self.mechanism.__name__} has no slider: {self.objective} does not apply")
+            c = criteria.of(self.objective, self.size)
+            raise self._err(f"{c.why_not(self.mechanism)}: {self.objective} does not apply")
         used = [criteria.of(self.objective, self.size)] if self.objective else []
         used += [c for k, c in criteria.bounds().items() if k in self.conditions]
         for c in used:
