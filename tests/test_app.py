@@ -257,8 +257,8 @@ def test_design_job_dynamic_objective_with_masses_loads_and_budget(client):
 
 def test_design_types_filter_with_a_user_type(client):
     """types names a built-in row and the served user type (by its module:Class name): one row each, every design
-    meeting the task; a budget keeps it short."""
-    body = {"time_ratio": 1.4, "stroke": 0.5, "types": ["crank-shaper", USER], "time_limit": 5}
+    meeting the task."""
+    body = {"time_ratio": 1.4, "stroke": 0.5, "types": ["crank-shaper", USER]}
     r = client.post("/api/design", json=body)
     assert r.status_code == 200, r.get_json()
     rows = r.get_json()["rows"]
