@@ -393,13 +393,8 @@ def design(
 def _row(kind, problem, r: Result) -> Row:
     if r.status not in SOLUTION_PRESENT:
         return Row(kind, r, {}, r.message)
-    dynamic = problem.masses is not None or problem.loads is not None  # the dynamic criteria need them
     problem = problem.settled(r)  # with the counterweight the solve chose, where it was free
-    values = {
-        c.name: c.value(problem, r.mechanism)
-        for c in criteria.reported(problem)
-        if c.applies(problem.mechanism) and (dynamic or not c.needs_masses)
-    }
+    values = {c.name: c.value(problem, r.mechanism) for c in criteria.reported(problem, problem.mechanism)}
     values["torque_per_newton"] = r.quantities["torque_per_newton"]
     return Row(kind, r, {k: values.get(k) for k in columns()}, "")
 

@@ -110,10 +110,8 @@ def quantities(problem, m) -> dict:
     q["grashof"] = m.grashof().kind if m.FOUR_BAR else None
     q["size"] = m.size(problem.size)
     q["working_direction"] = m.working_direction(problem.omega2)
-    dynamic = problem.masses is not None or problem.loads is not None
-    for c in criteria.reported(problem):
-        done = c.name in q or c.name in criteria.SIZES  # above (the size by the problem's measure)
-        if not done and (dynamic or not c.needs_masses) and c.applies(type(m)):
+    for c in criteria.reported(problem, type(m)):
+        if c.name not in q and c.name not in criteria.SIZES:  # above (the size by the problem's measure)
             q[c.name] = c.value(problem, m)
     return q
 

@@ -518,11 +518,17 @@ def of_problem(problem) -> Criterion | None:
     return of(problem.objective, problem.size) if problem.objective else None
 
 
-def reported(problem) -> list[Criterion]:
-    """The registered criteria a problem's results report: every ``reported`` one, and one that is not where the
-    problem's objective or a bound of its conditions uses it."""
+def reported(problem, kind) -> list[Criterion]:
+    """The registered criteria a problem's results report for a mechanism of class ``kind``: those that apply to
+    it, every ``reported`` one and one that is not where the problem's objective or a bound of its conditions uses
+    it; one that needs masses only where the problem has masses or loads."""
     used = {of_problem(problem)} | {c for k, c in bounds().items() if k in problem.conditions}
-    return [c for c in CRITERIA.values() if c.reported or c in used]
+    dynamic = problem.masses is not None or problem.loads is not None
+    return [
+        c
+        for c in CRITERIA.values()
+        if (c.reported or c in used) and c.applies(kind) and (dynamic or not c.needs_masses)
+    ]
 
 
 def grid_criterion(problem) -> Criterion | None:
