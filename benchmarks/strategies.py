@@ -137,11 +137,12 @@ def main(argv=None) -> None:
         default=["shape search", "related atlas optima", "atlas", "across a full turn's edge", "least-size tie-break"],
         help="strategy names (search.DEFAULT's), each left out in turn",
     )
+    ap.add_argument("--name", default="strategies", help="results/NAME.json and results/NAME.md")
     args = ap.parse_args(argv)
     records = run(args.tasks, args.objectives, args.leave_out)
     s = summary(records)
-    save("strategies.json", {"tasks": args.tasks, "objectives": args.objectives, "summary": s, "rows": records})
-    (RESULTS / "strategies.md").write_text(markdown(s))
+    save(f"{args.name}.json", {"tasks": args.tasks, "objectives": args.objectives, "summary": s, "rows": records})
+    (RESULTS / f"{args.name}.md").write_text(markdown(s))
     print(markdown(s))
 
 

@@ -48,13 +48,12 @@ from qropt.mechanisms import (
     grashof,
     mechanism_type,
 )
+from qropt.schema import VERSION as __version__  # noqa: F401 - the installed package's (pyproject.toml)
 from qropt.studies import Chart, Comparison, Family, Front, Reachable, chart, design, family, pareto, reachable
 from qropt.synthesis.certificate import Certificate
 from qropt.synthesis.problem import Problem
 from qropt.synthesis.result import STATUSES, Result
 from qropt.synthesis.solver import Solver, solve, target_range
-
-__version__ = "0.1.0"
 
 __all__ = [
     # mechanism types

@@ -14,15 +14,15 @@ import json
 import math
 from xml.sax.saxutils import escape
 
+from qropt import schema, validate
 from qropt import units as units_
-from qropt import validate
 from qropt.errors import InvalidParameter, QroptError
 from qropt.io import drawing
 from qropt.mechanisms import Mechanism, mechanism_type, type_reference
 from qropt.validate import output_path
 
 LAYERS = drawing.LAYERS  # name -> DXF colour
-RESERVED = ("type", "params", "units")  # the design file's own fields
+RESERVED = ("type", "params", "units", *schema.FIELDS)  # the design file's own fields
 LEGACY_UNITS = "lengths in one consistent unit, angles in rad"  # what design files said before units were stated
 DXF_UNITS = {"m": 6, "cm": 5, "mm": 4, "um": 13, "in": 1, "ft": 2}  # $INSUNITS codes (ezdxf.units)
 
@@ -157,9 +157,9 @@ def _coords(args):
 
 
 def save_design(m: Mechanism, path, **extra) -> None:
-    """A design file: the type (its KIND; a type not shipped with qropt as "module:Class"), every parameter, its
-    length unit ("units": "mm"; angles in rad), and any extra JSON-ready fields (strict JSON: finite numbers,
-    strings, lists, dictionaries, booleans and null)."""
+    """A design file: the schema version and qropt's (``qropt.schema.stamp``), the type (its KIND; a type not
+    shipped with qropt as "module:Class"), every parameter, its length unit ("units": "mm"; angles in rad), and any
+    extra JSON-ready fields (strict JSON: finite numbers, strings, lists, dictionaries, booleans and null)."""
     _mechanism(m)
     p = output_path(path, (".json",), "design file")
     clash = [k for k in extra if k in RESERVED]
@@ -171,7 +171,7 @@ def save_design(m: Mechanism, path, **extra) -> None:
         except (ValueError, TypeError, RecursionError) as e:
             why = "nan or infinite numbers" if isinstance(e, ValueError) else type(e).__name__
             raise InvalidParameter(f"save_design: extra field {k!r} is not strict JSON ({why}): {v!r:.80}") from None
-    d = {"type": type_reference(type(m)), "params": dict(m.params), "units": m.units, **extra}
+    d = {**schema.stamp(), "type": type_reference(type(m)), "params": dict(m.params), "units": m.units, **extra}
     text = json.dumps(d, indent=2, allow_nan=False) + "\n"
     _write(p, lambda q: q.write_text(text))
 
@@ -179,8 +179,10 @@ def save_design(m: Mechanism, path, **extra) -> None:
 def read_design(path) -> dict:
     """The table of a design file (``save_design``, or the JSON of ``qropt synth/analyze --json``): a JSON object
     with a type name under 'type' and a table under 'params'. InvalidParameter naming the file for a path that is
-    not a regular file of at most ``qropt.validate.MAX_FILE`` bytes, or text that is not such a table."""
+    not a regular file of at most ``qropt.validate.MAX_FILE`` bytes, or text that is not such a table, or a file
+    of a newer schema than this qropt's (one of an older schema, or of none, is read as before)."""
     d = validate.json_document(validate.read_text(path, "design file"), str(path), "design")
+    schema.check(d, str(path), InvalidParameter)
     if not isinstance(d, dict) or not isinstance(d.get("params"), dict) or not d.get("type"):
         raise InvalidParameter(f"{path}: a design file has 'type' and 'params'")
     if not isinstance(d["type"], str):

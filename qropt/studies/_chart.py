@@ -18,7 +18,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from qropt import validate
+from qropt import schema, validate
 from qropt.errors import ChartError, QroptError
 from qropt.synthesis import criteria
 from qropt.synthesis.criteria import maximises
@@ -336,6 +336,7 @@ class Chart:
     def to_dict(self) -> dict:
         axis = lambda a: None if a is None else {"name": a.name, "values": list(a.values), "kind": a.kind}  # noqa: E731
         return {
+            **schema.stamp(),
             "problem": self.problem.to_dict(),
             "x": axis(self.x),
             "y": axis(self.y),
@@ -351,13 +352,14 @@ class Chart:
 
     @classmethod
     def from_json(cls, path) -> Chart:
-        """A chart written by ``to_json``, checked whole on load: its axes, every cell in place, its stats
-        (ChartError naming the file and what is wrong)."""
+        """A chart written by ``to_json``, checked whole on load: its schema (a newer one than this qropt's is
+        refused), its axes, every cell in place, its stats (ChartError naming the file and what is wrong)."""
         _path(path, "JSON")
         try:
             d = validate.json_document(validate.read_text(path, "chart file"), str(path), "chart")
         except QroptError as e:
             raise ChartError(f"{path}: not a qropt chart file ({e})") from None
+        schema.check(d, str(path), ChartError)  # a newer file is refused; an older one (or one with none) is read
         try:
             return cls._from_dict(d)
         except QroptError as e:

@@ -22,6 +22,7 @@ import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 
+from qropt import schema
 from qropt import units as units_
 from qropt.errors import ProblemError, QroptError
 from qropt.mechanisms import TYPES as SHIPPED
@@ -203,8 +204,10 @@ class Comparison:
         return [r.record() | {"units": self.units} for r in self.rows]
 
     def to_json(self) -> str:
-        """The comparison as JSON; "units" names each criterion's unit, "length" the length unit."""
+        """The comparison as JSON, led by the schema version and qropt's (``qropt.schema.stamp``); "units" names
+        each criterion's unit, "length" the length unit."""
         d = {
+            **schema.stamp(),
             "time_ratio": self.time_ratio,
             "stroke": self.stroke,
             "objective": self.objective,

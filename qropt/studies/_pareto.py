@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from qropt import schema
 from qropt.errors import ProblemError
 from qropt.synthesis import criteria
 from qropt.synthesis.problem import Problem
@@ -56,9 +57,11 @@ class Front:
         ]
 
     def to_json(self) -> str:
-        """The front as strict JSON: its points (``table``) in order along it, the sweep points removed and why;
-        "units" names each criterion's unit, "length" the length unit."""
+        """The front as strict JSON, led by the schema version and qropt's (``qropt.schema.stamp``): its points
+        (``table``) in order along it, the sweep points removed and why; "units" names each criterion's unit,
+        "length" the length unit."""
         d = {
+            **schema.stamp(),
             "objectives": list(self.objectives),
             "criteria": list(self.criteria),
             "units": {"length": self.problem.units, **criteria.units(self.problem.units)},

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Any
 
+from qropt import schema
 from qropt import units as units_
 from qropt.dynamics.model import Loads, Masses
 from qropt.errors import ProblemError, QroptError
@@ -324,6 +325,8 @@ class Problem:
         """The Problem of ``to_dict`` (or a hand-written dict, TOML or JSON table), validated as always."""
         if not isinstance(d, Mapping):
             raise ProblemError(f"a problem is a table of fields, got {type(d).__name__}")
+        schema.check(d, "the problem", ProblemError)  # a newer file is refused; its schema and qropt are not fields
+        d = {k: v for k, v in d.items() if k not in schema.FIELDS}
         known = {f.name for f in fields(cls)}
         unknown = sorted(set(d) - known)
         if unknown or "mechanism" not in d:
@@ -334,7 +337,8 @@ class Problem:
         return cls(**d)
 
     def to_json(self) -> str:
-        return json.dumps(self.to_dict(), indent=2, allow_nan=False)
+        """JSON, led by the schema version and qropt's (``qropt.schema.stamp``)."""
+        return json.dumps({**schema.stamp(), **self.to_dict()}, indent=2, allow_nan=False)
 
     @classmethod
     def from_json(cls, text: str) -> Problem:
@@ -355,10 +359,10 @@ class Problem:
         return cls.from_dict(d)
 
     def to_toml(self) -> str:
-        """TOML (an objective of None is written "none")."""
+        """TOML (an objective of None is written "none"), led by the schema version and qropt's."""
         import tomli_w
 
-        d = self.to_dict()
+        d = {**schema.stamp(), **self.to_dict()}
         d["objective"] = d["objective"] or "none"
         return tomli_w.dumps(d)
 

@@ -19,6 +19,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from qropt import schema
 from qropt import units as units_
 from qropt.errors import ProblemError, QroptError
 from qropt.synthesis.certificate import Certificate
@@ -182,12 +183,14 @@ class Result:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
-        """Strict-JSON dictionary (no NaN: None); the mechanism as its type kind (a type not shipped with qropt as
-        "module:Class", see ``qropt.mechanisms.type_reference``) and parameters."""
+        """Strict-JSON dictionary (no NaN: None), led by the schema version and qropt's (``qropt.schema.stamp``);
+        the mechanism as its type kind (a type not shipped with qropt as "module:Class", see
+        ``qropt.mechanisms.type_reference``) and parameters."""
         from qropt.mechanisms import type_reference
 
         return json_safe(
             {
+                **schema.stamp(),
                 "units": unit_names(self.units),
                 "status": self.status,
                 "success": self.success,
@@ -214,6 +217,7 @@ class Result:
             raise ProblemError(f"not a qropt Result dictionary: a table of fields, got {type(d).__name__}")
         if _depth > MAX_DEPTH:
             raise ProblemError(f"not a qropt Result dictionary: local_optima nested deeper than {MAX_DEPTH} levels")
+        schema.check(d, "the Result dictionary", ProblemError)  # a newer one is refused; an older one read as before
         try:
             return cls._from_dict(d, _depth)
         except QroptError as e:
