@@ -117,6 +117,11 @@ def test_analyze_frames_and_a_user_type(client):
     d = r.get_json()["drawing"]
     assert len(d["frames"]) == 12 and [f["theta2_deg"] for f in d["frames"]][:2] == pytest.approx([0.0, 30.0])
     assert {f["working"] for f in d["frames"]} == {True, False}
+    # a hand-written loop has no polygons: the answer says why (the app writes it in the polygons' boxes)
+    a = client.post("/api/analyze", json={"type": name, "params": info[name]["params"]}).get_json()
+    assert a["polygons"] is None and "not declared with the linkage builder" in a["polygons_reason"]
+    paper = client.post("/api/analyze", json={"type": "drag-link-slider", "params": info["drag-link-slider"]["params"]})
+    assert paper.get_json()["polygons"] and paper.get_json()["polygons_reason"] == ""
 
 
 @pytest.mark.parametrize(

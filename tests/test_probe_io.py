@@ -120,3 +120,26 @@ def test_a_good_design_file_still_round_trips(tmp_path):
     d = json.loads((tmp_path / "d.json").read_text())
     assert d["note"] == "fine" and export.load_design(tmp_path / "d.json") == _m()
     assert issubclass(InvalidParameter, QroptError)
+
+
+@pytest.mark.parametrize(
+    ("kw", "words"),
+    [
+        ({"path": "x.xyz"}, "'.xyz'"),
+        ({"path": "no/x.png"}, "does not exist"),
+        ({"theta2": math.nan}, "theta2"),
+        ({"omega2": "fast"}, "omega2"),
+    ],
+)
+def test_a_mechanism_plot_checks_its_inputs_first(kw, words, tmp_path):
+    kw = {"path": "m.png", **kw}
+    path = tmp_path / kw.pop("path")
+    _fails_fast(lambda: _m().plot(path, **kw), InvalidParameter, words)
+    assert not path.exists()
+
+
+def test_a_mechanism_plot_draws_it_at_its_crank_angle(tmp_path):
+    _m().plot(tmp_path / "m.svg", theta2=math.radians(30), omega2=2.0)
+    labels = re.findall(r"<!-- (.*?) -->", (tmp_path / "m.svg").read_text())  # matplotlib's SVG names each text
+    assert "SliderCrank at theta2 = 30.0 deg" in labels and {"O2", "A", "C"} <= set(labels)
+    assert "x [m]" in labels and "theta2 [deg] (omega2 = 2 rad/s)" in labels

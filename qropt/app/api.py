@@ -221,7 +221,8 @@ def analyze(payload) -> dict:
     }
     out["drawing"] = drawing(m, theta2, frames, start, length)
     if show_polygons:
-        out["polygons"] = polygons(m, theta2, omega2, alpha2)
+        shown = polygons(m, theta2, omega2, alpha2)
+        out["polygons"], out["polygons_reason"] = (None, shown) if isinstance(shown, str) else (shown, "")
     if d.get("masses") is not None:
         out["dynamics"] = forces(m, theta2, omega2, alpha2, d["masses"], d.get("loads"), extremes)
     return out
@@ -276,13 +277,13 @@ def _shape(s) -> dict:
     return d
 
 
-def polygons(m: Mechanism, theta2: float, omega2: float, alpha2: float) -> list[dict] | None:
+def polygons(m: Mechanism, theta2: float, omega2: float, alpha2: float) -> list[dict] | str:
     """The velocity and acceleration equations at theta2, term by term (components and the joint's exact
-    vector), for a type built from dyads; None for a type without a linkage declaration."""
+    vector), for a type built from dyads; for a type without a linkage declaration, why not (a string)."""
     try:
         rm = m.relative_motion(theta2, omega2, alpha2)
-    except QroptError:
-        return None
+    except QroptError as e:
+        return str(e)
     return [
         {
             "joint": e.joint,

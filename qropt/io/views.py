@@ -5,8 +5,11 @@ imports this module, so every object has its views. matplotlib is imported on th
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
+from qropt import validate
 from qropt.convex.servo import SpeedProfile
 from qropt.errors import ChartError
 from qropt.io import notebook
@@ -15,6 +18,17 @@ from qropt.mechanisms.relative_motion import RelativeMotion
 from qropt.studies import Chart, Comparison, Family, Front
 from qropt.synthesis.result import Result
 from qropt.validate import picture_path
+
+
+def _plot_mechanism(self, path, theta2: float = math.radians(60), omega2: float = 1.0) -> None:
+    """The mechanism drawn at theta2 (rad), joints named, beside its output's position, velocity and acceleration
+    over a turn at omega2 (rad/s), the working stroke shaded (``qropt.io.plots.cycle_figure``)."""
+    from qropt.io import plots
+
+    picture_path(path)
+    theta2 = validate.number("theta2", theta2)
+    omega2 = validate.number("omega2", omega2)
+    plots.save(plots.cycle_figure(self, theta2, omega2), path)
 
 
 def _plot_relative_motion(self, path, units: str = "m") -> None:
@@ -69,6 +83,7 @@ def _plot_speed_profile(self, path) -> None:
 
 
 PLOTS = {
+    Mechanism: _plot_mechanism,
     RelativeMotion: _plot_relative_motion,
     Chart: _plot_chart,
     Comparison: _plot_comparison,

@@ -126,6 +126,22 @@ function el(tag, attrs, parent, text) {
   return e;
 }
 function clear(svg) { while (svg.firstChild) svg.removeChild(svg.firstChild); }
+
+// A sentence in an empty picture (why it has nothing to draw), wrapped to the picture's width.
+function note(svg, text) {
+  const w = svg.clientWidth || 300, h = svg.clientHeight || 150, per = Math.max(20, Math.floor(w / 7));
+  svg.setAttribute("viewBox", `0 0 ${w} ${h}`);
+  const t = el("text", { x: 8, y: 20, class: "note" }, svg);
+  const words = text.split(" ");
+  let line = "", n = 0;
+  for (const word of words) {
+    if ((line + " " + word).length > per && line) {
+      el("tspan", { x: 8, dy: n++ ? 16 : 0 }, t, line);
+      line = word;
+    } else line = line ? `${line} ${word}` : word;
+  }
+  el("tspan", { x: 8, dy: n ? 16 : 0 }, t, line);
+}
 // The size in drawing units of `px` pixels in an svg whose viewBox is w x h (shown with "meet").
 function unitsPerPixel(svg, w, h, px) {
   const r = svg.getBoundingClientRect();
@@ -475,7 +491,10 @@ function showAnalysis(a) {
     drawPolygon($("m-vpoly"), a.polygons, "velocity", `${u}/s`);
     drawPolygon($("m-apoly"), a.polygons, "acceleration", `${u}/s²`);
   } else {
-    clear($("m-vpoly")); clear($("m-apoly"));
+    for (const id of ["m-vpoly", "m-apoly"]) {
+      clear($(id));
+      if (a.polygons_reason) note($(id), `No polygons: ${a.polygons_reason}`);
+    }
   }
   if (a.dynamics) {
     showForces(a.dynamics, th, working);
