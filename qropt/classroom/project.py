@@ -7,24 +7,29 @@ minimum transmission angle over the turn); design requirement 2 (the travel of o
 working interval, and the part that covers a band of TRs); the four discussion issues; the analysis at a crank
 angle and speed by relative motion (polygons) and by computer; a simulation over a turn.
 
-The draws (numpy ``default_rng(seed)``, in this order each attempt): the TR from the type's range (two decimals),
-the stroke from STROKE_RANGE = 0.1..0.6 m (three decimals), each given link as a multiple of the stroke (three
-decimals), the TR band of requirement 2 (the TR minus 0.1..0.3, at least 1.05, to the TR plus 0.1..0.3), the crank
-angle (a multiple of 15 deg from 15 to 345) and omega2 (an integer from 5 to 20 rad/s). The TR ranges per type
-(``SPECS``): drag-link slider 1.45-1.8, crank-rocker slider 1.1-1.4, slider-crank 1.1-1.4, Whitworth, crank-shaper
-and slot-ram shaper 1.3-2.2 (a crank-rocker or an offset slider-crank gives only modest TRs with fair transmission
-angles; a drag-link with r1 about a third of the stroke no TR below about 1.45). A draw counts when requirement 1
-solves to a certified optimum (``qropt.solve``, status 'optimal') with gamma_min at least 15 deg (MIN_GAMMA),
-requirement 2's band lies on one monotone branch of the adjustable link, and the polygons exist; otherwise the
-next draw of the same generator is taken (at most MAX_DRAWS) and the number of redraws is recorded. Then the
-current lengths of the links to find are drawn (the solution's times 0.75..1.25, three decimals, a mechanism that
-works). Every number comes from the library code behind the command line.
+The draws (numpy ``default_rng`` seeded with the seed for an open project, or with HMAC-SHA256 of the type and seed
+under the instructor's secret for a class's: see ``project``; in this order each attempt): the TR from the type's
+range (two decimals), the stroke from STROKE_RANGE = 0.1..0.6 m (three decimals), each given link as a multiple of
+the stroke (three decimals), the TR band of requirement 2 (the TR minus 0.1..0.3, at least 1.05, to the TR plus
+0.1..0.3), the crank angle (a multiple of 15 deg from 15 to 345) and omega2 (an integer from 5 to 20 rad/s). The TR
+ranges per type (``SPECS``): drag-link slider 1.45-1.8, crank-rocker slider 1.1-1.4, slider-crank 1.1-1.4,
+Whitworth, crank-shaper and slot-ram shaper 1.3-2.2 (a crank-rocker or an offset slider-crank gives only modest TRs
+with fair transmission angles; a drag-link with r1 about a third of the stroke no TR below about 1.45). A draw
+counts when requirement 1 solves to a certified optimum (``qropt.solve``, status 'optimal') with gamma_min at least
+15 deg (MIN_GAMMA), requirement 2's band lies on one monotone branch of the adjustable link, and the polygons exist;
+otherwise the next draw of the same generator is taken (at most MAX_DRAWS) and the number of redraws is recorded.
+Then the current lengths of the links to find are drawn (the solution's times 0.75..1.25, three decimals, a
+mechanism that works). Every number comes from the library code behind the command line.
 """
 
 from __future__ import annotations
 
+import base64
+import hashlib
+import hmac
 import html
 import math
+import secrets
 from dataclasses import dataclass
 
 import numpy as np
@@ -235,6 +240,8 @@ class Project:
     reach: object
     adjust: object
     units: str = "m"
+    code: str = ""
+    keyed: bool = False
 
     @property
     def spec(self) -> Spec:
@@ -270,6 +277,41 @@ def _kind(kind) -> str:
     if not isinstance(kind, str) or kind not in KINDS:
         raise InvalidParameter(f"unknown project type {kind!r}; the types are {', '.join(KINDS)}")
     return kind
+
+
+MIN_SECRET = 8  # characters
+
+
+def new_secret() -> str:
+    """A fresh instructor's secret (16 random bytes, base32: 26 characters), for a class set's key file."""
+    return base64.b32encode(secrets.token_bytes(16)).decode().rstrip("=").lower()
+
+
+def _secret(secret) -> bytes | None:
+    if secret is None:
+        return None
+    if not isinstance(secret, str) or len(secret.strip()) < MIN_SECRET or secret != secret.strip():
+        raise InvalidParameter(
+            f"a project secret is a string of at least {MIN_SECRET} characters without leading or trailing spaces"
+        )
+    return secret.encode()
+
+
+def _mac(secret: bytes, what: str, kind: str, seed: int) -> bytes:
+    return hmac.new(secret, f"qropt-project:{what}:{kind}:{seed}".encode(), hashlib.sha256).digest()
+
+
+def statement_code(kind: str, seed: int, secret: str | None = None) -> str:
+    """The statement's code (8 base32 characters as XXXX-XXXX): HMAC-SHA256 of the type and seed under the
+    instructor's secret, so that the code says nothing of the seed without the secret; without a secret (an open
+    project, drawn from the seed alone) a plain SHA-256 of them."""
+    kind, seed, key = _kind(kind), _seed(seed), _secret(secret)
+    if key:
+        digest = _mac(key, "code", kind, seed)
+    else:
+        digest = hashlib.sha256(f"qropt-project:open:{kind}:{seed}".encode()).digest()
+    raw = base64.b32encode(digest).decode()[:8]
+    return f"{raw[:4]}-{raw[4:]}"
 
 
 def _seed(seed) -> int:
@@ -344,12 +386,16 @@ def _current(spec: Spec, m, rng) -> dict | None:
     return None
 
 
-def project(kind: str, seed: int) -> Project:
+def project(kind: str, seed: int, secret: str | None = None) -> Project:
     """The project of this type and seed (see the module docstring for the draws and the ranges); the same seed
-    gives the same project. InvalidParameter for an unknown type or a bad seed, or when no draw of MAX_DRAWS is
+    (and secret) gives the same project. Without ``secret`` an open project: the draws are numpy's
+    ``default_rng(seed)``, which anyone with qropt can repeat by trying seeds. With the instructor's ``secret``
+    (at least MIN_SECRET characters) the generator is seeded with HMAC-SHA256(secret, type and seed), so that
+    neither the statement's numbers nor its code (``statement_code``) lead back to the seed or the solution without
+    the secret. InvalidParameter for an unknown type, a bad seed or secret, or when no draw of MAX_DRAWS is
     solvable."""
-    kind, seed = _kind(kind), _seed(seed)
-    rng = np.random.default_rng(seed)
+    kind, seed, key = _kind(kind), _seed(seed), _secret(secret)
+    rng = np.random.default_rng(int.from_bytes(_mac(key, "draw", kind, seed), "big") if key else seed)
     for attempt in range(MAX_DRAWS):
         got = _attempt(kind, rng)
         if got is not None:
@@ -367,9 +413,24 @@ def project(kind: str, seed: int) -> Project:
                 result=result,
                 reach=reach,
                 adjust=adjust,
+                code=statement_code(kind, seed, secret),
+                keyed=key is not None,
                 **fields,
             )
     raise InvalidParameter(f"no solvable {kind} project in {MAX_DRAWS} draws of seed {seed}")
+
+
+def headline(p: Project) -> dict:
+    """The solution's headline numbers (a key file's columns): the links found, gamma_min [deg], the adjustable
+    link's travel for the band, and the slider's v and a at the analysis' crank angle (exact)."""
+    m = p.mechanism
+    out = {k: round(float(m.params[k]), 6) for k in p.find}
+    out["gamma_min_deg"] = round(math.degrees(m.gamma_min().value), 4)
+    lo, hi = p.adjust.interval
+    out["travel_from"], out["travel_to"] = round(float(min(lo, hi)), 6), round(float(max(lo, hi)), 6)
+    v, a = p.computer_ram()
+    out["v"], out["a"] = round(v, 6), round(a, 6)
+    return out
 
 
 # ---------------------------------------------------------------------------------------------------------- render
@@ -383,7 +444,57 @@ def _link_rows(p: Project, values: dict, what: str) -> list:
     return [(f"{k} [{p.units}]", p.spec.names[k], values[k], what) for k in values]
 
 
-def _statement(p: Project) -> str:
+MARKS = (
+    ("Design 1", "the links to find, with the method and the design's gamma_min", 20),
+    ("Design 2", "the adjustable link's working range, its TR range and the travel for the band", 15),
+    ("Discussion", "issues 1 to 4 (5 marks each)", 20),
+    ("Analysis 1", "velocity and acceleration polygons drawn to scale; the slider's v and a", 20),
+    ("Analysis 2", "the computer check: the program or command and its output beside the polygons", 10),
+    ("Analysis 3", "x, v and a of the slider over a turn, plotted against theta2", 10),
+    ("Presentation", "a drawing of the designed mechanism to scale; units, labels and a clear report", 5),
+)
+
+
+def _deliverables(p: Project) -> str:
+    finds = " and ".join(p.find)
+    items = (
+        f"The values of {finds} (design requirement 1), how they were found, and the design's minimum "
+        "transmission angle gamma_min over the whole turn; a drawing of the designed mechanism to scale.",
+        f"The working range of {p.adjustable}, the TR range it gives, a plot of TR against {p.adjustable}, and "
+        f"the travel of {p.adjustable} for TR {p.band[0]:.2f} to {p.band[1]:.2f} (design requirement 2).",
+        "Answers to the four discussion issues, each with its reasoning.",
+        "The velocity and acceleration polygons drawn to scale, with the slider's velocity and acceleration.",
+        "The computer check: the program (or the command) and its output, beside the polygons' values.",
+        "Plots of the slider's position, velocity and acceleration over a complete turn of the crank.",
+    )
+    listed = "".join(f"<li>{html.escape(i)}</li>" for i in items)
+    return f"<h2>Deliverables</h2><p>Hand in one report, the project code on its first page, with:</p><ol>{listed}</ol>"
+
+
+def _marks() -> str:
+    rows = "".join(
+        f"<tr><td>{html.escape(part)}</td><td>{html.escape(what)}</td><td>{m}</td><td></td></tr>"
+        for part, what, m in MARKS
+    )
+    total = sum(m for *_, m in MARKS)
+    return (
+        "<h2>Marks</h2><table class='text marks'><tr><th>part</th><th>what is marked</th><th>marks</th>"
+        f"<th>awarded</th></tr>{rows}<tr><th>Total</th><th></th><th>{total}</th><th></th></tr></table>"
+    )
+
+
+def _head(p: Project, due: str | None) -> str:
+    blank = "<span class=blank></span>"
+    due_text = html.escape(due) if due else blank
+    return (
+        f"<div class=head><h1>Quick-return project: {html.escape(p.spec.title)}</h1>"
+        f"<p class=code>Project code <b>{html.escape(p.code)}</b></p></div>"
+        f"<table class=fill><tr><th>Name</th><td>{blank}</td></tr><tr><th>Student number</th><td>{blank}</td></tr>"
+        f"<tr><th>Due</th><td>{due_text}</td></tr></table>"
+    )
+
+
+def _statement(p: Project, due: str | None = None) -> str:
     from qropt.io.report import _png
 
     spec, u = p.spec, p.units
@@ -393,7 +504,8 @@ def _statement(p: Project) -> str:
         rows += _link_rows(p, p.current, "current: to be redesigned")
     finds = " and ".join(f"{k} ({spec.names[k]})" for k in p.find)
     parts = [
-        f"<h1>Quick-return project: {html.escape(spec.title)} (seed {p.seed})</h1>",
+        "<section class=statement>",
+        _head(p, due),
         "<h2>Background</h2>",
         f"<p>An application requires a quick-return mechanism with a time ratio TR = {p.time_ratio:.3f} and a "
         f"stroke of {p.stroke:.4f} {u}. Currently a {html.escape(spec.title)} exists: "
@@ -401,7 +513,7 @@ def _statement(p: Project) -> str:
         _text_table(["link", "what", "length", ""], rows),
     ]
     if p.current is not None:
-        parts.append(_png(_current_figure(p)))
+        parts.append(f"<figure>{_png(_current_figure(p))}</figure>")
     parts += [
         f"<p>The given links are expensive to modify and stay. It is proposed to redesign {html.escape(finds)} so "
         f"that the mechanism performs the task. Furthermore, {p.adjustable} ({html.escape(spec.names[p.adjustable])}"
@@ -421,13 +533,11 @@ def _statement(p: Project) -> str:
         "<li>Check this result by computer (e.g. <code>qropt analyze</code>).</li>",
         "<li>Simulate the mechanism for a complete revolution of the input crank: slider position, velocity and "
         "acceleration against the crank angle.</li></ol>",
-        f"<p><small>Conventions: x to the right, y up, O2 at the origin, theta2 counter-clockwise from +x; "
-        f"TR = slow / fast crank interval between the dead centres. Drawn from numpy's default_rng({p.seed}): "
-        f"TR in {spec.time_ratio[0]}..{spec.time_ratio[1]}, stroke in {STROKE_RANGE[0]}..{STROKE_RANGE[1]} m, "
-        "given links as multiples of the stroke ("
-        + ", ".join(f"{k} {lo}..{hi}" for k, (lo, hi) in spec.given.items())
-        + f"), theta2 a multiple of {THETA2_STEP_DEG} deg, omega2 an integer in {OMEGA2_RANGE[0]}..{OMEGA2_RANGE[1]}"
-        f" rad/s; {p.redraws} draw(s) rejected as not solvable before this one.</small></p>",
+        _deliverables(p),
+        _marks(),
+        "<p><small>Conventions: x to the right, y up, O2 at the origin, theta2 counter-clockwise from +x; "
+        "TR = slow / fast crank interval between the dead centres. Write the project code on your report.</small></p>",
+        "</section>",
     ]
     return "".join(parts)
 
@@ -439,14 +549,72 @@ def _text_table(head, rows) -> str:
     return _table(head, rows).replace("<table>", "<table class=text>", 1)
 
 
+LABEL_DIRECTIONS = tuple((math.cos(math.radians(a)), math.sin(math.radians(a))) for a in range(45, 405, 45))
+
+
+def _label_joints(ax, shapes, size: float) -> None:
+    """Each pivot's and joint's name beside it, on the side (of 8) furthest from the other joints, the labels
+    already placed and the links near it: no label over another or over a joint (C over A, as pins that sit close
+    would have with one fixed offset)."""
+    from matplotlib.path import Path as MplPath
+
+    points = [(s.name, np.asarray(s.points[0], float)) for s in shapes if s.part in ("pivot", "joint")]
+    segments = [np.asarray(s.points, float) for s in shapes if s.part in ("link", "slot", "block", "ram", "plate")]
+    solids = [MplPath(np.asarray(s.points, float)) for s in shapes if s.part in ("block", "ram", "plate")]
+    d = 0.045 * size
+    placed = []
+    for name, xy in points:
+        others = [q for n, q in points if n != name or not np.allclose(q, xy)]
+
+        def clearance(c, xy=xy, others=others):
+            near = [float(np.hypot(*(c - q))) for q in others + placed]
+            for seg in segments:  # a label on a link is less bad than on a label: half weight
+                for a, b in zip(seg[:-1], seg[1:], strict=True):
+                    ab = b - a
+                    t = min(1.0, max(0.0, float(np.dot(c - a, ab) / max(float(np.dot(ab, ab)), 1e-300))))
+                    near.append(2.0 * float(np.hypot(*(c - a - t * ab))))
+            inside = any(solid.contains_point(c) for solid in solids)  # a label on a block hides it
+            return min(near, default=math.inf) * (0.25 if inside else 1.0)
+
+        def start(u, xy=xy):  # the label's near edge: out of the block the joint sits in
+            r = 0.4 * d
+            while r < 3 * d and any(solid.contains_point(xy + r * np.array(u)) for solid in solids):
+                r += 0.2 * d
+            return r + 0.1 * d if r > 0.4 * d else r
+
+        best = max(LABEL_DIRECTIONS, key=lambda u: clearance(xy + (start(u) + 0.6 * d) * np.array(u)) - start(u))
+        r = start(best)
+        placed.append(xy + (r + 0.6 * d) * np.array(best))
+        ha = "left" if best[0] > 0.3 else "right" if best[0] < -0.3 else "center"
+        va = "bottom" if best[1] > 0.3 else "top" if best[1] < -0.3 else "center"
+        at = xy + r * np.array(best)
+        ax.text(
+            *at, name, fontsize=9, ha=ha, va=va, zorder=6, bbox={"fc": "white", "ec": "none", "pad": 0.5, "alpha": 0.8}
+        )
+
+
+MIN_ASPECT, MAX_ASPECT = 0.45, 1.1  # the drawing's height over its width
+
+
 def _current_figure(p: Project):
-    from qropt.io import plots
+    """The existing mechanism at theta2 with its joints labelled apart, in a frame at least MIN_ASPECT and at most
+    MAX_ASPECT as high as wide (a long slide line makes no thin strip, a tall lever no narrow column)."""
+    from qropt.io import drawing, plots
 
     m = p.mechanism
     cur = type(m)(**{**m.params, **p.current}, units=m.units)
-    fig, ax = plots.plt.subplots(figsize=(8, 4))
-    x0, x1, y0, y1 = plots.draw_mechanism(ax, cur, p.theta2)
-    fig.set_size_inches(8, min(7.0, max(3.0, 1.2 + 6.5 * (y1 - y0) / max(x1 - x0, 1e-300))))  # no empty bands
+    shapes = drawing.at(drawing.scene(cur), p.theta2)
+    x0, x1, y0, y1 = drawing.bounds(shapes)
+    pad = 0.1 * max(x1 - x0, y1 - y0)
+    w, h = x1 - x0 + 2 * pad, y1 - y0 + 2 * pad
+    w, h = max(w, h / MAX_ASPECT), max(h, MIN_ASPECT * w)
+    cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+    fig, ax = plots.plt.subplots(figsize=(8, 1.3 + 6.2 * h / w))
+    plots.draw_shapes(ax, shapes, labels=False)
+    _label_joints(ax, shapes, max(w, h))
+    ax.set_xlim(cx - w / 2, cx + w / 2)
+    ax.set_ylim(cy - h / 2, cy + h / 2)
+    ax.set_aspect("equal")
     ax.set_title(f"the existing {p.spec.title} at theta2 = {math.degrees(p.theta2):.0f} deg (current lengths)")
     ax.set_xlabel(f"x [{p.units}]")
     ax.set_ylabel(f"y [{p.units}]")
@@ -473,7 +641,10 @@ def _solution(p: Project) -> str:
         (o.status, *(o.params[k] for k in p.find), math.degrees(o.quantities["gamma_min"])) for o in r.local_optima
     ]
     parts = [
-        "<hr><h1>Worked solution</h1>",
+        "<section class=solution><h1>Worked solution</h1>",
+        f"<p>Project code {html.escape(p.code)}: {p.kind}, seed {p.seed}"
+        + (" with the instructor's secret" if p.keyed else " (an open project: the seed's draw, no secret)")
+        + f"; {p.redraws} draw(s) rejected as not solvable before this one.</p>",
         "<h2>Design requirement 1</h2>",
         f"<p>Solved by qropt (the same solve as <code>qropt synth</code>): status <b>{html.escape(r.status)}</b>. "
         f"{html.escape(r.message)}</p>",
@@ -577,19 +748,68 @@ def _issue4(p: Project) -> str:
     )
 
 
-def render(project: Project, solution: bool = False) -> str:
-    """The project's page (one self-contained HTML document, pictures inline): the statement, and with
-    ``solution`` its worked solution."""
+PRINT_CSS = (
+    "@page{size:A4;margin:18mm}"
+    ".text td,.text th{text-align:left}.text td:nth-child(3),.text th:nth-child(3){text-align:right}"
+    ".head h1{margin-bottom:.2em}.code{font-family:monospace;font-size:1.1em;margin:0 0 .6em}"
+    ".fill th{text-align:left;width:9em}.fill td{text-align:left;width:22em;height:1.6em}"
+    ".blank{display:inline-block;min-width:10em}.marks td:nth-child(4){width:5em}figure{margin:.6em 0}"
+    "body{padding:0 12px}td,th{overflow-wrap:break-word}"
+    ".solution{border-top:2px solid #999;margin-top:2em}.wide{overflow-x:auto}"
+    "@media (max-width:600px){body{padding:0 6px}td,th{padding:.2em .35em;font-size:.92em}"
+    ".fill td{width:auto}}"
+    "@media print{body{max-width:none;margin:0;padding:0;font-size:10.5pt}"
+    "img,figure,table,tr{break-inside:avoid;page-break-inside:avoid}"
+    "h1,h2{break-after:avoid;page-break-after:avoid}"
+    ".solution{break-before:page;page-break-before:always;border:0;margin:0}.wide{overflow:visible}}"
+)
+
+
+def _due(due) -> str | None:
+    if due is None:
+        return None
+    import datetime
+
+    if isinstance(due, datetime.date):
+        return due.strftime("%Y-%m-%d")
+    try:
+        return datetime.date.fromisoformat(str(due)).isoformat()
+    except ValueError:
+        raise InvalidParameter(f"a due date is YYYY-MM-DD, got {due!r}") from None
+
+
+def render(project: Project, solution: bool = False, due=None) -> str:
+    """The project's page (one self-contained HTML document, pictures inline, A4 print margins): the statement
+    (project code, blanks for name and student number, the due date ``due`` (YYYY-MM-DD) or a blank,
+    deliverables and marks; no seed anywhere), and with ``solution`` its worked solution (which names the seed)."""
     from qropt.io.report import CSS
 
     if not isinstance(project, Project):
         raise InvalidParameter(f"render takes a classroom Project, got {type(project).__name__}")
-    body = _statement(project) + (_solution(project) if solution else "")
-    what = "solution" if solution else "project"
-    title = f"qropt {what}: {project.kind} seed {project.seed}"
-    style = CSS + ".text td{text-align:left}.text td:nth-child(3){text-align:right}"
-    head = f"<meta charset='utf-8'><title>{html.escape(title)}</title><style>{style}</style>"
+    due = _due(due)
+    worked = ""
+    if solution:  # its wide tables scroll sideways on a phone, not the page
+        worked = _solution(project).replace("<table>", "<div class=wide><table>").replace("</table>", "</table></div>")
+    body = _statement(project, due) + (worked + "</section>" if solution else "")
+    what = f"solution: {project.kind} seed {project.seed}," if solution else f"project: {project.spec.title},"
+    title = f"qropt {what} code {project.code}"
+    head = (
+        "<meta charset='utf-8'><meta name='viewport' content='width=device-width, initial-scale=1'>"
+        f"<title>{html.escape(title)}</title><style>{CSS}{PRINT_CSS}</style>"
+    )
     return f"<!DOCTYPE html><html><head>{head}</head><body>{body}</body></html>\n"
 
 
-__all__ = ["KINDS", "SPECS", "STROKE_RANGE", "Project", "Spec", "project", "render"]
+__all__ = [
+    "KINDS",
+    "MARKS",
+    "SPECS",
+    "STROKE_RANGE",
+    "Project",
+    "Spec",
+    "headline",
+    "new_secret",
+    "project",
+    "render",
+    "statement_code",
+]
