@@ -181,13 +181,10 @@ class CycleDynamics:
             t = np.linspace(lo, hi, k + 1) if closed else np.linspace(lo, hi, k, endpoint=False)
             h = (hi - lo) / k
             v = f(self.at(t % TWO_PI, on))
-            last = t.size - 1
-            sites = []
-            for i in range(t.size):
-                left = v[i - 1] if i > 0 or not closed else -np.inf
-                right = v[i + 1] if i < last else (-np.inf if closed else v[0])
-                if v[i] >= left and v[i] >= right:
-                    sites.append(float(t[i]))
+            left, right = np.roll(v, 1), np.roll(v, -1)  # a turn's grid wraps round; a stroke's ends have one side
+            if closed:
+                left[0] = right[-1] = -np.inf
+            sites = t[(v >= left) & (v >= right)].tolist()
             at = lo + (toggle - lo) % TWO_PI
             toggled = not closed or at <= hi
             if toggled:
