@@ -7,8 +7,10 @@ strategy takes (``Result.stats['t_strategies']``) summed over the rows. A strate
 time. Writes ``results/strategies.json`` and ``results/strategies.md``.
 
 Run: ``python -m benchmarks.strategies [--tasks 12] [--objectives max_gamma_min min_peak_torque]
-[--leave-out evolution guard ...]`` (repository root). By ``min_peak_torque`` the rows use ``benchmarks.tasks``'
-mass model, loads and speed; a run of the 12 tasks by it takes hours on two cores.
+[--leave-out evolution guard ...] [--types whitworth ...] [--evolutions K] [--name NAME]`` (repository root;
+``--types``: those rows only; ``--evolutions``: every Solver runs K evolutions where the evolution applies).
+By ``min_peak_torque`` the rows use ``benchmarks.tasks``' mass model, loads and speed; a run of the 12 tasks by
+it takes hours on two cores.
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ def pipelines(names: list[str]) -> dict:
     return {"default": list(search.DEFAULT), **{n: without(search.DEFAULT, n) for n in names}}
 
 
-def run(n_tasks: int, objectives: list[str], names: list[str]) -> list[dict]:
+def run(n_tasks: int, objectives: list[str], names: list[str], types=None, evolutions=None) -> list[dict]:
     """One record per (pipeline, objective, task, row): status, objective value, seconds, strategy seconds."""
     from qropt import Solver
     from qropt.studies._design import design
@@ -52,12 +54,12 @@ def run(n_tasks: int, objectives: list[str], names: list[str]) -> list[dict]:
 
     out = []
     for label, pipeline in pipelines(names).items():
-        solver = Solver(pipeline=pipeline)
+        solver = Solver(pipeline=pipeline, evolutions=evolutions)
         for objective in objectives:
             kw = {} if criteria.of(objective).kinematic else DYNAMIC
             for i, (tr, stroke) in enumerate(tasks(n_tasks)):
                 t = time.perf_counter()
-                cmp = design(tr, stroke, objective=objective, solver=solver, **kw)
+                cmp = design(tr, stroke, objective=objective, solver=solver, types=types, **kw)
                 print(f"  {label:28s} {objective:16s} task {i:2d}: {time.perf_counter() - t:7.2f} s", flush=True)
                 for r in cmp.rows:
                     res = r.result
@@ -137,9 +139,11 @@ def main(argv=None) -> None:
         default=["shape search", "related atlas optima", "atlas", "across a full turn's edge", "least-size tie-break"],
         help="strategy names (search.DEFAULT's), each left out in turn",
     )
+    ap.add_argument("--types", nargs="+", default=None, help="these design rows only (default every type)")
+    ap.add_argument("--evolutions", type=int, default=None, help="evolutions every Solver runs where they apply")
     ap.add_argument("--name", default="strategies", help="results/NAME.json and results/NAME.md")
     args = ap.parse_args(argv)
-    records = run(args.tasks, args.objectives, args.leave_out)
+    records = run(args.tasks, args.objectives, args.leave_out, args.types, args.evolutions)
     s = summary(records)
     save(f"{args.name}.json", {"tasks": args.tasks, "objectives": args.objectives, "summary": s, "rows": records})
     (RESULTS / f"{args.name}.md").write_text(markdown(s))

@@ -9,7 +9,7 @@ import pytest
 
 import qropt
 from qropt.studies._design import type_problem
-from qropt.synthesis import analytic, criteria, search
+from qropt.synthesis import analytic, criteria
 from qropt.synthesis.formulation import Formulation
 from tests.randmech import random_mechanisms
 
@@ -307,15 +307,12 @@ def test_the_whitworths_least_peak_torque_at_a_drawn_task_is_the_best_known():
     """The Whitworth's least peak torque at TR 1.796, 1.5711 m (a task tests/test_global.py drew): the row reaches
     3578.10864 N m, the design a solve from a known point near it reaches (it ended at 3578.88227, 2.2e-4 more,
     before its Sobol starts were screened: CHANGELOG.md). Both are certified and checked against the torque on a
-    20,001-angle grid. The row is solved without the differential evolution, which only adds candidates (the best
-    certified one is the row): the default pipeline's row is this one or better."""
+    20,001-angle grid."""
     from benchmarks.tasks import LOADS as loads
     from benchmarks.tasks import MASSES as masses
 
     p = type_problem("whitworth", 1.796, 1.5711, objective="min_peak_torque", masses=masses, loads=loads, omega2=10.0)
-    without = [s for s in search.DEFAULT if s.name != "differential evolution"]
-    assert len(without) == len(search.DEFAULT) - 1
-    r = qropt.Solver(pipeline=without).solve(p)
+    r = qropt.Solver().solve(p)
     assert r.status == "optimal", r.message
     th = np.linspace(0.0, 2 * np.pi, 20_001)
     peak = np.abs(r.mechanism.dynamics(th, 10.0, masses=masses, loads=loads).torque).max()

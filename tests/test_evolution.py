@@ -70,7 +70,7 @@ def test_a_solve_without_a_design_from_its_passes_starts_from_descents():
     from qropt import Solver
 
     problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
-    r = Solver(starts_n=0, settings=SHORT).solve(problem, use_analytic=False, diagnose=False)
+    r = Solver(starts_n=0, settings=SHORT, evolutions=1).solve(problem, use_analytic=False, diagnose=False)
     assert r.status in ("optimal", "acceptable"), r.message
     assert "differential evolution of 20 generations" in r.certificate.global_claim
     free = {k: r.params[k] for k in problem.free}
@@ -90,7 +90,7 @@ def test_a_descents_end_stands_as_a_feasible_design_where_no_start_certifies():
     from tests import brute
 
     problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
-    none = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": SHORT}
+    none = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": SHORT, "evolutions": 1}
     r = Solver(**none).solve(problem, use_analytic=False, diagnose=False)
     assert r.status == "feasible" and r.success, r.message
     assert "not certified" in r.message and r.certificate.local.startswith("none")
@@ -131,14 +131,15 @@ def test_the_evolution_options_are_true_or_false():
 
 
 def test_more_evolutions_add_their_ends_to_the_first_ones():
-    """``Solver(evolutions=2)`` runs the evolution from seeds 0 and 1: the first is the one evolution of a default
-    solve, so with no certified design (IPOPT gets no iteration) its best end is at least as good, and better
-    where the second seed's basin is; the claim names both seeds. Shortened (20 generations, 200 evaluations)."""
+    """``Solver(evolutions=2)`` runs the evolution from seeds 0 and 1: the first is the one evolution of
+    ``Solver(evolutions=1)``, so with no certified design (IPOPT gets no iteration) its best end is at least as
+    good, and better where the second seed's basin is; the claim names both seeds. Shortened (20 generations, 200
+    evaluations)."""
     from qropt import Solver
 
     problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
     kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": SHORT}
-    one = Solver(**kw).solve(problem, use_analytic=False, diagnose=False)
+    one = Solver(**kw, evolutions=1).solve(problem, use_analytic=False, diagnose=False)
     two = Solver(**kw, evolutions=2)
     assert Solver(**two.options()).evolutions == 2  # the options rebuild an equal Solver (a worker's)
     r = two.solve(problem, use_analytic=False, diagnose=False)
@@ -151,14 +152,14 @@ def test_more_evolutions_add_their_ends_to_the_first_ones():
 
 def test_the_four_bar_driven_rows_run_four_evolutions_by_default(monkeypatch):
     """``Solver()`` (evolutions None) runs ``evolution.count`` evolutions: four for the rows of seven and eight free
-    parameters, one for the others; a default solve's claim names the four seeds, an explicit count overrides it.
+    parameters, none for the others; a default solve's claim names the four seeds, an explicit count overrides it.
     Shortened (5 generations, 50 evaluations a descent, IPOPT given no iteration, no SQP)."""
     from qropt import Solver
     from qropt.studies._design import TYPES
     from qropt.synthesis import minimax
 
     counts = {k: evolution.count(type_problem(k, 1.6, 0.3, **KW)) for k in TYPES}
-    assert counts == {k: 4 if k in ("crank-rocker-slider", "drag-link-slider", "coupler-slider") else 1 for k in TYPES}
+    assert counts == {k: 4 if k in ("crank-rocker-slider", "drag-link-slider", "coupler-slider") else 0 for k in TYPES}
     monkeypatch.setattr(minimax, "polish", lambda problem, design, steps=None, settings=None: None)
     problem = type_problem("crank-rocker-slider", 1.6, 0.3, **KW)
     short = Settings(evolution_generations=5, descent_evals=50)

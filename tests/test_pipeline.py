@@ -76,7 +76,8 @@ def test_a_dynamic_criterion_in_one_file_gets_the_searches_the_shipped_ones_get(
     assert _accepted(toy, plan) == _accepted(shipped, plan)
     assert {"transmission guard", "differential evolution"} <= set(_accepted(toy, plan))
     assert minimax.applies(toy)
-    solver = Solver(starts_n=2, settings=Settings(evolution_generations=5, descent_evals=100))  # a short search
+    short = Settings(evolution_generations=5, descent_evals=100)
+    solver = Solver(starts_n=2, settings=short, evolutions=1)  # a short search, with the evolution
     a, b = solver.solve(shipped), solver.solve(toy)
     assert a.status == b.status and a.success, (a.message, b.message)
     assert b.objective == a.objective and b.params == a.params

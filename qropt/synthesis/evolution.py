@@ -43,10 +43,11 @@ DESCENT_LOCAL = "none: the end of a Nelder-Mead descent on the exact objective, 
 
 def count(problem, settings: Settings = DEFAULT) -> int:
     """The evolutions a solve runs by default: ``many_evolutions`` where the problem has ``many_free`` free
-    parameters or more (the
-    four-bar-driven types), else one: each evolution reaches its own basins at the cost of its own run, which
-    pays where the free parameters are many; with fewer, one evolution's basins already hold the best design."""
-    return settings.many_evolutions if len(problem.free) >= settings.many_free else 1
+    parameters or more (the four-bar-driven types), else none: each evolution reaches its own basins at the cost
+    of its own run, which pays where the free parameters are many; with fewer, the starts (the closed forms', the
+    atlas's and the spread ones) already reach the designs an evolution finds (docs/benchmarks.md).
+    ``Solver(evolutions=k)`` runs k anyway."""
+    return settings.many_evolutions if len(problem.free) >= settings.many_free else 0
 
 
 @dataclass(frozen=True)

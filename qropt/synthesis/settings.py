@@ -55,7 +55,7 @@ class Settings:
     evolution_keep: int = 4  # distinct designs an evolution hands on
     evolution_distinct: float = 0.05  # designs differ when a parameter differs by this (in log, or of its range)
     many_free: int = 7  # a problem with this many free parameters or more runs ``many_evolutions`` by default
-    many_evolutions: int = 4  # ... else one
+    many_evolutions: int = 4  # ... else none
     descent_evals: int = 1000  # exact evaluations of a Nelder-Mead descent
     secant_reach: float = 0.05  # relative: how far the secant steps onto the TR target may take the crank
     # the SQP on the exact peak (``minimax``)

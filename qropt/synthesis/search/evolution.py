@@ -26,6 +26,8 @@ class Evolution(Stage):
             return
         t0, seed = time.perf_counter(), context.seed
         count, generations = solver.evolutions_of(problem), context.settings.evolution_generations
+        if count == 0:
+            return
         each = []
         for i in range(count):
             if context.out_of_time():
