@@ -112,7 +112,7 @@ class Cell:
         return self.why in ("no certified neighbour", "warm start failed", "jump")
 
     def to_dict(self) -> dict:
-        result = self._data if self._result is None else self._result.to_dict()
+        result = self._data if self._result is None else self._result.to_dict(stamped=False)
         return {
             "i": self.i,
             "j": self.j,

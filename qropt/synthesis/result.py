@@ -182,15 +182,16 @@ class Result:
             )
         return "\n".join(lines)
 
-    def to_dict(self) -> dict:
-        """Strict-JSON dictionary (no NaN: None), led by the schema version and qropt's (``qropt.schema.stamp``);
+    def to_dict(self, stamped: bool = True) -> dict:
+        """Strict-JSON dictionary (no NaN: None), led by the schema version and qropt's (``qropt.schema.stamp``;
+        ``stamped=False`` for one held inside another saved table, as its local optima and a chart's cells are);
         the mechanism as its type kind (a type not shipped with qropt as "module:Class", see
         ``qropt.mechanisms.type_reference``) and parameters."""
         from qropt.mechanisms import type_reference
 
         return json_safe(
             {
-                **schema.stamp(),
+                **(schema.stamp() if stamped else {}),
                 "units": unit_names(self.units),
                 "status": self.status,
                 "success": self.success,
@@ -204,7 +205,7 @@ class Result:
                 "certificate": self.certificate.to_dict() if self.certificate is not None else None,
                 "stats": self.stats,
                 "reachable": {k: list(v) for k, v in self.reachable.items()},
-                "local_optima": [r.to_dict() for r in self.local_optima],
+                "local_optima": [r.to_dict(stamped=False) for r in self.local_optima],
                 **({} if self.counterweight is None else {"counterweight": self.counterweight.to_dict()}),
             }
         )
