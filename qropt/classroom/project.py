@@ -549,50 +549,6 @@ def _text_table(head, rows) -> str:
     return _table(head, rows).replace("<table>", "<table class=text>", 1)
 
 
-LABEL_DIRECTIONS = tuple((math.cos(math.radians(a)), math.sin(math.radians(a))) for a in range(45, 405, 45))
-
-
-def _label_joints(ax, shapes, size: float) -> None:
-    """Each pivot's and joint's name beside it, on the side (of 8) furthest from the other joints, the labels
-    already placed and the links near it: no label over another or over a joint (C over A, as pins that sit close
-    would have with one fixed offset)."""
-    from matplotlib.path import Path as MplPath
-
-    points = [(s.name, np.asarray(s.points[0], float)) for s in shapes if s.part in ("pivot", "joint")]
-    segments = [np.asarray(s.points, float) for s in shapes if s.part in ("link", "slot", "block", "ram", "plate")]
-    solids = [MplPath(np.asarray(s.points, float)) for s in shapes if s.part in ("block", "ram", "plate")]
-    d = 0.045 * size
-    placed = []
-    for name, xy in points:
-        others = [q for n, q in points if n != name or not np.allclose(q, xy)]
-
-        def clearance(c, xy=xy, others=others):
-            near = [float(np.hypot(*(c - q))) for q in others + placed]
-            for seg in segments:  # a label on a link is less bad than on a label: half weight
-                for a, b in zip(seg[:-1], seg[1:], strict=True):
-                    ab = b - a
-                    t = min(1.0, max(0.0, float(np.dot(c - a, ab) / max(float(np.dot(ab, ab)), 1e-300))))
-                    near.append(2.0 * float(np.hypot(*(c - a - t * ab))))
-            inside = any(solid.contains_point(c) for solid in solids)  # a label on a block hides it
-            return min(near, default=math.inf) * (0.25 if inside else 1.0)
-
-        def start(u, xy=xy):  # the label's near edge: out of the block the joint sits in
-            r = 0.4 * d
-            while r < 3 * d and any(solid.contains_point(xy + r * np.array(u)) for solid in solids):
-                r += 0.2 * d
-            return r + 0.1 * d if r > 0.4 * d else r
-
-        best = max(LABEL_DIRECTIONS, key=lambda u: clearance(xy + (start(u) + 0.6 * d) * np.array(u)) - start(u))
-        r = start(best)
-        placed.append(xy + (r + 0.6 * d) * np.array(best))
-        ha = "left" if best[0] > 0.3 else "right" if best[0] < -0.3 else "center"
-        va = "bottom" if best[1] > 0.3 else "top" if best[1] < -0.3 else "center"
-        at = xy + r * np.array(best)
-        ax.text(
-            *at, name, fontsize=9, ha=ha, va=va, zorder=6, bbox={"fc": "white", "ec": "none", "pad": 0.5, "alpha": 0.8}
-        )
-
-
 MIN_ASPECT, MAX_ASPECT = 0.45, 1.1  # the drawing's height over its width
 
 
@@ -610,8 +566,7 @@ def _current_figure(p: Project):
     w, h = max(w, h / MAX_ASPECT), max(h, MIN_ASPECT * w)
     cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
     fig, ax = plots.plt.subplots(figsize=(8, 1.3 + 6.2 * h / w))
-    plots.draw_shapes(ax, shapes, labels=False)
-    _label_joints(ax, shapes, max(w, h))
+    plots.draw_shapes(ax, shapes)  # each joint named where its name covers no other name or joint
     ax.set_xlim(cx - w / 2, cx + w / 2)
     ax.set_ylim(cy - h / 2, cy + h / 2)
     ax.set_aspect("equal")

@@ -20,12 +20,14 @@ import numpy as np
 from qropt import units as units_
 from qropt.errors import QroptError
 from qropt.io import drawing
+from qropt.io._labels import LINE_WEIGHTS, SOLIDS, place_labels
 
 MAX_ROWS = 20  # table rows shown; the rest are counted
 MAX_PICTURES = 12  # design pictures in a comparison
 MAX_CELLS = 2000  # heat-map cells drawn (a larger chart is drawn by every k-th value of each axis)
 MAX_CURVE = 400  # points of a family branch drawn
 MARGIN = 22  # px around a mechanism picture (room for the joints' names)
+NAME_CHAR, NAME_HEIGHT, NAME_GAPS = 8.4, 10.0, (2.0, 4.0, 8.0, 13.0)  # a joint's name at 12 px: its box, px
 FONT = "font-family:sans-serif;font-size:12px"
 INK, PATH, SLIDE, BAD = "#222", "#1f77b4", "#888", "#d62728"
 VIRIDIS = ("#440154", "#3b528b", "#21918c", "#5ec962", "#fde725")
@@ -198,7 +200,12 @@ def mechanism_svg(
     def xy(p):
         return f"{MARGIN + (p[0] - x0) * s:.1f},{MARGIN + (y1 - p[1]) * s:.1f}"
 
+    def up(p):  # px, y up (as _labels.place_labels takes them)
+        p = np.asarray(p, float).reshape(-1, 2)
+        return np.c_[MARGIN + (p[:, 0] - x0) * s, -(MARGIN + (y1 - p[:, 1]) * s)]
+
     layers = {k: [] for k in ("path", "slide", "link", "plate", "slot", "block", "joint", "label")}
+    names = []  # (name, (x, y) px with y up, marker radius px)
     for sh in shapes:
         pts = sh.points
         if sh.part == "path":
@@ -236,11 +243,9 @@ def mechanism_svg(
                 layers["joint"].append(
                     f'<circle cx="{cx:.1f}" cy="{cy:.1f}" r="3.2" fill="#fff" stroke="{color}" stroke-width="1.5"/>'
                 )
-            if labels:
-                layers["label"].append(
-                    f'<text x="{cx + 5:.1f}" y="{cy - 5:.1f}" stroke="#fff" stroke-width="3" paint-order="stroke" '
-                    f'fill="{color}">{_e(sh.name)}</text>'
-                )
+            names.append((sh.name, (cx, -cy), 4 * math.sqrt(2) if sh.part == "pivot" else 4.0))
+    if labels and names:
+        layers["label"] = _names(names, shapes, up, (0.0, 14.0 - h, w, 0.0), color)  # above the scale bar
     bar = _scale_bar(s, dx, h, m.units)
     label = f"{type(m).__name__} at theta2 = {math.degrees(theta2):.1f} deg"
     return (
@@ -248,6 +253,30 @@ def mechanism_svg(
         f'role="img" aria-label="{_e(label)}" style="background:#fff;{FONT}" font-size="10" fill="none">'
         f"<title>{_e(label)}</title>" + "".join("".join(v) for v in layers.values()) + bar + "</svg>"
     )
+
+
+def _names(names, shapes, up, frame, color) -> list:
+    """The joints' names as SVG texts, each beside its joint where ``_labels.place_labels`` finds room (px, y up
+    from ``up``; the text's box estimated from NAME_CHAR and NAME_HEIGHT)."""
+    lines = [
+        (up([*sh.points, sh.points[0]] if sh.kind == "polygon" else sh.points), LINE_WEIGHTS[sh.part])
+        for sh in shapes
+        if sh.part in LINE_WEIGHTS
+    ]
+    placed = place_labels(
+        [at for _, at, _ in names],
+        [(NAME_CHAR * len(name) + 2.0, NAME_HEIGHT) for name, _, _ in names],
+        [r for _, _, r in names],
+        NAME_GAPS,
+        lines,
+        [up(sh.points) for sh in shapes if sh.part in SOLIDS],
+        frame,
+    )
+    return [
+        f'<text x="{x0 + 1.0:.1f}" y="{-y0 - 1.0:.1f}" stroke="#fff" stroke-width="3" paint-order="stroke" '
+        f'fill="{color}">{_e(name)}</text>'
+        for (name, _, _), (_, _, (x0, y0, _, _)) in zip(names, placed, strict=True)
+    ]
 
 
 def _simplified(points, s: float, tol_px: float = 0.3) -> list:

@@ -7,6 +7,7 @@ import math
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.artist  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.colors import to_rgba  # noqa: E402
@@ -14,15 +15,21 @@ from matplotlib.patches import Polygon  # noqa: E402
 
 from qropt.errors import InvalidParameter  # noqa: E402
 from qropt.io import drawing  # noqa: E402
+from qropt.io._labels import LINE_WEIGHTS, SOLIDS, align, place_labels  # noqa: E402
 from qropt.mechanisms import Mechanism  # noqa: E402
 from qropt.synthesis import criteria  # noqa: E402
 from qropt.validate import picture_path  # noqa: E402
 
+PIVOT_SIZE, JOINT_SIZE, LABEL_SIZE = 7, 5, 8  # marker sizes and the joints' names, points
+LABEL_GAPS = (1.5, 4.0, 8.0, 13.0)  # a label's box from its joint's marker, points: nearest first
+
 
 def draw_shapes(ax, shapes, color="k", alpha=1.0, labels=True, joint_color=None) -> list:
-    """Draw shapes of ``qropt.io.drawing`` on a matplotlib axis (joints labelled if ``labels``); the artists."""
+    """Draw shapes of ``qropt.io.drawing`` on a matplotlib axis; the artists. With ``labels`` each pivot's and
+    joint's name is set beside it where ``place_labels`` finds room when the figure is drawn (``JointLabels``)."""
     out = []
     joint_color = joint_color or color
+    names = []
     for s in shapes:
         xy = np.array(s.points)
         if s.part == "link":
@@ -51,14 +58,93 @@ def draw_shapes(ax, shapes, color="k", alpha=1.0, labels=True, joint_color=None)
         else:  # a pivot or a joint
             pivot = s.part == "pivot"
             (x, y), c = s.points[0], color if pivot else joint_color
-            out += ax.plot(x, y, "s" if pivot else "o", color=c, ms=7 if pivot else 5, alpha=alpha, zorder=4)
-            if labels:
-                out.append(
-                    ax.annotate(
-                        s.name, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8, alpha=alpha, zorder=5
-                    )
-                )
+            ms = PIVOT_SIZE if pivot else JOINT_SIZE
+            out += ax.plot(x, y, "s" if pivot else "o", color=c, ms=ms, alpha=alpha, zorder=4)
+            names.append((s.name, (x, y), ms * (math.sqrt(2.0) if pivot else 1.0) / 2))  # the marker's radius
+    if labels and names:
+        texts = [
+            ax.annotate(
+                name,
+                xy,
+                textcoords="offset points",
+                xytext=(4, 4),
+                fontsize=LABEL_SIZE,
+                alpha=alpha,
+                zorder=6,
+                bbox={"fc": "white", "ec": "none", "pad": 0.5, "alpha": 0.8 * alpha},
+            )
+            for name, xy, _ in names
+        ]
+        placer = JointLabels(texts, [xy for _, xy, _ in names], [r for _, _, r in names], shapes, out)
+        out += [*texts, ax.add_artist(placer)]
     return out
+
+
+class JointLabels(matplotlib.artist.Artist):
+    """Places the joints' names (annotations offset in points) when the figure is drawn, by ``place_labels`` in
+    display pixels, so that they stay apart at the axis' final limits and size; draws nothing itself. Besides the
+    shapes' links, blocks and markers it keeps the names off what else the axis holds: its other lines, arrows
+    (annotations from and to data points), texts and legend."""
+
+    def __init__(self, texts, points, radii, shapes, own=()):
+        super().__init__()
+        self.texts, self.points, self.radii = list(texts), np.asarray(points, float).reshape(-1, 2), list(radii)
+        self.own = {id(a) for a in [*own, *texts]}  # the shapes' artists, drawn as shapes
+        self.lines = [(np.asarray(s.points, float), LINE_WEIGHTS[s.part]) for s in shapes if s.part in LINE_WEIGHTS]
+        self.solids = [np.asarray(s.points, float) for s in shapes if s.part in SOLIDS]
+        self.set_zorder(5.9)  # drawn before the labels (zorder 6)
+        self.set_in_layout(False)
+
+    def draw(self, renderer):
+        if not self.get_visible() or not self.texts:
+            return
+        to_px = self.axes.transData.transform
+        px = renderer.points_to_pixels(1.0)
+        sizes = [(b.width, b.height) for b in (t.get_window_extent(renderer) for t in self.texts)]
+        lines = [(to_px(p), w) for p, w in self.lines if len(p) > 1] + self._other_lines()
+        bb = self.axes.bbox
+        placed = place_labels(
+            to_px(self.points),
+            sizes,
+            [r * px for r in self.radii],
+            [g * px for g in LABEL_GAPS],
+            lines,
+            [to_px(p) for p in self.solids],
+            (bb.x0, bb.y0, bb.x1, bb.y1),
+            self._other_boxes(renderer),
+        )
+        for t, (u, r, _) in zip(self.texts, placed, strict=True):
+            t.xyann = (r / px * u[0], r / px * u[1])
+            ha, va = align(u)
+            t.set_horizontalalignment(ha)
+            t.set_verticalalignment(va)
+        self.stale = False
+
+    def _other_lines(self) -> list:
+        """The axis' lines and arrows that are not the shapes', in pixels, each as a link."""
+        out = []
+        for line in self.axes.lines:
+            if id(line) not in self.own and line.get_visible() and line.get_linestyle() not in ("None", " ", ""):
+                xy = np.asarray(line.get_xydata(), float)
+                if len(xy) > 1:
+                    out.append((line.get_transform().transform(xy), 1.0))
+        for t in self.axes.texts:
+            arrow = getattr(t, "arrow_patch", None)
+            if id(t) not in self.own and arrow is not None and t.xycoords == "data" and t.anncoords == "data":
+                out.append((self.axes.transData.transform(np.array([t.xyann, t.xy], float)), 1.0))
+        return out
+
+    def _other_boxes(self, renderer) -> list:
+        """The boxes (pixels) of the axis' texts that are not the shapes' names, and of its legend."""
+        boxes = [
+            t.get_window_extent(renderer)
+            for t in self.axes.texts
+            if id(t) not in self.own and t.get_visible() and t.get_text()
+        ]
+        legend = self.axes.get_legend()
+        if legend is not None and legend.get_visible():
+            boxes.append(legend.get_window_extent(renderer))
+        return [(b.x0, b.y0, b.x1, b.y1) for b in boxes]
 
 
 def draw_mechanism(ax, m: Mechanism, theta2: float, color="k", alpha=1.0):
@@ -422,6 +508,8 @@ def front_figure(front, designs: int = 3):
             f"{k + 1}: {_short(a, va[i], front.problem.units)}, {_short(b, vb[i], front.problem.units)}", fontsize=9
         )
         axm.tick_params(labelsize=7)
+        axm.set_xlabel(f"x [{front.problem.units}]", fontsize=8)
+        axm.set_ylabel(f"y [{front.problem.units}]", fontsize=8)
     fig.tight_layout()
     return fig
 
