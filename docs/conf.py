@@ -1,13 +1,19 @@
 """Sphinx configuration of qropt's documentation site (see docs/README.md).
 
 The Markdown pages in docs/ are read as they are by myst-parser; the API reference (docs/reference/) is written
-by autodoc from the docstrings. Nothing is fetched at build time or by the built pages.
+by autodoc from the docstrings; the example notebook's page is the notebook run at build time (docs/README.md).
+Nothing is fetched at build time or by the built pages.
 """
 
 from __future__ import annotations
 
+import ast
+import contextlib
+import io
+import json
 import re
 import sys
+import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -25,8 +31,8 @@ extensions = ["myst_parser", "sphinx.ext.autodoc"]
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
 exclude_patterns = ["_build", "README.md"]  # README.md: how to build, for the repository's readers
-# docs/notebook.ipynb is no page (rendering it would need myst-nb, and it has no outputs to show): notebook.md
-# describes it and links it, and the site offers it as a download
+# docs/notebook.ipynb is no source of its own (.ipynb is no source suffix): docs/tutorials/example-notebook.md shows
+# it, run at build time (see "the example notebook" below), and notebook.md links it as a download
 
 # the pages link to each other's headings as GitHub does (benchmarks.md#the-dynamic-rows)
 myst_heading_anchors = 4
@@ -154,6 +160,78 @@ def outside_links(app, docname: str, source: list[str]) -> None:
     source[0] = _OUTSIDE.sub(download, source[0])
 
 
+# -- the example notebook --------------------------------------------------------------------------------------
+# docs/notebook.ipynb is kept without outputs. A page whose source has the line ``{notebook} PATH`` in a fenced
+# directive (docs/tutorials/example-notebook.md) gets, in its place, the notebook run at build time, in this
+# process and with the qropt that autodoc documents: each markdown cell as it is, each code cell as a Python block,
+# then what Jupyter would show for it: its printed text and its last expression's value, as that object's
+# ``_repr_html_()`` (qropt's views: self-contained HTML with inline SVG) or else its ``repr()``. The cells run in
+# order in one namespace, in a temporary directory; a cell that fails stops the build with the cell's number.
+# Nothing is installed for this: no kernel, and no outputs stored in git to go stale.
+
+_NOTEBOOK = re.compile(r"^(`{3,}|~{3,})\{notebook\}[ \t]+(\S+)[ \t]*\n\1[ \t]*$", re.M)
+
+
+def _fence(text: str, info: str) -> str:
+    """``text`` in a fenced block (``info`` after the opening fence) longer than any backtick run inside it."""
+    ticks = max([3, *(len(run) + 1 for run in re.findall(r"`{3,}", text))])
+    return f"{'`' * ticks}{info}\n{text.rstrip()}\n{'`' * ticks}\n"
+
+
+def _shown(value) -> str:
+    """What a notebook shows for a cell's value, as MyST: a qropt view (or any object with ``_repr_html_``) as
+    raw HTML, anything else as its repr."""
+    html = getattr(value, "_repr_html_", None)
+    html = html() if callable(html) else None
+    if html:
+        return _fence(f'<div class="nb-output">\n{html}\n</div>', "{raw} html")
+    return _fence(repr(value), "text")
+
+
+def notebook_myst(path: Path) -> str:
+    """The notebook at ``path`` as MyST: its cells, each code cell followed by what running it shows."""
+    notebook = json.loads(path.read_text(encoding="utf-8"))
+    namespace = {"__name__": "__main__"}
+    parts = []
+    with tempfile.TemporaryDirectory() as scratch, contextlib.chdir(scratch):
+        for k, cell in enumerate(notebook["cells"]):
+            source = "".join(cell["source"])
+            if cell["cell_type"] == "markdown":
+                parts.append(source.rstrip() + "\n")
+                continue
+            if cell["cell_type"] != "code" or not source.strip():
+                continue
+            parts.append(_fence(source, "python"))
+            where = f"{path.name}, cell {k + 1}"
+            tree = ast.parse(source, where)
+            shows = not source.rstrip().endswith(";")  # as in Jupyter, a trailing ";" hides the value
+            last = tree.body.pop() if shows and tree.body and isinstance(tree.body[-1], ast.Expr) else None
+            printed = io.StringIO()
+            try:
+                with contextlib.redirect_stdout(printed):
+                    exec(compile(tree, where, "exec"), namespace)
+                    value = None
+                    if last is not None:
+                        value = eval(compile(ast.Expression(last.value), where, "eval"), namespace)
+            except Exception as error:
+                raise RuntimeError(f"{path}: cell {k + 1} (code) fails: {error!r}") from error
+            if printed.getvalue():
+                parts.append(_fence(printed.getvalue(), "text"))
+            if value is not None:
+                parts.append(_shown(value))
+    return "\n".join(parts)
+
+
+def notebooks(app, docname: str, source: list[str]) -> None:
+    def run(match: re.Match) -> str:
+        path = (Path(app.env.doc2path(docname)).parent / match.group(2)).resolve()
+        app.env.note_dependency(str(path))  # an edited notebook rebuilds its page
+        return notebook_myst(path)
+
+    source[0] = _NOTEBOOK.sub(run, source[0])
+
+
 def setup(app):
     app.connect("autodoc-process-docstring", prose_docstring)
     app.connect("source-read", outside_links)
+    app.connect("source-read", notebooks)

@@ -2,11 +2,14 @@
 builds with Sphinx with warnings as errors (a missing page, heading or reference, and a docstring that is not
 valid reST, are all warnings), offline, into pages whose internal links resolve and that load nothing from
 elsewhere: no ``<link>``, ``<script>``, ``<img>`` (or other embedded resource) and no stylesheet
-``@import``/``url()``/``@font-face`` with an address of another host."""
+``@import``/``url()``/``@font-face`` with an address of another host. The example notebook (docs/notebook.ipynb,
+kept without outputs) is a tutorial page with what each of its cells shows, run as the site is built (docs/conf.py)."""
 
 from __future__ import annotations
 
+import html
 import importlib.util
+import json
 import os
 import pkgutil
 import re
@@ -24,6 +27,7 @@ import qropt
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
 REFERENCE = DOCS / "reference"
+NOTEBOOK = DOCS / "notebook.ipynb"
 # ``.. autoclass:: qropt.Solver`` in reST, ```{autoclass} qropt.Solver`` in MyST
 DIRECTIVE = re.compile(r"^\s*(?:\.\.\s+|```\{)(auto\w+)(?:::|\})\s+([\w.]+)", re.M)
 EXTERNAL = re.compile(r"^\s*(?:[a-z][a-z0-9+.-]*:)?//", re.I)  # http://, https://, //host (not data: or file:)
@@ -173,3 +177,63 @@ def test_the_sites_links_resolve_and_nothing_is_loaded_from_elsewhere(site):
             r"""(?:@import\s+(?:url\()?|url\()\s*['"]?((?:[a-z][a-z0-9+.-]*:)?//[^'")\s]+)""", text, re.I
         )
         assert not addresses, f"{sheet.relative_to(site)} loads {addresses[:5]}"
+
+
+def test_the_example_notebook_is_a_tutorial_page_with_its_outputs(site):
+    assert "example-notebook.html" in (site / "tutorials" / "index.html").read_text(encoding="utf-8")
+    page = (site / "tutorials" / "example-notebook.html").read_text(encoding="utf-8")
+    code = [cell for cell in json.loads(NOTEBOOK.read_text(encoding="utf-8"))["cells"] if cell["cell_type"] == "code"]
+    outputs = re.findall(r'<div class="nb-output">(.*?)\n</div>', page, re.S)
+    assert len(outputs) == len(code), f"{len(code)} code cells, {len(outputs)} outputs on the page"
+    assert all("<svg" in output for output in outputs), "an output without its picture"
+    assert all("<table" in output for output in outputs[1:]), "a result, comparison or front without its table"
+    text = html.unescape(re.sub(r"<[^>]+>", "", page))
+    for cell in code:  # each cell's code is shown too
+        line = max("".join(cell["source"]).splitlines(), key=len)
+        assert line in text, line
+    for shown in ("1.5 (slow / fast)", "Result: optimal", "27.0082 deg", "crank-shaper", "non-dominated"):
+        assert shown in text, shown
+    assert "{notebook}" not in page
+
+
+@pytest.fixture(scope="module")
+def conf():
+    """docs/conf.py as a module (its notebook runner)."""
+    if importlib.util.find_spec("sphinx") is None:
+        pytest.skip('Sphinx is not installed (pip install ".[docs]" or ".[test]" installs it)')
+    spec = importlib.util.spec_from_file_location("qropt_docs_conf", DOCS / "conf.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def notebook(tmp_path: Path, *cells: tuple[str, str]) -> Path:
+    path = tmp_path / "n.ipynb"
+    path.write_text(json.dumps({"cells": [{"cell_type": t, "metadata": {}, "source": s} for t, s in cells]}))
+    return path
+
+
+def test_the_notebook_runner_shows_what_jupyter_shows(conf, tmp_path):
+    text = conf.notebook_myst(
+        notebook(
+            tmp_path,
+            ("markdown", "# Title\n\nSome `code`."),
+            ("code", "x = 2\nprint('printed', x)\nx * 21"),
+            ("code", "x;"),  # a trailing ";" shows nothing
+            ("code", "open('written', 'w').close()\ns = '````'\ns"),
+            ("code", "from qropt.examples import paper_mechanism\npaper_mechanism()"),
+        )
+    )
+    assert text.startswith("# Title\n\nSome `code`.\n")
+    assert "```python\nx = 2\nprint('printed', x)\nx * 21\n```\n" in text
+    assert "```text\nprinted 2\n```\n" in text and "```text\n42\n```\n" in text
+    assert "```python\nx;\n```\n\n`````python" in text  # and no output
+    assert "`````text\n'````'\n`````\n" in text  # a fence longer than any inside
+    assert not (tmp_path / "written").exists()  # the cells run in a temporary directory
+    assert text.count('```{raw} html\n<div class="nb-output">\n<div class="qropt-nb qropt-nb-mechanism"') == 1
+
+
+def test_the_notebook_runner_stops_on_a_failing_cell(conf, tmp_path):
+    path = notebook(tmp_path, ("code", "x = 1"), ("markdown", "text"), ("code", "1 / 0"))
+    with pytest.raises(RuntimeError, match=r"n.ipynb: cell 3 \(code\) fails: ZeroDivisionError"):
+        conf.notebook_myst(path)
