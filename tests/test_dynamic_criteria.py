@@ -26,12 +26,13 @@ def _table(m):
     return qropt.Loads(((d.x_min + 0.2 * span, 200.0), (d.x_min + 0.5 * span, 1500.0), (d.x_max, 600.0)), gravity=9.81)
 
 
-def _at_random_design(kind, objective, seed, loads=LOADS):
+def _at_random_design(kind, objective, seed, loads=LOADS, masses=MASSES):
     """A problem of a random design's own targets (free parameters around it), its Formulation, and the NLP point
-    and parameters at that design with n sample angles: (p, m, f, w, pv, th, params). ``loads``: a Loads, or a
-    callable of the design giving one."""
+    and parameters at that design with n sample angles: (p, m, f, w, pv, th, params). ``loads`` and ``masses``: a
+    Loads and a Masses, or callables of the design giving them."""
     params, m = random_mechanisms(kind, 1, seed=seed)[0]
     loads = loads(m) if callable(loads) else loads
+    masses = masses(m) if callable(masses) else masses
     kinds = type(m).kinds()
     free = [k for k in kinds if kinds[k] != "branch" and k in params]
     p = qropt.Problem(
@@ -40,7 +41,7 @@ def _at_random_design(kind, objective, seed, loads=LOADS):
         free={k: (v - 1e-3 if kinds[k] != "length" else v / 2, v + 1) for k, v in params.items() if k in free},
         targets={"time_ratio": m.time_ratio(), "stroke": m.stroke()},
         objective=objective,
-        masses=MASSES,
+        masses=masses,
         loads=loads,
         omega2=7.0,
         conditions={"grashof": m.grashof().kind} if type(m).FOUR_BAR else {},
@@ -108,14 +109,14 @@ def test_a_cutting_force_table_is_the_same_in_the_nlp_as_in_the_exact_analysis(k
     assert np.sort(got, axis=1) == pytest.approx(np.sort(want, axis=1), rel=1e-9, abs=1e-9 * want.max())
 
 
-def _stroke_loads(m, n, loads) -> np.ndarray:
+def _stroke_loads(m, n, loads, masses=MASSES) -> np.ndarray:
     """(2 n, joints): the squared joint forces at n fractions (0..1) of the working arc with the cutting force on,
     then of the return arc with it off (each stroke closed at its dead centres), by the exact analysis."""
     from qropt.dynamics.cycle import CycleDynamics
 
     lo, length = m.working_arc()
     fr = np.linspace(0, 1, n)
-    c = CycleDynamics(m, 7.0, masses=MASSES, loads=loads)
+    c = CycleDynamics(m, 7.0, masses=masses, loads=loads)
     out = []
     for t, on in ((lo + fr * length, True), (lo + length + fr * (2 * np.pi - length), False)):
         forces = c.at(t % (2 * np.pi), on).joint_forces

@@ -27,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from qropt.errors import InvalidParameter
+from qropt.errors import InvalidParameter, UnsupportedLoad
 from qropt.mechanisms import Mechanism
 from qropt.units import to_metres
 from qropt.validate import MAGNITUDE, number
@@ -490,8 +490,11 @@ def _check_dynamics(m, masses, loads, force, inertia):
         raise InvalidParameter(f"loads is a qropt.Loads, got {type(loads).__name__}")
     if loads is not None and loads.friction:
         raise InvalidParameter("friction makes the load depend on omega2^2: it stays out of the convex problem")
-    if loads is not None:
-        loads.require_plain("the servo's convex problem (speed_profile)")
+    if loads is not None and loads.pin_friction is not None:
+        raise UnsupportedLoad(
+            "the servo's convex problem (speed_profile) cannot apply pin friction: its moments depend on the joint "
+            "forces, so the torque is not linear in omega2^2; inverse_dynamics applies it"
+        )
     if force and loads is not None and (isinstance(loads.cutting_force, tuple) or loads.cutting_force):
         raise InvalidParameter("give the cutting force once: force= or loads=Loads(cutting_force=...), not both")
     if inertia and masses is not None:

@@ -19,10 +19,12 @@ import casadi
 import numpy as np
 
 from qropt import units as units_
+from qropt.dynamics.applied import carrier
 from qropt.dynamics.model import slender_bar, union
 from qropt.dynamics.rigid import body_motion
-from qropt.errors import InvalidParameter, UnsupportedLoad
+from qropt.errors import InvalidParameter
 from qropt.mechanisms.base import working_sign
+from qropt.synthesis import applied as symbolic_loads
 from qropt.synthesis.criteria import Criterion, Exchange, register
 
 TWO_PI = 2 * math.pi
@@ -46,15 +48,37 @@ def _problem_check(c, problem) -> str | None:
     if problem.masses is None and loads is None:
         return f"{c.objective} needs masses or loads (Problem(..., masses=qropt.Masses..., loads=qropt.Loads(...)))"
     what = f"the synthesis NLP ({c.objective})"
-    if loads is not None:
+    if loads is not None and loads.pin_friction is not None:
+        return (
+            f"{what} cannot apply pin friction (Loads.pin_friction) yet: its friction moments depend on the joint "
+            "forces, which it does not solve for exactly; inverse_dynamics, the cycle's extremes, the flywheel and "
+            "the efficiency apply it"
+        )
+    if loads is not None and loads.working is not None:
+        return (
+            f"{what} takes the slow stroke as the working one; a named working stroke (Loads(working="
+            f"{loads.working!r})) is for a mechanism of TR = 1, which a synthesis task does not ask for"
+        )
+    if loads is not None and (loads.forces or loads.torques):
+        cls = problem.mechanism
+        link = cls.linkage(dict(cls.PARAMS) | dict(problem.fixed) | {k: lo for k, (lo, _) in problem.free.items()})
         try:
-            loads.require_plain(what)
-        except UnsupportedLoad as e:
+            symbolic_loads.resolved(link, _system(link, cls.__name__, problem.masses), loads)
+        except InvalidParameter as e:
             return str(e)
-    if problem.masses is not None and problem.masses.points:
-        joint = next(iter(problem.masses.points))
-        return f"{what} cannot take the point mass at {joint} yet (Masses(points=...)); inverse_dynamics does"
     return None
+
+
+def _system(link, name, masses):
+    """The Newton-Euler structure of the linkage (``qropt.dynamics.inverse._System``) for this mass model."""
+    from qropt.dynamics.inverse import _System
+
+    def massive(body):
+        if masses is None:
+            return False
+        return masses.bodies[body].mass > 0 if body in masses.bodies else masses.block > 0
+
+    return _System.of_linkage(link, name, massive)
 
 
 def _cycle(problem, m):
@@ -181,10 +205,40 @@ class _Symbolic:
             model = part if model is None else union(model, part)
         return model
 
+    def triples(self, out, b) -> dict:
+        """joint -> ((x, x', x''), (y, y', y'')) (SI, per unit theta2) of body b's first two joints."""
+        return {j: tuple(tuple(self.point(out, j, k)[i] for k in range(3)) for i in (0, 1)) for j in b.joints[:2]}
+
     def motion(self, out, b, com):
         """(G, v_G, a_G, (cos phi, sin phi, phi', phi'')) of body b per unit theta2 (SI), by ``body_motion``."""
-        pts = {j: tuple(tuple(self.point(out, j, k)[i] for k in range(3)) for i in (0, 1)) for j in b.joints[:2]}
-        return body_motion(b, com, pts)
+        return body_motion(b, com, self.triples(out, b))
+
+    def gravity(self) -> tuple:
+        """(gx, gy) (m/s^2)."""
+        return self.f.loads.gravity_vector if self.f.loads is not None else (0.0, 0.0)
+
+    def general(self, out, working=None) -> list:
+        """The forces and torques of ``Loads`` at one point (``symbolic_loads.at``; ``working`` as ``forces``)."""
+        loads = self.f.loads
+        if loads is None or not (loads.forces or loads.torques):
+            return []
+        if getattr(self, "_resolved", None) is None:
+            self._resolved = symbolic_loads.resolved(self.f.mechanism.linkage(self.f.params), self.system(), loads)
+            self._tables = {}
+        way = working_sign(self.f.orientation > 0, self.f.omega2)
+        return symbolic_loads.at(self, self._resolved, out, working, way, self.f.omega2, self._tables)
+
+    def particles(self, out) -> list:
+        """The point masses (``Masses.points``) at one point: (body that carries it, kg, its joint's (x, y), velocity
+        and acceleration per unit theta2), SI."""
+        masses = self.f.masses
+        if masses is None or not masses.points:
+            return []
+        link = self.f.mechanism.linkage(self.f.params)
+        return [
+            (carrier(link, link, j), mass, self.point(out, j), self.point(out, j, 1), self.point(out, j, 2))
+            for j, mass in masses.points.items()
+        ]
 
     def kinematics(self, out, b, com):
         """(v_G, a_G, phi', phi'') of body b per unit theta2 (SI)."""
@@ -198,18 +252,8 @@ class _Symbolic:
     def system(self):
         """The Newton-Euler structure of the linkage (``qropt.dynamics.inverse._System``)."""
         if getattr(self, "_system", None) is None:
-            from qropt.dynamics.inverse import _System
-
-            masses = self.f.masses
-
-            def massive(name):
-                if masses is None:
-                    return False
-                return masses.bodies[name].mass > 0 if name in masses.bodies else masses.block > 0
-
-            self._system = _System.of_linkage(
-                self.f.mechanism.linkage(self.f.params), self.f.mechanism.__name__, massive
-            )
+            link = self.f.mechanism.linkage(self.f.params)
+            self._system = _system(link, self.f.mechanism.__name__, self.f.masses)
         return self._system
 
     def forces(self, out, working=None, lengths=None) -> tuple:
@@ -224,7 +268,7 @@ class _Symbolic:
 
         self.no_lock()
         f, s = self.f, self.system()
-        entries, rhs = self._assembled(out, lengths)
+        entries, rhs = self._assembled(out, lengths, working)
         ram = s.output
         force = self.cutting_force(out)
         way = working_sign(f.orientation > 0, f.omega2)
@@ -244,9 +288,11 @@ class _Symbolic:
         e = friction_load(casadi, x[col], unit[col], f.loads.friction, sigma)
         return [p + q * e for p, q in zip(x, unit, strict=True)], e
 
-    def _assembled(self, out, lengths=None) -> tuple:
+    def _assembled(self, out, lengths=None, working=None) -> tuple:
         """The Newton-Euler system at one crank angle at constant omega2: (entries, right-hand sides) with the
-        mass model (``lengths`` as ``mass_model``) and gravity, no cutting force."""
+        mass model (``lengths`` as ``mass_model``), gravity, the point masses and the general loads (``working``
+        as ``forces``), no cutting force. A known force F at p and torque tau on a body leave its rows as
+        -(F, (p - G) x F + tau); a point mass m at p adds m (a - g) and (p - G) x m (a - g)."""
         f, s = self.f, self.system()
         w2 = f.omega2**2
         models = self.mass_model(out, lengths)
@@ -257,8 +303,26 @@ class _Symbolic:
             kin[b.name] = (self.centre(out, b, com), (a[0] * w2, a[1] * w2), al * w2, mass, inertia)
         P = {j: self.point(out, j) for j in f.joint_index}
         g = f.loads.gravity if f.loads is not None else 0.0
-        entries, rows = s.assemble(P, kin, g, casadi.sqrt)
-        return entries, dict(rows)
+        tilted = isinstance(g, tuple)  # a gravity vector's weights go on the rows below
+        entries, rows = s.assemble(P, kin, 0.0 if tilted else g, casadi.sqrt)
+        rows = dict(rows)
+        gx, gy = self.gravity()
+
+        def add(body, fx, fy, at, moment=0):
+            r, G = s.rows[body], kin[body][0]
+            rows[r] = rows.get(r, 0.0) + fx
+            rows[r + 1] = rows.get(r + 1, 0.0) + fy
+            if s.kind(body) != "ram":
+                rows[r + 2] = rows.get(r + 2, 0.0) + (at[0] - G[0]) * fy - (at[1] - G[1]) * fx + moment
+
+        for b in s.bodies if tilted else ():
+            mass = kin[b.name][3]
+            add(b.name, -mass * gx, -mass * gy, kin[b.name][0])
+        for body, mass, p, _, a in self.particles(out):
+            add(body, mass * (a[0] * w2 - gx), mass * (a[1] * w2 - gy), p)
+        for load in self.general(out, working):
+            add(load.body, -load.force[0], -load.force[1], load.point, -load.torque)
+        return entries, rows
 
     def no_lock(self):
         """Rows that keep the slide from locking (mu |dN/dF| <= NO_LOCK, where ``friction_load`` holds) at every
@@ -311,11 +375,17 @@ class _Symbolic:
         f = self.f
         w2 = f.omega2**2
         g = f.loads.gravity if f.loads is not None else 0.0
+        gx, gy = self.gravity()
         T = 0
         for name, (m, com, inertia) in self.mass_model(out, lengths).items():
             b = next(x for x in self.bodies if x.name == name)
             v, a, w, al = self.kinematics(out, b, com)
-            T += w2 * (m * (v[0] * a[0] + v[1] * a[1]) + inertia * w * al) + g * m * v[1]
+            weight = -m * (gx * v[0] + gy * v[1]) if isinstance(g, tuple) else g * m * v[1]
+            T += w2 * (m * (v[0] * a[0] + v[1] * a[1]) + inertia * w * al) + weight
+        for _, m, _, v, a in self.particles(out):
+            T += m * (w2 * (v[0] * a[0] + v[1] * a[1]) - (gx * v[0] + gy * v[1]))
+        for load in self.general(out):
+            T -= load.force[0] * load.velocity[0] + load.force[1] * load.velocity[1] + load.torque * load.spin
         return T + self.load(out) + self.friction_torque(out, lengths)
 
     def friction_torque(self, out, lengths=None):
@@ -357,6 +427,8 @@ class _Symbolic:
         for name, (m, com, _) in self.mass_model(out).items():
             b = next(x for x in self.bodies if x.name == name)
             _, a, _, _ = self.kinematics(out, b, com)
+            sx, sy = sx + m * a[0] * w2, sy + m * a[1] * w2
+        for _, m, _, _, a in self.particles(out):
             sx, sy = sx + m * a[0] * w2, sy + m * a[1] * w2
         return sx * sx + sy * sy
 

@@ -93,6 +93,7 @@ class Kin(NamedTuple):
     coords: object
     dcoords: object
     ddcoords: object  # second derivatives of the coordinates where a criterion needs them (dynamics), else 0
+    theta2: object = None  # the crank angle (rad)
 
 
 class Blocks:
@@ -354,12 +355,12 @@ class Formulation:
             dcoords,
             casadi.jacobian(dcoords, t) if self.dynamic else casadi.SX(0),
         ]
-        kin = casadi.Function("kin", [t, X, PF], outs, ["theta2", "free", "fixed"], list(Kin._fields))
+        kin = casadi.Function("kin", [t, X, PF], outs, ["theta2", "free", "fixed"], list(Kin._fields)[:-1])
         self.n_coords = coords.shape[0]
         moving = [i for i in range(self.n_coords) if casadi.depends_on(casadi.SX(coords[i]), t)]
         # a box side's default coordinate (before a design names the one that reaches it): the first moving x, y
         self._default_coord = [next((i for i in moving if i % 2 == a), moving[0]) for a in (0, 0, 1, 1)]
-        self.at = lambda theta: Kin(*kin(theta, X, PF))
+        self.at = lambda theta: Kin(*kin(theta, X, PF), theta)
 
     def row(self, name, expr, lb, ub, kind=RowKind.CONDITION) -> Row:
         """Add a constraint row lb <= expr <= ub (kind: a RowKind or its value)."""
