@@ -26,7 +26,7 @@ def _table(m):
     return qropt.Loads(((d.x_min + 0.2 * span, 200.0), (d.x_min + 0.5 * span, 1500.0), (d.x_max, 600.0)), gravity=9.81)
 
 
-def _at_random_design(kind, objective, seed, loads=LOADS, masses=MASSES):
+def _at_random_design(kind, objective, seed, loads=LOADS, masses=MASSES, drive=None):
     """A problem of a random design's own targets (free parameters around it), its Formulation, and the NLP point
     and parameters at that design with n sample angles: (p, m, f, w, pv, th, params). ``loads`` and ``masses``: a
     Loads and a Masses, or callables of the design giving them."""
@@ -43,6 +43,7 @@ def _at_random_design(kind, objective, seed, loads=LOADS, masses=MASSES):
         objective=objective,
         masses=masses,
         loads=loads,
+        drive=drive,
         omega2=7.0,
         conditions={"grashof": m.grashof().kind} if type(m).FOUR_BAR else {},
     )

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import casadi
 import numpy as np
 from scipy.optimize import brentq
 
@@ -61,6 +62,20 @@ class Drive:
         if self.motor is not None and not isinstance(self.motor, Motor):
             raise InvalidParameter(f"the drive's motor is a qropt.Motor or None, got {type(self.motor).__name__}")
 
+    def to_dict(self) -> dict:
+        """Its numbers as plain data (the motor's by ``Motor.to_dict``)."""
+        out = {"ratio": self.ratio, "efficiency": self.efficiency, "gearbox_inertia": self.gearbox_inertia}
+        return out | ({} if self.motor is None else {"motor": self.motor.to_dict()})
+
+    @classmethod
+    def from_dict(cls, d) -> Drive:
+        """The Drive of ``to_dict``; InvalidParameter naming what is wrong."""
+        keys = ("ratio", "efficiency", "gearbox_inertia", "motor")
+        if not isinstance(d, dict) or "ratio" not in d or set(d) - set(keys):
+            raise InvalidParameter(f"a drive is a table of {list(keys)} (ratio required), got {d!r:.160}")
+        motor = d.get("motor")
+        return cls(**{**d, "motor": None if motor is None else Motor.from_dict(motor)})
+
     @property
     def reflected_inertia(self) -> float:
         """The gearbox's and the rotor's inertia at the crank: ``i^2 (gearbox_inertia + motor.inertia)`` kg m^2."""
@@ -68,10 +83,14 @@ class Drive:
         return self.ratio**2 * (self.gearbox_inertia + rotor)
 
     def motor_torque(self, crank_torque, omega2: float):
-        """The motor's torque (N m) for crank torques T (N m, a number or an array) at crank speed omega2 (rad/s):
-        ``T / (i eta)`` where the motor drives (``T * omega2 > 0``), ``T eta / i`` where it brakes."""
-        t = np.asarray(crank_torque, float)
+        """The motor's torque (N m) for crank torques T (N m, a number, an array or a CasADi expression) at crank
+        speed omega2 (rad/s): ``T / (i eta)`` where the motor drives (``T * omega2 > 0``), ``T eta / i`` where it
+        brakes."""
         i, eta = self.ratio, self.efficiency
+        if isinstance(crank_torque, casadi.SX | casadi.MX):
+            t = crank_torque
+            return casadi.if_else(t * omega2 > 0, t / (i * eta), t * eta / i)
+        t = np.asarray(crank_torque, float)
         out = np.where(t * omega2 > 0, t / (i * eta), t * eta / i)
         return float(out) if out.ndim == 0 else out
 
@@ -176,7 +195,7 @@ def drive_check(m, drive: Drive, omega2: float, *, masses=None, loads=None, flyw
 
     pieces = _split_at_zeros(cd)
     mean_t = cd.quadrature(reflect, pieces) / TWO_PI
-    rms = math.sqrt(cd.quadrature(lambda d: reflect(d) ** 2, pieces) / TWO_PI)
+    rms = rms_motor_torque(cd, drive, pieces)
     peak = cd.peak(lambda d: np.abs(reflect(d)))
     wm = i * omega2
     top = cd.peak(lambda d: reflect(d) * wm)
@@ -207,6 +226,16 @@ def drive_check(m, drive: Drive, omega2: float, *, masses=None, loads=None, flyw
     motion = _Motion(m, drive, masses, cd.loads, omega2, need)
     out |= motion.check(cd, fw, cs)
     return DriveCheck(**out)
+
+
+def rms_motor_torque(cd, drive: Drive, pieces=None, *, split: bool = True) -> float:
+    """The RMS of the motor's torque over the turn (N m) for a cycle's dynamics ``cd`` (``CycleDynamics`` at its
+    constant omega2): Gauss-Legendre on each stroke's pieces, ``split`` where the crank torque changes sign (the
+    motor turns from driving to braking, a kink of its torque's square), else on the cycle's own pieces (the
+    strokes, split at the loads' edges: the synthesis NLP's rule); ``pieces``: the split pieces if already found."""
+    if split and pieces is None:
+        pieces = _split_at_zeros(cd)
+    return math.sqrt(cd.quadrature(lambda d: drive.motor_torque(d.torque, cd.omega2) ** 2, pieces) / TWO_PI)
 
 
 def _split_at_zeros(cd) -> list[tuple]:
@@ -390,4 +419,4 @@ def _operating_speed(drive: Drive, tau: float) -> float | None:
     return None
 
 
-__all__ = ["Drive", "DriveCheck", "drive_check"]
+__all__ = ["Drive", "DriveCheck", "drive_check", "rms_motor_torque"]

@@ -124,6 +124,23 @@ class Motor:
     def is_constant(self) -> bool:
         return self.free_speed == math.inf
 
+    def to_dict(self) -> dict:
+        """Its numbers as plain data (a constant torque without a free speed; unrated ratings left out)."""
+        out = {"stall": self.stall} | ({} if self.is_constant else {"free_speed": self.free_speed})
+        out |= {k: getattr(self, k) for k in ("rated_torque", "peak_torque", "rated_speed") if getattr(self, k)}
+        return out | ({"inertia": self.inertia} if self.inertia else {})
+
+    @classmethod
+    def from_dict(cls, d) -> Motor:
+        """The Motor of ``to_dict``; InvalidParameter naming what is wrong."""
+        keys = ("stall", "free_speed", "rated_torque", "peak_torque", "rated_speed", "inertia")
+        if not isinstance(d, dict) or "stall" not in d or set(d) - set(keys):
+            raise InvalidParameter(f"a motor is a table of {list(keys)} (stall required), got {d!r:.160}")
+        d = dict(d)
+        if d.get("free_speed") is None:
+            d["free_speed"] = math.inf
+        return cls(**d)
+
     def torque(self, omega):
         """N m at speed omega (rad/s; a number or an array), both in the sense of rotation; within +-peak_torque
         when the motor has one."""

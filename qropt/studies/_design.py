@@ -95,10 +95,12 @@ def type_problem(
     units: str = units_.DEFAULT,
     masses=None,
     loads=None,
+    drive=None,
 ) -> Problem:
     """The task as a Problem of one type (a name of ``TYPES``, or a slider type of one's own: see ``type_row``):
     default bounds scaled by the stroke, ``bounds`` (name -> (lo, hi)) overriding those the type has,
-    ``conditions`` added to the type's own; lengths in ``units``; ``masses`` and ``loads`` for its dynamics."""
+    ``conditions`` added to the type's own; lengths in ``units``; ``masses``, ``loads`` and ``drive`` for its
+    dynamics."""
     kind, (mech, lengths, offsets, fixed, angles) = type_row(kind, bounds)
     s = stroke
     free = {k: bounds_of("length", s) for k in lengths} | {k: bounds_of("offset", s) for k in offsets}
@@ -119,6 +121,7 @@ def type_problem(
         units=units,
         masses=masses,
         loads=loads,
+        drive=drive,
     )
 
 
@@ -254,6 +257,7 @@ def task_problems(
     units: str = units_.DEFAULT,
     masses=None,
     loads=None,
+    drive=None,
 ) -> dict:
     """Row name -> the Problem ``design`` solves for it, every argument checked (ProblemError naming the first
     that is wrong); what ``design`` and the web application's design jobs check before any solve."""
@@ -294,6 +298,7 @@ def task_problems(
             units=units,
             masses=masses,
             loads=loads,
+            drive=drive,
         )
         for kind in types
     }
@@ -316,6 +321,7 @@ def design(
     units: str = units_.DEFAULT,
     masses=None,
     loads=None,
+    drive=None,
     workers: int | None = None,
     time_limit: float | None = None,
 ) -> Comparison:
@@ -325,13 +331,13 @@ def design(
     pareto: two objectives whose front is computed for every type (``n`` points each; a type without one gets
     the reason in ``Comparison.fronts``); progress: a callable called once per finished type; units: the length
     unit of the stroke, the bounds and every length of the answer (one of ``qropt.units.LENGTH_UNITS``); masses,
-    loads: every type's mass model and loads (``qropt.Masses``, ``qropt.Loads``; the bars follow each design's
-    links), for the dynamic objectives and bounds; workers: solve the rows in that many worker processes, kept
-    for later calls (``qropt.studies._workers``; the same rows as in this process, the largest given out first);
-    time_limit: seconds of wall time for the whole comparison, shared by the rows (in this process each row gets
-    an equal share of what is left when it starts; in K workers each row K / rows of the whole), each row's
-    Result the best found within its share (``Solver.solve``'s time_limit). Every argument is checked (every
-    type's problem built, the front's objectives and ``n``) before any solve.
+    loads, drive: every type's mass model and loads (``qropt.Masses``, ``qropt.Loads``; the bars follow each
+    design's links) and gearbox (``qropt.Drive``), for the dynamic objectives and bounds; workers: solve the rows
+    in that many worker processes, kept for later calls (``qropt.studies._workers``; the same rows as in this
+    process, the largest given out first); time_limit: seconds of wall time for the whole comparison, shared by
+    the rows (in this process each row gets an equal share of what is left when it starts; in K workers each row
+    K / rows of the whole), each row's Result the best found within its share (``Solver.solve``'s time_limit).
+    Every argument is checked (every type's problem built, the front's objectives and ``n``) before any solve.
     """
     from qropt.synthesis.solver import DEFAULT, Solver, check_time_limit
 
@@ -355,6 +361,7 @@ def design(
         units=units,
         masses=masses,
         loads=loads,
+        drive=drive,
     )
     units = units_.length_unit(units)
     if pareto is not None:

@@ -185,6 +185,7 @@ class Formulation:
         )  # the body accelerations: masses, loads and omega2 are baked in
         if self.dynamic:
             self.masses, self.loads, self.omega2 = problem.masses, problem.loads, problem.omega2
+            self.drive = problem.drive
             self.units = problem.units
         self.rows: list[Row] = []
 

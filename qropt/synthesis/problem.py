@@ -20,6 +20,7 @@ from typing import Any
 
 from qropt import schema
 from qropt import units as units_
+from qropt.dynamics.drive import Drive
 from qropt.dynamics.model import Loads, Masses
 from qropt.errors import ProblemError, QroptError
 from qropt.mechanisms import Mechanism, mechanism_type, type_reference
@@ -49,7 +50,8 @@ class Problem:
     (at ``omega2``, over the 'cycle' or the 'working' stroke), 'min_peak_velocity' (at ``omega2``, over the
     working stroke) or None (see ``qropt.criteria``); branches: name -> allowed signs; units: the length unit
     of every length above and of the answer (one of ``qropt.units.LENGTH_UNITS``; default metres); masses,
-    loads: the mass model and loads of its dynamics (``qropt.Masses``, ``qropt.Loads``, or their dicts), SI.
+    loads: the mass model and loads of its dynamics (``qropt.Masses``, ``qropt.Loads``, or their dicts), SI; drive:
+    the gearbox (and motor) the motor's criteria read (``qropt.Drive`` or its dict).
     """
 
     mechanism: Any
@@ -66,6 +68,7 @@ class Problem:
     units: str = units_.DEFAULT
     masses: Any = None
     loads: Any = None
+    drive: Any = None
 
     def __post_init__(self):
         try:
@@ -80,7 +83,11 @@ class Problem:
             units_.length_unit(self.units)
         except QroptError as e:
             raise self._err(str(e)) from None
-        for k, kind in (("masses", Masses), ("loads", Loads)):  # data: a dict (a file's table) or the object
+        for k, kind in (
+            ("masses", Masses),
+            ("loads", Loads),
+            ("drive", Drive),
+        ):  # a dict (a file's table) or the object
             v = getattr(self, k)
             try:
                 set_(self, k, v if v is None or isinstance(v, kind) else kind.from_dict(v))
@@ -315,6 +322,7 @@ class Problem:
             "units": self.units,
             **({} if self.masses is None else {"masses": self.masses.to_dict()}),
             **({} if self.loads is None else {"loads": self.loads.to_dict()}),
+            **({} if self.drive is None else {"drive": self.drive.to_dict()}),
         }
 
     def __reduce__(self):  # pickled as its plain values (``to_dict``), validated again when loaded
