@@ -400,3 +400,81 @@ def test_the_default_design_is_the_librarys_example(client):
     r = client.post("/api/analyze", json=body)
     assert r.status_code == 200, r.get_json()
     assert r.get_json()["cycle"]["x"][30] == pytest.approx(0.529649, abs=5e-7)  # the README's x at 60 deg
+
+
+def test_a_problem_file_read_as_the_cli_reads_it(client):
+    """qropt's own .toml and .json problem files come back as Problem.to_dict's form; a .py problem is refused
+    with why (code runs only when the command line names it); a bad file is a 400 with its reason."""
+    from pathlib import Path
+
+    from qropt.synthesis.problem import Problem
+
+    text = Path("problems/paper_task.toml").read_text()
+    r = client.post("/api/problem/read", json={"name": "paper_task.toml", "text": text})
+    assert r.status_code == 200, r.get_json()
+    assert r.get_json() == Problem.from_toml(text).to_dict()
+    as_json = Problem.from_toml(text).to_json()
+    r = client.post("/api/problem/read", json={"name": "task.JSON", "text": as_json})
+    assert r.get_json() == Problem.from_json(as_json).to_dict()
+    for name, text, words in (
+        ("paper_drag_link.py", "import os\n", "runs it only when the command line names it (qropt app"),
+        ("task.toml", "mechanism = [", "task.toml is not TOML"),
+        ("task.json", "{nope", "task.json is not a JSON problem"),
+        ("task.toml", 'mechanism = "os:system"', "load a type of your own"),
+        ("task.toml", 'mechanism = "slider-crank"\nhappiness = 1', "unknown: ['happiness']"),
+        ("task.txt", "", "qropt's are .json or .toml"),
+    ):
+        r = client.post("/api/problem/read", json={"name": name, "text": text})
+        assert r.status_code == 400 and words in r.get_json()["error"], (name, r.get_json())
+    assert client.post("/api/problem/read", json={"name": "a.toml"}).status_code == 400
+    assert client.get("/api/health").status_code == 200
+
+
+def test_design_rows_say_why_in_words():
+    """A row without a design says in a sentence which target is beyond the range the type reaches (proved by a
+    closed form: 'can reach'; sampled: 'found'); a design with a violent peak acceleration or a small gamma_min
+    is flagged."""
+    from qropt.app.api import row_warnings, row_words
+
+    reach = {"time_ratio": (1.0, 1.0779), "stroke": (0.0549, 0.617)}
+    assert row_words("failed", reach, 20.0, 0.3, "m") == (
+        "No design: TR 20 is above the highest found for this type within its bounds (1 to 1.078)."
+    )
+    assert "this type can reach" in row_words("infeasible", reach, 20.0, 0.3, "m")
+    both = row_words("failed", reach, 1.05, 0.3, "m")
+    assert both.startswith("No design found: each target alone is within reach (TR 1 to 1.078, the stroke")
+    assert "the stroke 0.01 m is below the lowest" in row_words("failed", reach, 1.05, 0.01, "m")
+    assert row_words("failed", {}, 1.5, 0.3, "m") == ""
+    calm = {"peak_accel": 0.25 * 100, "gamma_min": math.radians(40)}
+    assert row_warnings(calm, 1.5, 0.3, 10.0) == []
+    wild = {"peak_accel": 1000 * 0.3 * 100, "gamma_min": math.radians(5)}
+    w = row_warnings(wild, 20.0, 0.3, 10.0)
+    assert len(w) == 2 and "1000 times stroke" in w[0] and "17.1°" in w[0] and "gamma_min is only 5°" in w[1]
+
+
+def test_an_impossible_design_job_answers_in_words(client):
+    """TR 20: the slider-crank's row says in words that TR 20 is beyond what it reaches, its solver's account kept
+    as the reason; the crank-shaper's design is exact but flagged as extreme; every row names its parameter kinds."""
+    job = client.post(
+        "/api/jobs",
+        json={
+            "kind": "design",
+            "input": {"time_ratio": 20, "stroke": 0.3, "omega2": 10, "types": ["slider-crank", "crank-shaper"]},
+        },
+    ).get_json()
+    s = _wait(client, job["id"])
+    assert s["state"] == "done", s
+    rows = {r["type"]: r for r in s["result"]["rows"]}
+    sc, cs = rows["slider-crank"], rows["crank-shaper"]
+    assert sc["mechanism"] is None and sc["words"].startswith("No design: TR 20 is above the highest found"), sc
+    assert "ipopt" in sc["reason"] or "sampled" in sc["reason"]
+    assert cs["mechanism"] == "crank-shaper" and cs["words"] == "" and cs["kinds"]["r1"] == "length"
+    assert any(w.startswith("extreme: its peak acceleration") for w in cs["warnings"]), cs["warnings"]
+    m = mechanism_type("crank-shaper")(**cs["params"])
+    assert m.time_ratio() == pytest.approx(20, rel=1e-6)
+
+
+def test_types_say_which_parameter_is_which_link(client):
+    info = {t["type"]: t for t in client.get("/api/types").get_json()}
+    assert info["slider-crank"]["summary"].startswith("Offset slider-crank (r2 crank, r3 rod, e slide-line offset)")
+    assert all(t["summary"] for t in info.values())

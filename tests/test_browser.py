@@ -43,6 +43,20 @@ SLIDER_CRANK = {
 }
 
 
+# The pairs of the selected elements whose boxes on the screen overlap (each pair of one picture).
+OVERLAPS = """(sel) => {
+  const out = [], els = [...document.querySelectorAll(sel)];
+  els.forEach((a, i) => els.slice(0, i).forEach((b) => {
+    const p = a.getBoundingClientRect(), q = b.getBoundingClientRect();
+    const near = a.ownerSVGElement === b.ownerSVGElement;
+    if (near && p.left < q.right && q.left < p.right && p.top < q.bottom && q.top < p.bottom) {
+      out.push([a.textContent, b.textContent]);
+    }
+  }));
+  return out;
+}"""
+
+
 @pytest.fixture(scope="module")
 def server():
     from werkzeug.serving import make_server
@@ -79,11 +93,14 @@ def page(browser, server, tmp_path):
     assert errors == [], errors
 
 
+DOCS_SHOTS = ("mechanism", "design", "synthesis")  # the pages docs/images shows (docs/make_images.py)
+
+
 def _shot(pg, tmp_path, name):
     path = tmp_path / f"{name}.png"
     pg.screenshot(path=path, full_page=True)
     extra = os.environ.get("QROPT_SCREENSHOTS")
-    if extra:
+    if extra and name in DOCS_SHOTS:
         shutil.copy(path, Path(extra) / f"app_{name}.png")
     assert path.stat().st_size > 10_000
 
@@ -102,6 +119,13 @@ def test_mechanism_page_drag_a_slider(page, tmp_path):
     names = sorted(page.locator("#m-svg text.joint-name").all_text_contents())  # every joint named, as the tables
     assert names == ["A", "B", "C", "D", "O2", "O4"], names
     assert page.locator("#m-svg .path-working").count() >= 1 and page.locator("#m-svg .path-return").count() >= 1
+    helps = page.eval_on_selector_all("#m-numbers tr[title]", "rows => rows.map((r) => r.title)")  # help texts
+    assert len(helps) == 8 and helps[0].startswith("time ratio TR: the time of the working (cutting) stroke")
+    assert "The joint in brackets, e.g. (B), is where it occurs" in helps[2]
+    assert "assembly branch" in page.get_attribute("#m-params label:has(#p-sigma)", "title")
+    assert page.inner_text("#m-legend").startswith("The parameters: Drag-link (r1 shortest, Grashof) driving C")
+    assert page.evaluate(OVERLAPS, "#m-vpoly text.term-name, #m-apoly text.term-name") == []  # names spread apart
+    assert page.evaluate(OVERLAPS, "#m-svg text.joint-name") == []
     assert page.locator("#m-vpoly line").count() >= 4 and page.locator("#m-plot polyline").count() == 3
     # the forces appear with a mass model, the exact peaks once the inputs rest
     page.check("#m-dyn")
@@ -149,9 +173,19 @@ def test_type_change_and_export(page, tmp_path):
     with page.expect_download() as dl:
         page.click("#export-mechanism-svg")
     assert "<svg" in Path(dl.value.path()).read_text()
+    assert page.inner_text("#export-mechanism-msg") == "downloaded whitworth.svg (whitworth)"  # beside the button
+    page.click("#tab-design")  # a message belongs to its page
+    assert page.inner_text("#export-mechanism-msg") == ""
+    page.click("#export-design-dxf")
+    assert page.inner_text("#export-design-msg") == "no design on this page yet: run it first"
+    page.click("#tab-mechanism")
     page.fill("#n-r2", "0.001")  # a design that cannot turn: the page says why and keeps working
     page.dispatch_event("#n-r2", "change")
     page.wait_for_function("document.getElementById('m-error').textContent.length > 0")
+    page.click("#m-play")  # nothing to animate or export, and the page says why beside the button
+    assert page.inner_text("#m-play-msg").startswith("no animation: the inputs give no design that turns")
+    page.click("#export-mechanism-json")
+    assert page.inner_text("#export-mechanism-msg").startswith("no export: the inputs give no design that turns")
     page.fill("#n-r2", str(p["r2"]))
     page.dispatch_event("#n-r2", "change")
     page.wait_for_function("document.getElementById('m-error').textContent.length === 0")
@@ -182,6 +216,8 @@ def test_design_page(page, tmp_path):
     page.wait_for_timeout(200)
     p = page.evaluate("window.qropt.params")
     assert p == pytest.approx(want.rows[2].result.params), (want.rows[2].type, want.rows[2].result.message)
+    assert want.rows[2].type == "whitworth" and 0 < abs(p["h"]) < 1e-12  # a rounding residue beside lengths of tenths
+    assert page.input_value("#n-h") == "0"  # shows as 0 in its box
 
 
 def test_design_page_dynamic_objective_and_stale_results(page, tmp_path):
@@ -236,18 +272,49 @@ def test_a_bad_r3_marks_the_results_stale(page, tmp_path):
 
 
 def test_synthesis_page(page, tmp_path):
+    """A TOML problem file loads into the JSON and the form alike, a .py one is refused with why; the solve's
+    certificate and r3 equal qropt.solve's and its design is drawn; a front on a problem with no freedom left says
+    so; the form and the JSON follow each other; a front's point opens its design."""
+    from qropt.synthesis.problem import Problem
+
     page.click("#tab-synthesis")
+    toml = Path(qropt.__file__).parents[1] / "problems" / "paper_task.toml"
+    page.set_input_files("#s-file", str(toml))
+    page.wait_for_function("document.getElementById('s-file-msg').textContent.startsWith('loaded')")
+    assert json.loads(page.input_value("#s-json")) == Problem.from_toml(toml.read_text()).to_dict()
+    assert page.input_value("#s-v-r1") == "0.1" and page.is_checked("#s-f-r3") and not page.is_checked("#s-f-r1")
+    assert page.input_value("#s-lo-r3") == "0.05" and page.input_value("#s-tr") == "1.5"
+    assert page.input_value("#s-b-sigma") == "-1" and page.input_value("#s-objective") == "gamma_min"
+    page.set_input_files("#s-file", str(toml.with_name("paper_drag_link.py")))
+    page.wait_for_function("document.getElementById('s-file-msg').textContent.includes('not loaded')")
+    assert "runs it only when the command line names it (qropt app paper_drag_link.py)" in page.inner_text(
+        "#s-file-msg"
+    )
     page.click("#s-solve")
     page.wait_for_selector("#s-claim", timeout=60_000)
     want = qropt.solve(paper_problem())
     assert page.inner_text("#s-claim") == f"certificate: {want.certificate.global_claim}"
     cell = page.locator("#s-optima tr.pick").nth(0).locator("td").nth(2)
     assert float(cell.inner_text()) == pytest.approx(want.params["r3"], rel=1e-5)
-    page.fill("#s-json", json.dumps(SLIDER_CRANK))
+    page.wait_for_function("document.querySelectorAll('#s-svg text.joint-name').length === 6")  # the design drawn
+    page.click("#s-front")  # two free parameters, two targets: no freedom left, and the page says so
+    page.wait_for_function("document.getElementById('s-front-note').textContent.length > 0", timeout=120_000)
+    assert "The front is one design" in page.inner_text("#s-front-note")
+    assert page.locator(".front-point").count() == 0
+    page.fill("#s-json", json.dumps({**SLIDER_CRANK, "targets": {"time_ratio": 1.35, "stroke": 0.3}}))
+    assert page.input_value("#s-type") == "slider-crank" and page.is_checked("#s-f-e")  # the form follows the JSON
+    page.fill("#s-tr", "1.3")  # and the JSON the form
+    assert json.loads(page.input_value("#s-json"))["targets"] == SLIDER_CRANK["targets"]
+    assert json.loads(page.input_value("#s-json"))["free"] == SLIDER_CRANK["free"]
+    page.click("#s-solve")
+    page.wait_for_function("document.querySelectorAll('#s-svg text.joint-name').length === 3", timeout=60_000)
+    assert "minimum transmission angle" not in page.inner_text("#s-optima")  # (gamma_min is the objective's column)
     page.click("#s-front")
     page.wait_for_selector(".front-point", timeout=120_000)
     n = page.locator(".front-point").count()
     assert n >= 3
+    assert "[deg]" in page.text_content("#s-front-svg")  # the objective in degrees
+    page.wait_for_timeout(200)
     _shot(page, tmp_path, "synthesis")
     page.locator(".front-point").nth(n - 1).click()
     page.wait_for_function("location.hash === '#mechanism' && window.qropt.type === 'slider-crank'")
@@ -255,3 +322,114 @@ def test_synthesis_page(page, tmp_path):
     page.wait_for_timeout(200)
     m = mechanism_type("slider-crank")(**page.evaluate("window.qropt.params"))
     assert m.time_ratio() == pytest.approx(1.3, abs=1e-6) and m.stroke() == pytest.approx(0.3, abs=1e-6)
+
+
+def test_a_shared_link_restores_the_page(page, browser, server):
+    """The URL holds the page, the type, the parameters, theta2, omega2 and the mass model: a new page opened at
+    it shows the same design and numbers; back and forward move through the edits, a drag being one entry."""
+    page.select_option("#m-type", "slider-crank")
+    page.wait_for_function("window.qropt.type === 'slider-crank' && !window.qropt.inflight")
+    page.wait_for_timeout(1100)
+    page.fill("#n-r3", "0.41")
+    page.dispatch_event("#n-r3", "change")
+    page.fill("#m-theta-n", "100")
+    page.dispatch_event("#m-theta-n", "change")
+    page.fill("#m-omega", "7.5")
+    page.dispatch_event("#m-omega", "change")
+    page.check("#m-dyn")
+    page.wait_for_function("window.qropt.params.r3 === 0.41 && !window.qropt.inflight")
+    page.wait_for_timeout(1100)
+    box = page.locator("#p-r2").bounding_box()  # a drag: one history entry
+    y = box["y"] + box["height"] / 2
+    page.mouse.move(box["x"] + 0.3 * box["width"], y)
+    page.mouse.down()
+    for i in range(1, 11):
+        page.mouse.move(box["x"] + (0.3 + 0.01 * i) * box["width"], y)
+        page.wait_for_timeout(20)
+    page.mouse.up()
+    page.wait_for_function("!window.qropt.inflight && !window.qropt.pending")
+    page.wait_for_timeout(300)
+    url, params = page.url, page.evaluate("window.qropt.params")
+    assert "type=slider-crank" in url and "theta2=100" in url and "omega2=7.5" in url and "mass=" in url, url
+    assert url.endswith("#mechanism")
+    shown = page.inner_text("#m-numbers")
+    other = browser.new_page(viewport={"width": 1400, "height": 1000})
+    try:
+        other.goto(url)
+        other.wait_for_selector("body[data-ready='1']", timeout=60_000)
+        other.wait_for_function("window.qropt.updates > 0 && !window.qropt.inflight")
+        assert other.evaluate("window.qropt.params") == params
+        assert other.input_value("#m-theta-n") == "100" and other.input_value("#m-omega") == "7.5"
+        assert other.is_checked("#m-dyn") and other.inner_text("#m-numbers") == shown
+        other.wait_for_function("document.getElementById('m-forces').textContent.includes('crank torque')")
+    finally:
+        other.close()
+    page.go_back()  # the drag, undone at once
+    page.wait_for_function("!window.qropt.inflight")
+    page.wait_for_timeout(300)
+    back = page.evaluate("window.qropt.params")
+    assert back["r3"] == 0.41 and back["r2"] != params["r2"]
+    page.go_forward()
+    page.wait_for_function(f"window.qropt.params.r2 === {params['r2']!r}")
+    page.goto(server + "?type=nonesuch#mechanism")  # a link the app cannot follow says why and opens the default
+    page.wait_for_selector("body[data-ready='1']")
+    assert "does not serve (nonesuch)" in page.inner_text("#m-url-msg")
+
+
+def test_design_page_link_lengths_and_an_impossible_task(page, tmp_path):
+    """TR 20: the page says in a sentence which types reach it and why the others do not (the solver's account
+    behind a toggle); the extreme designs are marked doubtful; each row shows its parameters with the unit and the
+    peak acceleration names the omega2 it is at."""
+    page.click("#tab-design")
+    page.fill("#d-tr", "20")
+    for box in page.locator("#d-types input").all():
+        box.set_checked(box.get_attribute("value") in ("slider-crank", "crank-shaper"))
+    page.click("#d-run")
+    page.wait_for_selector("#d-table tr.pick", timeout=120_000)
+    rows = page.evaluate("window.qropt.designRows")
+    head = page.locator("#d-table th").all_text_contents()
+    assert "peak accel at omega2 = 10 rad/s [m/s²]" in head and "parameters [m; angles in deg]" in head, head
+    assert page.inner_text("#d-summary").startswith("1 of 2 types has a design for TR 20 and stroke 0.3 m")
+    cs = page.locator("#d-table tr.pick").nth(0)
+    assert "doubtful" in cs.get_attribute("class") and "extreme" in cs.inner_text()
+    p = rows[0]["params"]
+    cells = cs.locator("td").all_text_contents()
+    assert cells[6] == ", ".join(f"{k} {float(format(p[k], '.4g'))!r}" for k in ("r1", "r2", "r4")), cells[6]
+    sc = page.locator("#d-table tr.pick").nth(1)
+    assert "failed" in sc.get_attribute("class")
+    reason = sc.locator("p.reason").inner_text()
+    assert reason.startswith("No design: TR 20 is above the highest found for this type within its bounds (1 to")
+    toggle = sc.locator("details")
+    assert toggle.get_attribute("open") is None and toggle.locator("summary").inner_text() == "the solver's account"
+    assert sc.locator("td").last.evaluate("e => getComputedStyle(e).textAlign") == "left"
+    page.screenshot(path=tmp_path / "design_impossible.png", full_page=True)
+
+
+@pytest.mark.parametrize("width", [420, 1400])
+def test_pages_at_a_phone_and_a_desktop_width(browser, server, tmp_path, width):
+    """Each page at 420 and 1,400 px: nothing wider than the screen, the pictures as wide as their column, and a
+    screenshot with something drawn in it."""
+    from PIL import Image
+
+    pg = browser.new_page(viewport={"width": width, "height": 900})
+    try:
+        pg.goto(server + "#mechanism")
+        pg.wait_for_selector("body[data-ready='1']", timeout=60_000)
+        pg.wait_for_function("window.qropt.updates > 0 && !window.qropt.inflight")
+        for name in ("mechanism", "design", "synthesis"):
+            pg.click(f"#tab-{name}")
+            pg.wait_for_timeout(300)
+            over = pg.evaluate("document.documentElement.scrollWidth - document.documentElement.clientWidth")
+            assert over <= 0, (name, width, over)
+            path = tmp_path / f"{name}_{width}.png"
+            pg.screenshot(path=path, full_page=True)
+            img = Image.open(path).convert("L")
+            assert img.width == width and len(img.getcolors(1 << 16)) > 20, (name, width)  # not blank
+        pg.click("#tab-mechanism")
+        pg.wait_for_timeout(300)
+        assert pg.evaluate(OVERLAPS, "text.term-name, text.joint-name") == [], width
+        for svg in ("m-svg", "m-plot", "m-vpoly", "m-apoly"):
+            w = pg.locator(f"#{svg}").bounding_box()["width"]
+            assert w >= 0.7 * min(width, 700) - 40, (svg, width, w)
+    finally:
+        pg.close()

@@ -127,6 +127,62 @@ def design_type(name) -> str:
     return name
 
 
+EXTREME_ACCEL = 10.0  # peak acceleration over stroke x omega2^2 above which a design is flagged (a crank's is ~1)
+SMALL_GAMMA = 10.0  # deg: a least transmission angle below this is flagged
+
+
+def row_words(status: str, reachable: dict, time_ratio: float, stroke: float, units: str) -> str:
+    """Why a design row has no design, in a sentence a student reads: each target against the range the type
+    reaches within its bounds (``Result.reachable``; 'can reach' where a closed form proves the range, 'was found
+    to reach' where designs were sampled), else that no design meets the targets together."""
+    proved = status == "infeasible"
+    names = {"time_ratio": ("TR", time_ratio, ""), "stroke": ("the stroke", stroke, f" {units}")}
+    said, inside = [], []
+    for k, (lo, hi) in (reachable or {}).items():
+        if k not in names:
+            continue
+        word, v, u = names[k]
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            return "No design of this type turns fully within its bounds and conditions."
+        span = f"{lo:.4g} to {hi:.4g}{u}"
+        if lo - 1e-6 * abs(v) <= v <= hi + 1e-6 * abs(v):
+            inside.append(f"{word} {span}")
+            continue
+        side = "above the highest" if v > hi else "below the lowest"
+        reach = "this type can reach" if proved else "found for this type"
+        said.append(f"{word} {v:g}{u} is {side} {reach} within its bounds ({span})")
+    if said:
+        return "No design: " + "; ".join(said) + "."
+    if inside:
+        return (
+            f"No design found: each target alone is within reach ({', '.join(inside)}), but no design found "
+            "meets them together with the conditions."
+        )
+    return ""
+
+
+def row_warnings(row: dict, time_ratio: float, stroke: float, omega2: float) -> list[str]:
+    """What makes a design row's answer doubtful though the solve succeeded: a peak acceleration many times
+    stroke x omega2^2 (the return stroke squeezed into a small part of the turn), a least transmission angle near
+    zero (the links push along each other and the mechanism may jam)."""
+    out = []
+    a, g = row.get("peak_accel"), row.get("gamma_min")
+    if a is not None and omega2:
+        k = a / (stroke * omega2**2)
+        if k > EXTREME_ACCEL:
+            arc = 360.0 / (1.0 + time_ratio)
+            out.append(
+                f"extreme: its peak acceleration is {k:.0f} times stroke × omega2² (about 1 for an ordinary "
+                f"crank); the return stroke takes only {arc:.3g}° of the crank's turn"
+            )
+    if g is not None and math.degrees(g) < SMALL_GAMMA:
+        out.append(
+            f"gamma_min is only {math.degrees(g):.3g}°: the links push nearly along each other and the "
+            "mechanism may jam"
+        )
+    return out
+
+
 def known_type(name) -> type[Mechanism]:
     """A registered type by its KIND, class name or ``module:Class`` reference; never imports."""
     if isinstance(name, str) and ":" in name:
@@ -149,7 +205,8 @@ def types() -> list[str]:
 
 
 def type_info() -> list[dict]:
-    """Each type's name, class, output and parameters (name -> kind), and a valid default design."""
+    """Each type's name, class, output, parameters (name -> kind), a valid default design and its summary (the
+    first paragraph of the class's docstring, which says which parameter is which link)."""
     from qropt.app.defaults import default_params
 
     out = []
@@ -163,6 +220,7 @@ def type_info() -> list[dict]:
                 "kinds": cls.kinds(),
                 "required": cls.required(),
                 "params": default_params(cls),
+                "summary": " ".join((cls.__doc__ or "").strip().split("\n\n")[0].split()),
             }
         )
     return out

@@ -33,10 +33,13 @@ def _solve(payload: dict, progress) -> dict:
 
 def _design(payload: dict, progress) -> dict:
     """``design``'s arguments (masses and loads as dicts; ``time_limit`` the budget of the whole comparison): the
-    Comparison's JSON, each row with the type its design opens as ("mechanism") and its certificate's global claim
-    ("claim": with a budget, it names the strategies the budget left out)."""
+    Comparison's JSON, each row with the type its design opens as ("mechanism"), that type's parameter kinds
+    ("kinds"), its certificate's global claim ("claim": with a budget, it names the strategies the budget left
+    out), why it has no design in a sentence ("words", ``api.row_words``) and what makes a design doubtful
+    ("warnings", ``api.row_warnings``)."""
     import json
 
+    from qropt.app.api import row_warnings, row_words
     from qropt.dynamics.model import Loads, Masses
     from qropt.mechanisms import type_reference
     from qropt.studies import design
@@ -59,6 +62,13 @@ def _design(payload: dict, progress) -> dict:
         m, cert = r.result.mechanism, r.result.certificate
         row["mechanism"] = None if m is None else type_reference(type(m))
         row["claim"] = cert.global_claim if cert is not None else None
+        row["kinds"] = None if m is None else type(m).kinds()
+        if r.success:
+            row["words"], row["warnings"] = "", row_warnings(row, c.time_ratio, c.stroke, c.omega2)
+        else:
+            found = r.result.reachable
+            row["words"] = row_words(r.result.status, found, c.time_ratio, c.stroke, c.units)
+            row["warnings"] = []
     return out
 
 

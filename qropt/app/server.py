@@ -5,6 +5,8 @@ in one line; nothing a request sends stops the server.
 - ``GET /api/health``; ``GET /api/types`` (every type, its parameters and a valid design to open with);
   ``GET /api/problems`` (the problem files the app was started with)
 - ``POST /api/analyze``: ``{type, params, theta2, omega2}`` -> the analysis (``qropt.app.api.analyze``)
+- ``POST /api/problem/read``: ``{name, text}`` (a ``.json`` or ``.toml`` problem file) -> the problem in
+  ``Problem.to_dict``'s form; a ``.py`` file is refused (code runs only when the command line names it)
 - ``POST /api/solve``: a problem (``Problem.to_dict``'s form) -> the Result (``Result.to_dict``'s form)
 - ``GET /api/design/options``: what a design may ask for: the objectives (the criteria registry's), the types
   (``design``'s rows and the served user types) and the longest time budget
@@ -44,6 +46,36 @@ def _problem(payload):
     d = dict(payload)
     d["mechanism"] = api.known_type(d.get("mechanism"))
     return Problem.from_dict(d)
+
+
+def read_problem(payload) -> dict:
+    """``{name, text}``: a problem file's text (qropt's ``.json`` or ``.toml``; ``name`` the file's name, whose
+    ending says which) as ``Problem.to_dict``'s form, read and checked as ``qropt synth`` reads it. A ``.py``
+    problem is code: it is refused (the app runs one only when the command line names it)."""
+    import tomllib
+
+    d = api.fields(payload, ("name", "text"))
+    name, text = d["name"], d["text"]
+    if not isinstance(name, str) or not isinstance(text, str):
+        raise api.ApiError("name and text are strings: the file's name and its text")
+    kind, short = Path(name).suffix.lower(), Path(name).name[:80]
+    if kind == ".py":
+        raise api.ApiError(
+            f"{short} is a Python problem, which is code: the app runs it only when the command line names it "
+            f"(qropt app {short}); here load a .json or .toml problem"
+        )
+    if kind not in (".json", ".toml"):
+        raise api.ApiError(f"{short!r} is not a problem file: qropt's are .json or .toml (or .py on the command line)")
+    if validate.nesting(text) > validate.MAX_NESTING:
+        raise api.ApiError(f"{short}: nested deeper than {validate.MAX_NESTING} levels")
+    if kind == ".json":
+        table = validate.json_document(text, short, "problem", error=api.ApiError)
+    else:
+        try:
+            table = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as e:
+            raise api.ApiError(f"{short} is not TOML: {e}") from None
+    return _problem(table).to_dict()
 
 
 _DESIGN_FIELDS = (
@@ -194,6 +226,10 @@ def create_app(files=(), workers: int = 1, queue_size: int = 8, time_limit: floa
         if job.state == "timeout":
             raise api.ApiError(f"the {kind} stopped at the time limit of {jobs.time_limit:g} s", 408)
         raise api.ApiError(job.error or job.state, 400 if job.error and "internal error" not in job.error else 500)
+
+    @app.post("/api/problem/read")
+    def problem_read():
+        return jsonify(read_problem(body()))
 
     @app.post("/api/solve")
     def solve():

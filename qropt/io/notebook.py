@@ -505,7 +505,7 @@ def _plain(params) -> str:
 
 def comparison_html(c) -> str:
     """A type comparison: the ranked table (gamma_min in degrees, each criterion in its unit) and every design
-    drawn at one scale."""
+    drawn, each to its own scale (its scale bar says how large)."""
     from qropt.synthesis import criteria
 
     u = criteria.units(c.units)

@@ -8,11 +8,45 @@ const COLOURS = { absolute: "#000", relative: "#1565c0", normal: "#2e7d32", tang
   sliding: "#6a1b9a", coriolis: "#c62828" };
 const WORK = "#2e7d32", RET = "#e65100";
 
+// What each quantity a student reads means: a row's or a heading's tooltip (title=).
+const HELP = {
+  time_ratio: "time ratio TR: the time of the working (cutting) stroke over the time of the return stroke at a steady "
+    + "crank speed; TR 1.5 means the return takes 2/3 of the working stroke's time",
+  stroke: "stroke: the distance the ram travels between its two ends (its dead centres)",
+  swing: "swing: the angle the output link turns through between its two ends",
+  gamma_min: "gamma_min: the least transmission angle over the turn, the angle at which a link pushes what it drives "
+    + "(folded to 0-90 deg): 90 deg transmits the force best, near 0 the mechanism jams. The joint in brackets, "
+    + "e.g. (B), is where it occurs",
+  dead_centres: "dead centres: the crank angles theta2 at which the ram stops and turns back (the ends of the stroke)",
+  peak_accel: "peak acceleration: the largest acceleration of the ram over one turn at the omega2 given, and the crank "
+    + "angle where it occurs",
+  peak_accel_design: "peak acceleration: the largest acceleration of the ram over one turn at the omega2 of the task "
+    + "(it grows as omega2 squared)",
+  footprint: "footprint: the area of the smallest rectangle that holds the mechanism over its whole turn",
+  x: "x: the ram's position at theta2", v: "v: the ram's velocity at theta2", a: "a: the ram's acceleration at theta2",
+  theta2: "theta2: the crank angle, in degrees from the line of centres",
+  omega2: "omega2: the crank's speed in rad/s (its sign is its sense of rotation); 10 rad/s is about 95 rpm",
+  sigma: "sigma: the assembly branch, which of the two ways the links fit together at one crank angle (+1 or -1); "
+    + "a mechanism stays on its branch while it turns",
+  torque: "crank torque: the torque the motor must give the crank at theta2 to keep omega2 steady",
+  force: "joint force: the magnitude of the force the joint passes on at theta2",
+  rms: "RMS torque: the root mean square of the crank torque over a turn (what heats the motor)",
+  shaking: "peak shaking force: the largest force the mechanism puts on its frame over a turn",
+  flywheel: "flywheel: the moment of inertia that keeps the crank's speed within a coefficient of fluctuation "
+    + "Cs = 0.05 (plus or minus 2.5%)",
+  objective: "objective: the quantity the solve makes as large (max_) or as small (min_) as it can",
+  status: "status: optimal (certified best of its kind), feasible (meets the task, not proved best), infeasible (no "
+    + "design exists within the bounds) or failed (none found)",
+  parameters: "parameters: the design's link lengths and offsets in the unit named, angles in degrees (the branch "
+    + "signs are on the Mechanism page); the line under the Mechanism page's sliders says which is which link",
+  free: "free: the solve chooses this parameter between its low and high bounds; unticked, it stays at its value",
+};
+
 // The app's state; window.qropt lets a test read what the page shows and how fast it updates.
 const state = {
   types: {}, type: null, params: {}, units: "m", analysis: null, frames: null, playing: false,
   inflight: false, pending: false, updates: 0, answers: 0, designRows: [], selected: null, result: null, job: null,
-  objectives: {}, results: {},
+  objectives: {}, results: {}, restoring: false, solved: null,
 };
 window.qropt = state;
 
@@ -31,7 +65,12 @@ async function call(method, url, body) {
   return data === null ? text : data;
 }
 
-function say(text) { $("status").textContent = text || ""; }
+// A message beside what caused it: the element `id` (an export bar's, the Animate button's), "" clears it.
+function say(id, text, bad = false) {
+  const e = $(id);
+  e.textContent = text || "";
+  e.classList.toggle("bad", bad);
+}
 
 // ---- results and the inputs they belong to ----------------------------------------------------------------
 // Every page's results are a group: its panels, a note above them and a function giving the page's inputs
@@ -143,12 +182,51 @@ function note(svg, text) {
   el("tspan", { x: 8, dy: n ? 16 : 0 }, t, line);
 }
 // The size in drawing units of `px` pixels in an svg whose viewBox is w x h (shown with "meet").
+// The view box x, y, w, h widened (or heightened) to the svg's own shape, so that it fills the svg and text placed
+// at its corner is at the picture's corner; set on the svg and returned.
+function fitView(svg, x, y, w, h) {
+  const r = svg.getBoundingClientRect();
+  if (r.width > 0 && r.height > 0) {
+    const want = r.width / r.height;
+    if (w / h < want) { const w2 = h * want; x -= (w2 - w) / 2; w = w2; } else { const h2 = w / want; y -= (h2 - h) / 2; h = h2; }
+  }
+  svg.setAttribute("viewBox", `${x} ${y} ${w} ${h}`);
+  return { x, y, w, h };
+}
 function unitsPerPixel(svg, w, h, px) {
   const r = svg.getBoundingClientRect();
   const scale = Math.min((r.width || 400) / w, (r.height || 300) / h);
   return px / scale;
 }
-const fmt = (v, d = 4) => (v === null || v === undefined || Number.isNaN(v) ? "-" : Number(v).toPrecision(d));
+// A number as a person reads it: d significant digits, trailing zeros dropped, 0 for a value within `tiny` of
+// zero (a rounding residue such as h = -1.9e-17 of a design whose lengths are tenths of a metre).
+function num(v, d = 6, tiny = 0) {
+  if (v === null || v === undefined || Number.isNaN(Number(v))) return "-";
+  if (Math.abs(v) <= tiny) return "0";
+  return String(+Number(v).toPrecision(d));
+}
+// The residue below which a parameter of this design is zero: 1e-9 of its longest length or offset.
+function tinyOf(params, kinds) {
+  const sizes = Object.entries(params).filter(([k]) => ["length", "offset"].includes(kinds[k])).map(([, v]) => Math.abs(v));
+  return 1e-9 * Math.max(0, ...sizes);
+}
+// A design's parameters in one line: lengths and offsets in the unit (named in the column's head), angles in
+// degrees; the branch signs left out.
+function paramText(params, kinds, unit) {
+  const tiny = tinyOf(params, kinds), out = [];
+  for (const [k, v] of Object.entries(params)) {
+    const kind = kinds[k];
+    if (kind === "branch" || kind === undefined) continue;
+    out.push(kind === "angle" ? `${k} ${num(v / DEG, 4)}°` : `${k} ${num(v, 4, tiny)}`);
+  }
+  return out.join(", ");
+}
+// d significant digits, zeros kept (90.00); an exponent only outside 1e-4..1e9.
+function fmt(v, d = 4) {
+  if (v === null || v === undefined || Number.isNaN(v)) return "-";
+  const s = Number(v).toPrecision(d), a = Math.abs(v);
+  return s.includes("e") && a >= 1e-4 && a < 1e9 ? String(+s) : s;
+}
 const pts = (p) => p.map((q) => `${q[0]},${q[1]}`).join(" ");
 
 const STYLE = {
@@ -166,7 +244,7 @@ const STYLE = {
 function drawMechanism(svg, drawing, shapes, label) {
   clear(svg);
   const [x, y, w, h] = drawing.view, pad = 0.06 * Math.max(w, h);
-  svg.setAttribute("viewBox", `${x - pad} ${-(y + h) - pad} ${w + 2 * pad} ${h + 2 * pad}`);
+  const view = fitView(svg, x - pad, -(y + h) - pad, w + 2 * pad, h + 2 * pad);
   svg.setAttribute("preserveAspectRatio", "xMidYMid meet");
   const g = el("g", { transform: "scale(1,-1)" }, svg);
   if (drawing.path) {
@@ -194,14 +272,31 @@ function drawMechanism(svg, drawing, shapes, label) {
     }
   }
   if (label) {
-    const fs = unitsPerPixel(svg, w + 2 * pad, h + 2 * pad, 13);
-    el("text", { x: x - pad + fs * 0.5, y: -(y + h) - pad + fs * 1.2, "font-size": fs, fill: "#333" }, svg, label);
-    const js = unitsPerPixel(svg, w + 2 * pad, h + 2 * pad, 13);  // each joint's name, as the tables name it
+    const fs = unitsPerPixel(svg, view.w, view.h, 13), per = Math.max(12, Math.floor(view.w / (0.58 * fs)) - 2);
+    const lines = [];  // the label wrapped to the picture's width
+    for (const word of label.split(" ")) {
+      if (lines.length && (lines[lines.length - 1] + " " + word).length <= per) lines[lines.length - 1] += " " + word;
+      else lines.push(word);
+    }
+    const t = el("text", { x: view.x + fs * 0.5, y: view.y + fs * 1.2, "font-size": fs, fill: "#333" }, svg);
+    lines.forEach((line, i) => el("tspan", { x: view.x + fs * 0.5, dy: i ? 1.2 * fs : 0 }, t, line));
+    const longest = Math.max(...lines.map((l) => l.length));
+    const boxes = [[view.x, view.y, view.x + 0.62 * fs * longest, view.y + (0.4 + 1.2 * lines.length) * fs]];  // its box
+    // each joint's name, as the tables name it, beside its joint where it overlaps no name before it
+    const around = [[0.5, -0.5], [-0.5, -0.5], [0.5, 1.3], [-0.5, 1.3], [0.9, 0.4], [-0.9, 0.4], [0, -1], [0, 1.8]];
     for (const s of shapes) {
       if (s.part !== "pivot" && s.part !== "joint") continue;
-      const [jx, jy] = s.points[0];
-      el("text", { x: jx + 0.5 * js, y: -jy - 0.5 * js, "font-size": js, fill: "#1a237e", stroke: "#fff",
-        "stroke-width": 0.25 * js, "paint-order": "stroke", "font-weight": "bold", class: "joint-name" }, svg, s.name);
+      const [jx, jy] = s.points[0], w = 0.68 * fs * s.name.length;
+      let spot = null;
+      for (const [dx, dy] of around) {
+        const tx = jx + dx * fs + (dx < 0 ? -w : dx === 0 ? -w / 2 : 0), ty = -jy + dy * fs;
+        const b = [tx, ty - fs, tx + w, ty];
+        if (!boxes.some((o) => b[0] < o[2] && o[0] < b[2] && b[1] < o[3] && o[1] < b[3])) { spot = [tx, ty, b]; break; }
+      }
+      if (!spot) spot = [jx + 0.5 * fs, -jy - 0.5 * fs, null];
+      if (spot[2]) boxes.push(spot[2]);
+      el("text", { x: spot[0], y: spot[1], "font-size": fs, fill: "#1a237e", stroke: "#fff",
+        "stroke-width": 0.25 * fs, "paint-order": "stroke", "font-weight": "bold", class: "joint-name" }, svg, s.name);
     }
   }
 }
@@ -209,7 +304,7 @@ function drawMechanism(svg, drawing, shapes, label) {
 // Panels of curves over the crank angle in one svg: each its own y axis and label with units.
 function plotCycle(svg, th, panels, working, mark) {
   clear(svg);
-  const W = 640, H = 90 * panels.length + 40, L = 70, R = 15, T = 10;
+  const W = Math.max(360, Math.min(900, svg.clientWidth || 640)), H = 90 * panels.length + 40, L = 70, R = 15, T = 10;
   svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
   const ph = (H - T - 35) / panels.length;
   const X = (t) => L + ((W - L - R) * t) / 360;
@@ -258,16 +353,16 @@ function drawPolygon(svg, equations, quantity, unit) {
   }
   const x0 = Math.min(...xs), x1 = Math.max(...xs), y0 = Math.min(...ys), y1 = Math.max(...ys);
   const span = Math.max(x1 - x0, y1 - y0, 1e-12), pad = 0.18 * span;
-  svg.setAttribute("viewBox", `${x0 - pad} ${-y1 - pad} ${x1 - x0 + 2 * pad} ${y1 - y0 + 2 * pad}`);
+  const view = fitView(svg, x0 - pad, -y1 - pad, x1 - x0 + 2 * pad, y1 - y0 + 2 * pad);
   const defs = el("defs", {}, svg);
   for (const [k, c] of Object.entries(COLOURS)) {
     const mk = el("marker", { id: `arrow-${quantity}-${k}`, viewBox: "0 0 10 10", refX: 10, refY: 5,
       markerWidth: 7, markerHeight: 7, orient: "auto-start-reverse" }, defs);
     el("path", { d: "M 0 0 L 10 5 L 0 10 z", fill: c }, mk);
   }
-  const fs = unitsPerPixel(svg, x1 - x0 + 2 * pad, y1 - y0 + 2 * pad, 11);
+  const fs = unitsPerPixel(svg, view.w, view.h, 11);
   const g = el("g", { transform: "scale(1,-1)" }, svg);
-  const drawn = new Set();
+  const drawn = new Set(), named = [];
   for (const s of segs) {
     const key = s.from.concat(s.to).map((v) => Math.round(v / (1e-6 * span))).join(",");
     if (drawn.has(key) || Math.hypot(s.term.vector[0], s.term.vector[1]) < 1e-12 * span) continue;
@@ -276,22 +371,40 @@ function drawPolygon(svg, equations, quantity, unit) {
       "stroke-width": 1.8, "vector-effect": "non-scaling-stroke",
       "marker-end": `url(#arrow-${quantity}-${s.term.kind})` }, g);
     if (Math.hypot(s.term.vector[0], s.term.vector[1]) < 0.15 * span) continue;  // short terms: no room to name
-    el("text", { x: (s.from[0] + s.to[0]) / 2, y: -(s.from[1] + s.to[1]) / 2, "font-size": fs, fill: COLOURS[s.term.kind],
-      transform: "scale(1,-1)" }, g, s.term.name);
+    named.push(s);
+  }
+  // Each term named beside its arrow's middle, moved along the arrow's normal until it overlaps no name before it.
+  const title = `${quantity} polygon [${unit}]`, tx = view.x + fs * 0.4, ty = view.y + fs * 1.3;
+  const boxes = [[tx, ty - 1.2 * fs, tx + 0.62 * 1.2 * fs * title.length, ty]];  // the title's
+  const free = (b) => !boxes.some((o) => b[0] < o[2] && o[0] < b[2] && b[1] < o[3] && o[1] < b[3]);
+  for (const s of named) {
+    const mx = (s.from[0] + s.to[0]) / 2, my = -(s.from[1] + s.to[1]) / 2;  // (y down, as the svg's)
+    const dx = s.to[0] - s.from[0], dy = -(s.to[1] - s.from[1]), len = Math.hypot(dx, dy) || 1;
+    const nx = -dy / len, ny = dx / len, w = 0.62 * fs * s.term.name.length, h = fs;
+    let spot = null;
+    for (let k = 0; k < 16 && !spot; k++) {
+      const d = (k % 2 ? -1 : 1) * (0.7 + 1.1 * Math.floor(k / 2)) * fs;
+      const x = mx + nx * d, y = my + ny * d + 0.35 * h;
+      const b = [x - w / 2, y - 1.15 * h, x + w / 2, y + 0.15 * h];  // (with a margin)
+      if (free(b)) spot = [x, y, b];
+    }
+    if (!spot) continue;  // no room near its arrow: left unnamed (its colour and the legend say its kind)
+    boxes.push(spot[2]);
+    el("text", { x: spot[0], y: spot[1], "font-size": fs, fill: COLOURS[s.term.kind], "text-anchor": "middle",
+      stroke: "#fff", "stroke-width": 0.2 * fs, "paint-order": "stroke", class: "term-name" }, svg, s.term.name);
   }
   for (const e of eqs) {
     el("line", { x1: 0, y1: 0, x2: e.exact[0], y2: e.exact[1], stroke: "#777", "stroke-dasharray": "4 3",
       "vector-effect": "non-scaling-stroke" }, g);
   }
   el("circle", { cx: 0, cy: 0, r: 0.012 * span, fill: "#000" }, g);
-  el("text", { x: x0 - pad + fs * 0.4, y: -y1 - pad + fs * 1.3, "font-size": fs * 1.2 }, svg,
-    `${quantity} polygon [${unit}]`);
+  el("text", { x: tx, y: ty, "font-size": fs * 1.2 }, svg, title);
 }
 
 // A scatter of two criteria whose points open their designs.
 function scatter(svg, pts2, xlabel, ylabel, onPick) {
   clear(svg);
-  const W = 640, H = 300, L = 70, B = 40, T = 10, R = 15;
+  const W = Math.max(360, Math.min(900, svg.clientWidth || 640)), H = 300, L = 70, B = 40, T = 10, R = 15;
   svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
   const xs = pts2.map((p) => p[0]), ys = pts2.map((p) => p[1]);
   const xl = Math.min(...xs), xh = Math.max(...xs), yl = Math.min(...ys), yh = Math.max(...ys);
@@ -314,25 +427,79 @@ function scatter(svg, pts2, xlabel, ylabel, onPick) {
     "text-anchor": "middle" }, svg, ylabel);
 }
 
+// A table: a header row and rows of cells, each a text or a DOM node; onPick(i) when row i is clicked.
 function table(tbl, head, rows, onPick) {
   tbl.innerHTML = "";
   const tr = tbl.insertRow();
-  for (const h of head) { const th = document.createElement("th"); th.textContent = h; tr.appendChild(th); }
+  for (const h of head) {
+    const th = document.createElement("th");
+    if (h instanceof Node) th.appendChild(h); else th.textContent = h;
+    tr.appendChild(th);
+  }
   rows.forEach((r, i) => {
     const row = tbl.insertRow();
-    for (const c of r) row.insertCell().textContent = c;
+    r.forEach((c, k) => {
+      const td = row.insertCell();
+      td.dataset.label = head[k] instanceof Node ? head[k].textContent : head[k];  // its heading on a narrow screen
+      if (c instanceof Node) td.appendChild(c); else td.textContent = c;
+    });
     if (onPick) { row.className = "pick"; row.addEventListener("click", () => onPick(i)); }
   });
+}
+
+// Each row of a quantity table gets its quantity's help as a tooltip, found by the row's first words.
+const HELP_ROWS = [["time ratio", "time_ratio"], ["stroke", "stroke"], ["swing", "swing"], ["gamma_min", "gamma_min"],
+  ["dead centres", "dead_centres"], ["peak acceleration", "peak_accel"], ["x ", "x"], ["v ", "v"], ["a ", "a"],
+  ["theta4", "x"], ["omega4", "v"], ["alpha4", "a"], ["crank torque", "torque"], ["force at", "force"],
+  ["peak torque", "torque"], ["RMS torque", "rms"], ["peak shaking", "shaking"], ["flywheel", "flywheel"]];
+function helpRows(tbl) {
+  for (const tr of tbl.rows) {
+    const text = tr.cells[0].textContent, hit = HELP_ROWS.find(([start]) => text.startsWith(start));
+    if (hit) tr.title = HELP[hit[1]];
+  }
+}
+
+// A block of text elements: [tag, text, class] each, in a <div> (a table cell's content).
+function block(parts) {
+  const div = document.createElement("div");
+  for (const [tag, text, cls] of parts) {
+    if (!text) continue;
+    const e = document.createElement(tag);
+    e.textContent = text;
+    if (cls) e.className = cls;
+    div.appendChild(e);
+  }
+  return div;
+}
+// Details behind a toggle: <details><summary>summary</summary>text</details>.
+function toggle(summary, text) {
+  const d = document.createElement("details"), s = document.createElement("summary");
+  s.textContent = summary;
+  d.append(s, text);
+  d.addEventListener("click", (ev) => ev.stopPropagation());  // opening it does not pick the row
+  return d;
 }
 
 // ---- pages ----------------------------------------------------------------------------------------------
 function route() {
   const page = (location.hash || "#mechanism").slice(1);
+  for (const m of document.querySelectorAll(".msg")) say(m.id, "");  // a message belongs to the page it was said on
   for (const p of ["design", "mechanism", "synthesis"]) {
     $(`page-${p}`).classList.toggle("shown", p === page);
     $(`tab-${p}`).classList.toggle("active", p === page);
   }
+  redraw();
 }
+
+// The shown page's pictures drawn again at the size they are shown (drawn while hidden, or the window resized).
+function redraw() {
+  if ($("page-mechanism").classList.contains("shown") && state.analysis) showAnalysis(state.analysis);
+  if ($("page-synthesis").classList.contains("shown") && state.solved) {
+    drawMechanism($("s-svg"), state.solved[0], state.solved[0].shapes, state.solved[1]);
+  }
+}
+let resized = null;
+window.addEventListener("resize", () => { clearTimeout(resized); resized = setTimeout(redraw, 200); });
 
 // Mechanism: a slider and a number box per parameter; every change analysed at once (one request in flight).
 function paramRange(kind, v, all) {
@@ -350,11 +517,14 @@ function showParams(type, params) {
   $("m-type").value = type;
   const box = $("m-params");
   box.innerHTML = "";
-  const kinds = state.types[type].kinds;
+  const kinds = state.types[type].kinds, summary = state.types[type].summary.replace(/``/g, "");
+  $("m-legend").textContent = summary ? `The parameters: ${summary}` : "";
+  const tiny = tinyOf(state.params, kinds);
   for (const [k, kind] of Object.entries(kinds)) {
     if (!(k in state.params)) continue;
     const label = document.createElement("label");
     label.innerHTML = `<span>${k} <span class="unit">${{ angle: "deg", branch: "" }[kind] ?? state.units}</span></span>`;
+    label.title = kind === "branch" ? HELP.sigma : `${k}: a ${kind} of the ${state.types[type].class}. ${summary}`;
     if (kind === "branch") {
       const s = document.createElement("select");
       s.id = `p-${k}`;
@@ -368,7 +538,7 @@ function showParams(type, params) {
       const r = document.createElement("input");
       Object.assign(r, { type: "range", min: lo, max: hi, step, value: shown, id: `p-${k}` });
       const n = document.createElement("input");
-      Object.assign(n, { type: "number", step: "any", value: +shown.toPrecision(6), id: `n-${k}` });
+      Object.assign(n, { type: "number", step: "any", value: num(shown, 6, kind === "angle" ? 0 : tiny), id: `n-${k}` });
       const set = (v) => { state.params[k] = kind === "angle" ? v * DEG : v; analyze(); };
       r.addEventListener("input", () => { n.value = +Number(r.value).toPrecision(6); set(Number(r.value)); });
       n.addEventListener("change", () => { if (n.value !== "") { r.value = n.value; set(Number(n.value)); } });
@@ -426,8 +596,76 @@ function request(frames) {
   return body;
 }
 
+// ---- the state in the URL: the page in its hash, the Mechanism page's design in its query -------------------
+// ?type=drag-link-slider&r1=0.1&...&theta2=60&omega2=10&mass=1.57,20,1000,9.81: the parameters as the library
+// takes them (lengths in the unit, angles in rad), theta2 in deg, omega2 in rad/s, the mass model (links kg/m,
+// ram kg, cutting force N, gravity m/s²) only when it is ticked. A burst of edits (a slider dragged) is one
+// entry of the browser's history: the first edit after a pause adds an entry, the next ones rewrite it.
+const EDIT_PAUSE = 1000;  // ms
+let lastEdit = -Infinity;
+function stateQuery() {
+  const q = new URLSearchParams();
+  q.set("type", state.type);
+  for (const [k, v] of Object.entries(state.params)) q.set(k, String(v));
+  q.set("theta2", $("m-theta").value);
+  q.set("omega2", $("m-omega").value);
+  if ($("m-dyn").checked) q.set("mass", MASS_FIELDS.map(([k]) => $(`m-${k}`).value).join(","));
+  return q;
+}
+function keepState() {
+  const restoring = state.restoring;
+  state.restoring = false;
+  if (!state.type) return;
+  const url = `${location.pathname}?${stateQuery()}${location.hash}`;
+  if (url === location.pathname + location.search + location.hash) return;
+  if (restoring) { history.replaceState(null, "", url); return; }
+  const now = performance.now();
+  if (now - lastEdit < EDIT_PAUSE) history.replaceState(null, "", url);
+  else history.pushState(null, "", url);
+  lastEdit = now;
+}
+// The design the URL names ({type, params, theta2, omega2, mass}), null if it names none; what it gets wrong is
+// said beside the type and left at the type's default.
+function fromURL() {
+  const q = new URLSearchParams(location.search), type = q.get("type");
+  if (!type) return null;
+  const t = state.types[type], bad = [];
+  if (!t) {
+    say("m-url-msg", `The link names a type this app does not serve (${type}): the default design is shown.`, true);
+    return null;
+  }
+  const params = { ...t.params };
+  const number = (k) => {
+    const v = q.get(k) === null || q.get(k) === "" ? NaN : Number(q.get(k));
+    if (!Number.isFinite(v)) bad.push(k);
+    return v;
+  };
+  for (const k of Object.keys(t.kinds)) if (q.has(k)) { const v = number(k); if (Number.isFinite(v)) params[k] = v; }
+  const out = { type, params };
+  for (const k of ["theta2", "omega2"]) if (q.has(k)) { const v = number(k); if (Number.isFinite(v)) out[k] = v; }
+  if (q.has("mass")) {
+    const m = q.get("mass").split(",").map(Number);
+    if (m.length === MASS_FIELDS.length && m.every(Number.isFinite)) out.mass = m; else bad.push("mass");
+  }
+  if (bad.length) say("m-url-msg", `The link's ${bad.join(", ")} ${bad.length > 1 ? "are" : "is"} not a number: left as before.`, true);
+  return out;
+}
+// The Mechanism page set to the design the URL names; false if it names none.
+function applyURL() {
+  const u = fromURL();
+  if (!u) return false;
+  if (u.theta2 !== undefined) { $("m-theta").value = u.theta2; $("m-theta-n").value = u.theta2; }
+  if (u.omega2 !== undefined) $("m-omega").value = u.omega2;
+  $("m-dyn").checked = !!u.mass;
+  if (u.mass) MASS_FIELDS.forEach(([k], i) => { $(`m-${k}`).value = u.mass[i]; });
+  state.restoring = true;
+  showParams(u.type, u.params);
+  return true;
+}
+
 let framesTimer = null;
 async function analyze() {
+  keepState();
   if (state.inflight) { state.pending = true; return; }
   state.inflight = true;
   state.pending = false;
@@ -440,6 +678,7 @@ async function analyze() {
     state.answers += 1;
     showAnalysis(a);
     fresh("mechanism", asked);
+    say("m-play-msg", "");
   } catch (e) {
     state.answers += 1;
     stale("mechanism", e.message);
@@ -475,6 +714,7 @@ function showAnalysis(a) {
     [out ? "omega4 [rad/s]" : `v [${u}/s]`, fmt(a.state.v, 6)],
     [out ? "alpha4 [rad/s²]" : `a [${u}/s²]`, fmt(a.state.a, 6)],
   ]);
+  helpRows($("m-numbers"));
   $("m-numbers").dataset.timeRatio = a.time_ratio;
   $("m-numbers").dataset.stroke = a.stroke;
   $("m-numbers").dataset.gammaMin = g.value_deg;
@@ -500,11 +740,13 @@ function showAnalysis(a) {
     showForces(a.dynamics, th, working);
   } else {
     clear($("m-torque"));
+    $("m-torque").classList.add("none");
     $("m-forces").innerHTML = "";
   }
 }
 
 function showForces(dy, th, working) {
+  $("m-torque").classList.remove("none");
   plotCycle($("m-torque"), dy.torque.theta2_deg, [{ y: dy.torque.value, label: "torque [N m]", colour: "#6a1b9a" }],
     working, th);
   const rows = [
@@ -520,6 +762,7 @@ function showForces(dy, th, working) {
     rows.push(["peak torque [N m]", "(when the inputs rest)"]);
   }
   table($("m-forces"), ["at theta2", "value"], rows);
+  helpRows($("m-forces"));
 }
 
 let animation = null;
@@ -531,13 +774,20 @@ function stopAnimation() {
 }
 function play() {
   if (state.playing) return stopAnimation();
-  if (!state.frames || !state.frames.frames.length) { say("the turn is still being computed"); return; }
+  const g = state.results.mechanism;
+  if (g.stale) { say("m-play-msg", "no animation: the inputs give no design that turns (the reason is above the numbers)", true); return; }
+  if (!state.frames || !state.frames.frames.length) {
+    say("m-play-msg", "the turn's frames are still being computed: try again in a moment");
+    return;
+  }
+  say("m-play-msg", "");
   state.playing = true;
   $("m-play").textContent = "Stop";
-  const f = state.frames.frames, t0 = performance.now();
+  const turn = state.frames, f = turn.frames, t0 = performance.now();
   const step = (now) => {
+    if (!state.playing) return;
     const i = Math.floor((Math.max(0, now - t0) / 1000) * 24) % f.length;  // (a frame's time may precede t0)
-    drawMechanism($("m-svg"), state.frames, f[i].shapes,
+    drawMechanism($("m-svg"), turn, f[i].shapes,
       `theta2 = ${f[i].theta2_deg.toFixed(0)} deg, ${f[i].working ? "working" : "return"} stroke`);
     if (state.playing) animation = requestAnimationFrame(step);
   };
@@ -547,22 +797,24 @@ function play() {
 function openDesign(type, params) {
   location.hash = "#mechanism";
   route();
+  lastEdit = performance.now();  // the design opened rewrites the page change's history entry
   showParams(type, params);
 }
 
 // Design: the task solved for every chosen type in a worker (a dynamic objective with the mass model and load,
 // within a time budget), the rows ranked, each with its picture.
-function objectiveOptions(select, entries) {
+function objectiveOptions(select, entries, first = true) {
   for (const o of entries) {
     const text = o.objective + (o.size ? ` (${o.size})` : "") + ` — ${o.label}` + (o.dynamic ? ", mass model" : "");
     const opt = new Option(text, o.criterion);
     opt.dataset.dynamic = o.dynamic ? "1" : "";
     select.add(opt);
   }
-  select.value = "gamma_min";
+  if (first) select.value = "gamma_min";
 }
 
 function chosenObjective(select) {
+  if (select.value === "") return { objective: null };
   const o = state.objectives[select.value];
   return o.size ? { objective: o.objective, size: o.size } : { objective: o.objective };
 }
@@ -624,76 +876,268 @@ async function runDesign(ev) {
   }
 }
 
+const unitText = (u) => String(u).replace("^2", "²");
+
+// The Design page's rows: each type's criteria, its parameters, and its certificate; a row without a design
+// says why in words (the solver's own account behind a toggle); a doubtful design says what is doubtful.
 function showDesign(c, input) {
   const u = c.units, length = u.length, obj = state.objectives[$("d-objective").value];
-  const cols = [["gamma_min", "gamma_min [deg]", (v) => fmt(v / DEG, 4)], ["footprint", `footprint [${length}²]`],
-    ["peak_accel", `peak accel [${length}/s²]`]];
-  if (!cols.some((col) => col[0] === obj.criterion)) cols.push([obj.criterion, `${obj.label} [${u[obj.criterion]}]`]);
+  const at = `at omega2 = ${num(c.omega2)} rad/s`;
+  const cols = [["gamma_min", "gamma_min [deg]", (v) => fmt(v / DEG, 4)], ["footprint", `footprint [${unitText(u.footprint)}]`],
+    ["peak_accel", `peak accel ${at} [${unitText(u.peak_accel)}]`]];
+  if (!cols.some((col) => col[0] === obj.criterion)) {
+    const deg = obj.unit === "rad";
+    cols.push([obj.criterion, `${obj.label} [${deg ? "deg" : unitText(u[obj.criterion])}]`, deg ? (v) => fmt(v / DEG, 4) : fmt]);
+  }
   if (input.masses && obj.criterion !== "peak_torque") cols.push(["peak_torque", `peak torque [${u.peak_torque}]`]);
-  table($("d-table"), ["#", "type", "status", ...cols.map((col) => col[1]), "certificate or reason"],
-    c.rows.map((r, i) => [i + 1, r.type, r.status,
-      ...cols.map(([k, , f]) => (r[k] === null || r[k] === undefined ? "-" : (f || fmt)(r[k]))),
-      r.reason || r.claim || ""]),
+  const head = ["#", "type", "status", ...cols.map((col) => col[1]), `parameters [${length}; angles in deg]`,
+    "certificate or reason"];
+  const help = { "gamma_min [deg]": HELP.gamma_min, [cols[1][1]]: HELP.footprint, [cols[2][1]]: HELP.peak_accel_design,
+    status: HELP.status, [head[head.length - 2]]: HELP.parameters };
+  table($("d-table"), head,
+    c.rows.map((r, i) => {
+      const bad = !r.mechanism, doubt = (r.warnings || []).length > 0;
+      const status = block([["span", bad ? `no design (${r.status})` : doubt ? `${r.status}, doubtful` : r.status,
+        bad ? "status-failed" : doubt ? "status-doubtful" : `status-${r.status}`]]);
+      let why;
+      if (bad) {
+        why = block([["p", r.words || firstClause(r.reason), "reason"]]);
+        why.appendChild(toggle("the solver's account", r.reason));
+      } else {
+        why = block([...(r.warnings || []).map((w) => ["p", w, "warning"]), ["p", r.claim || "", "claim"]]);
+      }
+      return [i + 1, r.type, status,
+        ...cols.map(([k, , f]) => (r[k] === null || r[k] === undefined ? "-" : (f || fmt)(r[k]))),
+        r.params && r.kinds ? paramText(r.params, r.kinds, length) : "-", why];
+    }),
     (i) => c.rows[i].mechanism && openDesign(c.rows[i].mechanism, c.rows[i].params));
+  $("d-table").querySelectorAll("th").forEach((th) => { if (help[th.textContent]) th.title = help[th.textContent]; });
+  c.rows.forEach((r, i) => {
+    const tr = $("d-table").rows[i + 1];
+    if (!r.mechanism) tr.classList.add("failed");
+    else if ((r.warnings || []).length) tr.classList.add("doubtful");
+  });
+  $("d-summary").textContent = designSummary(c);
   const ok = c.rows.filter((r) => r.mechanism);
   state.selected = ok.length ? { type: ok[0].mechanism, params: ok[0].params } : null;
-  $("d-pictures").innerHTML = "";
-  for (const r of ok) {
-    const card = document.createElement("div");
-    card.className = "card";
-    card.innerHTML = `<strong></strong><br><span></span>`;
-    card.querySelector("strong").textContent = r.type;
-    card.querySelector("span").textContent = `${obj.label} ${fmt(obj.unit === "rad" ? r[obj.criterion] / DEG : r[obj.criterion], 4)}`
-      + `${obj.unit === "rad" ? " deg" : " " + u[obj.criterion]}, ${r.status}`;
-    const svg = el("svg", { role: "img" }, card);
-    card.addEventListener("click", () => openDesign(r.mechanism, r.params));
-    $("d-pictures").appendChild(card);
-    call("POST", "/api/analyze", { type: r.mechanism, params: r.params, theta2: 0, omega2: 1, polygons: false })
-      .then((a) => drawMechanism(svg, a.drawing, a.drawing.shapes)).catch((e) => { card.title = e.message; });
-  }
+  designPictures(ok, obj, u);
 }
 
-// Synthesis: a problem as a form or JSON, solved in a worker: every local optimum and the certificate; a front.
-function synthesisForm(type) {
-  const t = state.types[type], box = $("s-params");
+// One sentence over the rows: how many types have a design, and how many of those are doubtful.
+function designSummary(c) {
+  const ok = c.rows.filter((r) => r.mechanism), doubt = ok.filter((r) => (r.warnings || []).length);
+  const task = `TR ${num(c.time_ratio)} and stroke ${num(c.stroke)} ${c.units.length}`;
+  if (!ok.length) return `No type has a design for ${task}: each row says why.`;
+  let out = `${ok.length} of ${c.rows.length} types ${ok.length === 1 ? "has" : "have"} a design for ${task}, best first.`;
+  if (doubt.length === 1 && ok.length === 1) out += " It is doubtful: see the warnings in its row.";
+  else if (doubt.length === ok.length) out += " Every one is doubtful: see the warnings in its row.";
+  else if (doubt.length) out += ` ${doubt.length} of them doubtful: see the warnings in their rows.`;
+  return out;
+}
+
+// The reason's first clause (before the solver's counts and ranges), for a reason the server did not word.
+function firstClause(reason) {
+  const r = String(reason || "no design");
+  const cut = r.search(/ \(|; /);
+  return cut > 0 ? r.slice(0, cut) : r;
+}
+
+// Every design drawn at one scale (the frame that holds the largest), each card its type and objective.
+async function designPictures(rows, obj, u) {
+  const box = $("d-pictures");
+  box.innerHTML = "";
+  const cards = rows.map((r) => {
+    const card = document.createElement("div");
+    card.className = "card" + ((r.warnings || []).length ? " doubtful" : "");
+    card.innerHTML = `<strong></strong><br><span></span>`;
+    card.querySelector("strong").textContent = r.type;
+    const deg = obj.unit === "rad";
+    card.querySelector("span").textContent = `${obj.label} ${fmt(deg ? r[obj.criterion] / DEG : r[obj.criterion], 4)}`
+      + `${deg ? " deg" : " " + unitText(u[obj.criterion])}, ${r.status}` + ((r.warnings || []).length ? ", doubtful" : "");
+    const svg = el("svg", { role: "img" }, card);
+    card.addEventListener("click", () => openDesign(r.mechanism, r.params));
+    box.appendChild(card);
+    return { svg, card, r };
+  });
+  const drawn = await Promise.all(cards.map(({ card, r }) =>
+    call("POST", "/api/analyze", { type: r.mechanism, params: r.params, theta2: 0, omega2: 1, polygons: false })
+      .then((a) => a.drawing).catch((e) => { card.title = e.message; return null; })));
+  const views = drawn.filter(Boolean).map((d) => d.view);
+  if (!views.length) return;
+  const W = Math.max(...views.map((v) => v[2])), H = Math.max(...views.map((v) => v[3]));
+  cards.forEach(({ svg }, i) => {
+    const d = drawn[i];
+    if (!d) return;
+    const [x, y, w, h] = d.view;
+    drawMechanism(svg, { ...d, view: [x + w / 2 - W / 2, y + h / 2 - H / 2, W, H] }, d.shapes);
+  });
+  const scale = document.createElement("p");
+  scale.className = "legend";
+  scale.id = "d-scale";
+  scale.textContent = `Every design drawn at one scale: the largest, ${num(W, 3)} x ${num(H, 3)} ${u.length} over its `
+    + "turn, fills its picture.";
+  box.prepend(scale);
+}
+
+// Synthesis: one problem shown two ways, a form and its JSON (Problem.to_json's form), kept in step: an edit of
+// either rewrites the other, and Solve sends the JSON. The form shows the type, each parameter fixed or free
+// between bounds, each branch sign, the targets and the objective; what else the JSON sets (conditions, masses,
+// ...) stays in it and is named under the form.
+const FORM_KEYS = ["mechanism", "fixed", "free", "branches", "targets", "objective", "size"];
+
+function synthesisForm(type, problem) {
+  const t = state.types[type], box = $("s-params"), p = problem || {};
+  const fixed = p.fixed || {}, free = p.free || {}, branches = p.branches || {};
   box.innerHTML = "";
   const head = document.createElement("div");
   head.className = "s-head";
-  for (const h of ["", `value [${state.units}]`, "free", "low", "high"]) {
+  for (const [h, help] of [["", ""], [`value [${state.units}; deg]`, ""], ["free", HELP.free], ["low", ""], ["high", ""]]) {
     const sp = document.createElement("span");
     sp.textContent = h;
+    if (help) sp.title = help;
     head.appendChild(sp);
   }
   box.appendChild(head);
+  const tiny = tinyOf({ ...t.params, ...fixed }, t.kinds);
   for (const [k, kind] of Object.entries(t.kinds)) {
-    if (kind === "branch" || !(k in t.params)) continue;
-    const v = t.params[k], label = document.createElement("label");
-    label.innerHTML = `<span>${k}</span>`;
+    const label = document.createElement("label");
+    label.innerHTML = `<span class="name" title="${k}"></span>`;
+    label.firstChild.textContent = k;
+    label.className = "s-row";
+    if (kind === "branch") {
+      const sel = document.createElement("select");
+      sel.id = `s-b-${k}`;
+      sel.title = HELP.sigma;
+      for (const [v, text] of [["1", "+1"], ["-1", "-1"], ["both", "both"]]) sel.add(new Option(text, v));
+      const given = branches[k] || (k in fixed ? [fixed[k]] : [t.params[k] ?? 1]);
+      sel.value = given.length > 1 ? "both" : String(Math.sign(given[0]) || 1);
+      label.appendChild(sel);
+      label.classList.add("s-branch");
+      box.appendChild(label);
+      continue;
+    }
+    const shownValue = (v) => (kind === "angle" ? num(v / DEG, 12) : num(v, 12, tiny));
+    const v = k in fixed ? fixed[k] : t.params[k] ?? 0;
     const val = document.createElement("input");
-    Object.assign(val, { type: "number", step: "any", value: +v.toPrecision(5), id: `s-v-${k}` });
-    const free = document.createElement("input");
-    Object.assign(free, { type: "checkbox", id: `s-f-${k}`, title: "free, between the two bounds" });
+    Object.assign(val, { type: "number", step: "any", value: shownValue(v), id: `s-v-${k}` });
+    const isFree = document.createElement("input");
+    Object.assign(isFree, { type: "checkbox", id: `s-f-${k}`, title: HELP.free, checked: k in free });
     const lo = document.createElement("input"), hi = document.createElement("input");
     const span = Math.max(Math.abs(v), 0.05);
-    Object.assign(lo, { type: "number", step: "any", value: kind === "length" ? +(span / 5).toPrecision(3) : -+(3 * span).toPrecision(3), id: `s-lo-${k}` });
-    Object.assign(hi, { type: "number", step: "any", value: +(3 * span).toPrecision(3), id: `s-hi-${k}` });
-    label.append(val, free, lo, hi);
-    label.className = "s-row";
+    const plain = { length: [span / 5, 3 * span], angle: [-Math.PI, Math.PI] }[kind] || [-3 * span, 3 * span];
+    const [l, h] = free[k] || plain.map((x) => +x.toPrecision(kind === "angle" ? 12 : 3));
+    Object.assign(lo, { type: "number", step: "any", value: shownValue(l), id: `s-lo-${k}` });
+    Object.assign(hi, { type: "number", step: "any", value: shownValue(h), id: `s-hi-${k}` });
+    label.append(val, isFree, lo, hi);
     box.appendChild(label);
   }
 }
 
-function formProblem() {
+// The form's problem merged into `base` (the JSON's other fields kept): angles in the form are degrees.
+function formProblem(base = {}) {
   const type = $("s-type").value, t = state.types[type];
-  const fixed = {}, free = {};
+  const out = {};
+  for (const [k, v] of Object.entries(base)) if (!FORM_KEYS.includes(k)) out[k] = v;
+  const fixed = {}, free = {}, branches = {};
   for (const [k, kind] of Object.entries(t.kinds)) {
-    if (!(k in t.params)) continue;
-    if (kind === "branch") { fixed[k] = t.params[k]; continue; }
-    if ($(`s-f-${k}`).checked) free[k] = [Number($(`s-lo-${k}`).value), Number($(`s-hi-${k}`).value)];
-    else fixed[k] = Number($(`s-v-${k}`).value);
+    const rad = (x) => (kind === "angle" ? Number(x) * DEG : Number(x));
+    if (kind === "branch") {
+      const v = $(`s-b-${k}`).value;
+      branches[k] = v === "both" ? [1, -1] : [Number(v)];
+    } else if ($(`s-f-${k}`).checked) free[k] = [rad($(`s-lo-${k}`).value), rad($(`s-hi-${k}`).value)];
+    else if ($(`s-v-${k}`).value !== "") fixed[k] = rad($(`s-v-${k}`).value);
   }
-  return { mechanism: type, fixed, free, targets: { time_ratio: Number($("s-tr").value), stroke: Number($("s-stroke").value) },
-    ...chosenObjective($("s-objective")) };
+  const o = chosenObjective($("s-objective"));
+  const size = o.size || (base.objective === o.objective ? base.size : undefined);
+  return { mechanism: type, fixed, free, branches, targets: { ...(base.targets || {}), time_ratio: Number($("s-tr").value),
+    stroke: Number($("s-stroke").value) }, objective: o.objective, ...(size ? { size } : {}), ...out };
+}
+
+// The criterion (an option of the objective list) of a problem's objective and size; one the list lacks is added.
+function objectiveOf(p) {
+  if (p.objective === null || p.objective === undefined || p.objective === "none") return "";
+  const all = Object.values(state.objectives).filter((o) => o.objective === p.objective);
+  const o = all.find((x) => !x.size || x.size === (p.size || "footprint")) || all[0];
+  if (!o) return null;
+  if (![...$("s-objective").options].some((opt) => opt.value === o.criterion)) objectiveOptions($("s-objective"), [o], false);
+  return o.criterion;
+}
+
+// The JSON's problem shown in the form; false (and why, under the form) where the form cannot show it.
+function problemToForm(p) {
+  const why = (text) => { $("s-form-note").textContent = text; $("s-form").classList.toggle("stale", !!text); return !text; };
+  if (!p || typeof p !== "object" || Array.isArray(p)) return why("The form is not in step: the JSON is not a problem (an object).");
+  if (!state.types[p.mechanism]) {
+    return why(`The form is not in step: the app serves no type ${JSON.stringify(p.mechanism)} (it serves ${Object.keys(state.types).join(", ")}).`);
+  }
+  const objective = objectiveOf(p);
+  if (objective === null) return why(`The form is not in step: no objective ${JSON.stringify(p.objective)}.`);
+  $("s-type").value = p.mechanism;
+  synthesisForm(p.mechanism, p);
+  const tg = p.targets || {};
+  $("s-tr").value = tg.time_ratio ?? "";
+  $("s-stroke").value = tg.stroke ?? "";
+  $("s-objective").value = objective;
+  const plain = { omega2: 1, accel_over: "cycle", units: state.units };  // the defaults, not named
+  const extra = Object.entries(p).filter(([k, v]) => !FORM_KEYS.includes(k) && k !== "name" && v !== null && v !== ""
+    && plain[k] !== v && !(typeof v === "object" && !Object.keys(v).length))
+    .map(([k, v]) => (typeof v === "object" ? `${k} (${Object.keys(v).join(", ")})` : `${k} ${v}`));
+  const others = Object.keys(tg).filter((k) => !["time_ratio", "stroke"].includes(k));
+  if (others.length) extra.unshift(`targets ${others.join(", ")}`);
+  why("");
+  $("s-extra").textContent = extra.length ? `Also in the JSON (edit it there): ${extra.join("; ")}.` : "";
+  return true;
+}
+
+// The JSON box set to a problem, the form following it; the results marked as the old problem's.
+function problemSet(problem) {
+  $("s-json").value = JSON.stringify(problem, null, 2);
+  problemToForm(problem);
+  inputsChanged("solve");
+  inputsChanged("front");
+}
+
+// The form edited: the JSON rewritten from it, its other fields kept.
+function formChanged() {
+  let base = {};
+  try { base = JSON.parse($("s-json").value); } catch (e) { base = {}; }
+  if (!base || typeof base !== "object" || Array.isArray(base)) base = {};
+  $("s-json").value = JSON.stringify(formProblem(base), null, 2);
+  $("s-form-note").textContent = "";
+  $("s-form").classList.remove("stale");
+  say("s-file-msg", "");  // (the problem is no longer the file's)
+  inputsChanged("solve");
+  inputsChanged("front");
+}
+
+// Another type chosen: its own parameters (its default design), the task and objective kept; the old type's
+// conditions, branches and name dropped.
+function typeChanged() {
+  const type = $("s-type").value;
+  synthesisForm(type);
+  let base = {};
+  try { base = JSON.parse($("s-json").value); } catch (e) { base = {}; }
+  for (const k of ["conditions", "name"]) delete base[k];
+  $("s-json").value = JSON.stringify(formProblem(base), null, 2);
+  problemToForm(JSON.parse($("s-json").value));
+  inputsChanged("solve");
+  inputsChanged("front");
+}
+
+// A problem file picked: its text read by the server (qropt's .json and .toml; a .py is refused, with why).
+async function loadProblemFile() {
+  const f = $("s-file").files[0];
+  if (!f) return;
+  say("s-file-msg", `reading ${f.name}...`);
+  try {
+    const text = await f.text();
+    $("s-file").value = "";  // the same file picked again loads again
+    const p = await call("POST", "/api/problem/read", { name: f.name, text });
+    problemSet(p);
+    say("s-file-msg", `loaded ${f.name}: the form and the JSON show it`);
+  } catch (e) {
+    say("s-file-msg", `${f.name} not loaded: ${e.message}`, true);
+  }
 }
 
 // The Synthesis page's inputs: the problem's JSON, flattened (targets.time_ratio = 1.5).
@@ -714,6 +1158,14 @@ function problemText() {
   try { return JSON.parse($("s-json").value); } catch (e) { throw new Error(`the problem is not JSON: ${e.message}`); }
 }
 
+// A criterion's value as shown: angles in degrees, the unit with the problem's length unit ("" if none).
+function criterionShown(criterion, units) {
+  const o = state.objectives[criterion];
+  if (!o) return { label: criterion, unit: "", value: (v) => v };
+  if (o.unit === "rad") return { label: o.label, unit: "deg", value: (v) => v / DEG };
+  return { label: o.label, unit: unitText(o.unit.replace(/length/g, units || state.units)), value: (v) => v };
+}
+
 async function runSolve() {
   $("s-solve").disabled = true;
   const asked = synthesisInputs();
@@ -726,6 +1178,7 @@ async function runSolve() {
     const h = document.createElement("p");
     h.innerHTML = `<span class="status-${r.status}"></span> <span></span>`;
     h.children[0].textContent = r.status;
+    h.children[0].title = HELP.status;
     h.children[1].textContent = r.message;
     div.appendChild(h);
     if (r.certificate) {
@@ -734,20 +1187,45 @@ async function runSolve() {
       c.id = "s-claim";
       div.appendChild(c);
     }
-    const type = problem.mechanism;
-    const free = Object.keys(problem.free || {});
+    const type = problem.mechanism, kinds = (state.types[type] || {}).kinds || {};
+    const free = Object.keys(problem.free || {}), length = (r.units && r.units.length) || problem.units || state.units;
     const opt = r.local_optima && r.local_optima.length ? r.local_optima : (r.params && Object.keys(r.params).length ? [r] : []);
-    table($("s-optima"), ["#", "status", ...free, "gamma_min [deg]", "objective"],
-      opt.map((o, i) => [i + 1, o.status, ...free.map((k) => fmt(o.params[k], 6)),
-        o.quantities && o.quantities.gamma_min !== undefined ? fmt(o.quantities.gamma_min / DEG, 5) : "-", fmt(o.objective, 6)]),
+    const criterion = objectiveOf(problem) || "", crit = criterionShown(criterion, length);
+    const objective = criterion && criterion !== "gamma_min";  // (gamma_min has its own column)
+    const head = ["#", "status", ...free.map((k) => (kinds[k] === "angle" ? `${k} [deg]` : `${k} [${length}]`)),
+      "gamma_min [deg]", ...(objective ? [`${crit.label}${crit.unit ? ` [${crit.unit}]` : ""}`] : [])];
+    table($("s-optima"), head,
+      opt.map((o, i) => [i + 1, o.status, ...free.map((k) => fmt(kinds[k] === "angle" ? o.params[k] / DEG : o.params[k], 6)),
+        o.quantities && o.quantities.gamma_min !== undefined ? fmt(o.quantities.gamma_min / DEG, 5) : "-",
+        ...(objective ? [o.objective === null || o.objective === undefined ? "-" : fmt(crit.value(o.objective), 6)] : [])]),
       (i) => openDesign(type, opt[i].params));
-    if (r.params && Object.keys(r.params).length) state.selected = { type, params: r.params };
+    $("s-optima").rows[0].cells[2 + free.length].title = HELP.gamma_min;
+    const solved = r.success && r.params && Object.keys(r.params).length;
+    state.selected = solved ? { type, params: r.params } : null;
+    await drawSolved(solved ? type : null, r.params);
     fresh("solve", asked);
   } catch (e) {
     $("s-progress").textContent = "";
     stale("solve", e.message);
   } finally {
     $("s-solve").disabled = false;
+  }
+}
+
+// The solved design drawn as the Mechanism page draws it (at theta2 = 0, its joints named); nothing without one.
+async function drawSolved(type, params) {
+  const svg = $("s-svg");
+  clear(svg);
+  svg.classList.toggle("none", !type);
+  state.solved = null;
+  if (!type) return;
+  try {
+    const a = await call("POST", "/api/analyze", { type, params, theta2: 0, omega2: 1, polygons: false });
+    state.solved = [a.drawing, `the solved design at theta2 = 0 deg: TR ${fmt(a.time_ratio, 5)}, `
+      + `stroke ${fmt(a.stroke, 5)} ${a.units}`];
+    drawMechanism(svg, state.solved[0], state.solved[0].shapes, state.solved[1]);
+  } catch (e) {
+    note(svg, `No picture: ${e.message}`);
   }
 }
 
@@ -758,10 +1236,25 @@ async function runFront() {
     const problem = problemText();
     const f = await runJob("pareto", { problem, objectives: ["max_gamma_min", "min_peak_accel"], n: 7 },
       $("s-progress"), $("s-cancel"));
-    const [a, b] = f.criteria;
-    scatter($("s-front-svg"), f.values.map((v) => [a === "gamma_min" ? v[0] / DEG : v[0], v[1]]),
-      a === "gamma_min" ? "gamma_min [deg]" : a, `${b} [${f.units}/s²]`,
-      (i) => openDesign(problem.mechanism, f.points[i].params));
+    $("s-front-svg").classList.remove("none");
+    const [ca, cb] = f.criteria.map((c) => criterionShown(c, f.units));
+    const xy = f.values.map((v) => [ca.value(v[0]), cb.value(v[1])]);
+    const xlabel = `${ca.label} [${ca.unit}]`, ylabel = `${cb.label} [${cb.unit}]`;
+    const spread = (k) => Math.max(...xy.map((p) => p[k])) - Math.min(...xy.map((p) => p[k]));
+    const one = xy.length > 0 && spread(0) <= 1e-9 * Math.abs(xy[0][0]) + 1e-12 && spread(1) <= 1e-9 * Math.abs(xy[0][1]) + 1e-12;
+    if (!xy.length || one) {
+      clear($("s-front-svg"));
+      const nfree = Object.keys(problem.free || {}).length, ntargets = Object.keys(problem.targets || {}).length;
+      const why = !xy.length ? "The front has no point: no design meets the task."
+        : `The front is one design (${xlabel} ${fmt(xy[0][0], 5)}, ${ylabel} ${fmt(xy[0][1], 5)}): with ${nfree} free `
+          + `parameter${nfree === 1 ? "" : "s"} and ${ntargets} target${ntargets === 1 ? "" : "s"}, meeting the targets leaves no `
+          + "freedom to trade one criterion against the other. Free another parameter (tick its box) for a front.";
+      $("s-front-note").textContent = why;
+      $("s-front-svg").classList.add("none");
+    } else {
+      $("s-front-note").textContent = `The front of ${xy.length} designs: a point opens its design on the Mechanism page.`;
+      scatter($("s-front-svg"), xy, xlabel, ylabel, (i) => openDesign(problem.mechanism, f.points[i].params));
+    }
     fresh("front", asked);
   } catch (e) {
     $("s-progress").textContent = "";
@@ -785,7 +1278,10 @@ function download(name, data, mime) {
   setTimeout(() => { URL.revokeObjectURL(a.href); a.remove(); }, 1000);
 }
 function exportBar(div) {
-  const page = div.dataset.from;
+  const page = div.dataset.from, msg = document.createElement("span");
+  msg.id = `export-${page}-msg`;
+  msg.className = "msg";
+  msg.setAttribute("role", "status");
   for (const fmt2 of ["dxf", "svg", "json", "report"]) {
     const b = document.createElement("button");
     b.type = "button";
@@ -793,24 +1289,30 @@ function exportBar(div) {
     b.id = `export-${page}-${fmt2}`;
     b.addEventListener("click", async () => {
       const d = current(page);
-      if (!d) { say("no design on this page yet"); return; }
+      if (!d) { say(msg.id, "no design on this page yet: run it first", true); return; }
+      if (page === "mechanism" && state.results.mechanism.stale) {
+        say(msg.id, "no export: the inputs give no design that turns (the reason is above the numbers)", true);
+        return;
+      }
+      const name = `${d.type.replace(/[^\w.-]+/g, "_")}.${fmt2 === "report" ? "html" : fmt2}`;
       try {
         const theta2 = Number($("m-theta").value) * DEG;
         if (fmt2 === "report") {
-          say("writing the report...");
+          say(msg.id, "the report is being written...");
           const r = await runJob("report", { ...d, theta2, omega2: Number($("m-omega").value) });
-          download(`${d.type}.html`, r.html, "text/html");
-          say("");
+          download(name, r.html, "text/html");
         } else {
           const r = await fetch(`/api/export/${fmt2}`, { method: "POST", headers: { "Content-Type": "application/json" },
             body: JSON.stringify({ ...d, theta2 }) });
           if (!r.ok) throw new Error((await r.json()).error);
-          download(`${d.type}.${fmt2}`, await r.blob(), r.headers.get("Content-Type"));
+          download(name, await r.blob(), r.headers.get("Content-Type"));
         }
-      } catch (e) { say(e.message); }
+        say(msg.id, `downloaded ${name} (${d.type}${page === "mechanism" ? "" : ", the page's design"})`);
+      } catch (e) { say(msg.id, `no ${fmt2 === "report" ? "report" : fmt2.toUpperCase()}: ${e.message}`, true); }
     });
     div.appendChild(b);
   }
+  div.appendChild(msg);
 }
 
 async function start() {
@@ -820,7 +1322,8 @@ async function start() {
   const [info, options] = await Promise.all([call("GET", "/api/types"), call("GET", "/api/design/options")]);
   for (const o of options.objectives) state.objectives[o.criterion] = o;
   objectiveOptions($("d-objective"), options.objectives);
-  objectiveOptions($("s-objective"), options.objectives.filter((o) => !o.dynamic));  // the form has no masses
+  $("s-objective").add(new Option("none — any design meeting the task", ""));
+  objectiveOptions($("s-objective"), options.objectives.filter((o) => !o.dynamic));  // (a file's dynamic one is added)
   designTypes(options.types);
   $("d-budget").max = options.time_limit;
   $("d-objective").addEventListener("change", designObjectiveChanged);
@@ -828,8 +1331,8 @@ async function start() {
   resultGroup("mechanism", { panels: ["m-numbers", "m-svg", "m-plot", "m-vpoly", "m-apoly", "m-torque", "m-forces"],
     inputs: mechanismInputs, note: "m-error", live: true });
   resultGroup("design", { panels: ["d-table", "d-pictures"], inputs: designInputs, watch: ["design-form"] });
-  resultGroup("solve", { panels: ["s-result", "s-optima"], inputs: synthesisInputs, watch: ["s-json"] });
-  resultGroup("front", { panels: ["s-front-svg"], inputs: synthesisInputs, watch: ["s-json"] });
+  resultGroup("solve", { panels: ["s-result", "s-svg", "s-optima"], inputs: synthesisInputs, watch: ["s-json"] });
+  resultGroup("front", { panels: ["s-front-note", "s-front-svg"], inputs: synthesisInputs, watch: ["s-json"] });
   for (const t of info) {
     state.types[t.type] = t;
     $("m-type").add(new Option(`${t.class} (${t.type})`, t.type));
@@ -841,27 +1344,37 @@ async function start() {
   for (const id of ["m-omega", "m-dyn", "m-density", "m-ram", "m-force", "m-gravity"]) $(id).addEventListener("change", analyze);
   $("m-play").addEventListener("click", play);
   $("design-form").addEventListener("submit", runDesign);
-  $("s-type").addEventListener("change", () => synthesisForm($("s-type").value));
-  const problemSet = (text) => { $("s-json").value = text; inputsChanged("solve"); inputsChanged("front"); };
-  $("s-to-json").addEventListener("click", () => problemSet(JSON.stringify(formProblem(), null, 2)));
+  $("s-type").addEventListener("change", typeChanged);
+  for (const ev of ["input", "change"]) {
+    $("s-form").addEventListener(ev, (e) => { if (e.target.id !== "s-type") formChanged(); });
+  }
+  $("s-json").addEventListener("input", () => {
+    say("s-file-msg", "");  // (the problem is no longer the file's)
+    let p;
+    try { p = JSON.parse($("s-json").value); } catch (e) {
+      $("s-form-note").textContent = `The form is not in step: the JSON does not read (${e.message}).`;
+      $("s-form").classList.add("stale");
+      return;
+    }
+    problemToForm(p);
+  });
   $("s-solve").addEventListener("click", runSolve);
   $("s-front").addEventListener("click", runFront);
-  $("s-file").addEventListener("change", async () => {
-    const f = $("s-file").files[0];
-    if (f) problemSet(await f.text());
-  });
+  $("s-file").addEventListener("change", loadProblemFile);
   document.querySelectorAll(".export").forEach(exportBar);
   const first = info.find((t) => t.type === "drag-link-slider") || info[0];
-  $("s-type").value = first.type;
-  synthesisForm(first.type);
   const files = await call("GET", "/api/problems");
-  $("s-json").value = JSON.stringify(files.length ? files[0].problem : {
+  problemSet(files.length ? files[0].problem : {
     mechanism: "drag-link-slider", fixed: { r1: 0.1, r2: 0.225, r4: 0.275, r6: 0.3 },
     free: { r3: [0.05, 1.0], r5: [0.01, 0.5] }, targets: { time_ratio: 1.5, stroke: 0.3 },
-    conditions: { grashof: "drag-link" }, objective: "max_gamma_min" }, null, 2);
+    conditions: { grashof: "drag-link" }, objective: "max_gamma_min" });
   const open = files.length ? state.types[files[0].problem.mechanism] : null;
-  showParams((open || first).type, (open || first).params);
+  if (!applyURL()) {
+    state.restoring = true;
+    showParams((open || first).type, (open || first).params);
+  }
+  window.addEventListener("popstate", () => { route(); applyURL(); });
   document.body.dataset.ready = "1";
 }
 
-start().catch((e) => say(e.message));
+start().catch((e) => { $("status").textContent = `the app could not start: ${e.message}`; });
