@@ -167,3 +167,37 @@ def _serves(shell: str, cwd) -> None:
         p.send_signal(signal.SIGINT)  # Ctrl-C
         code = p.wait(timeout=30)
     assert code == 0
+
+
+SHOWN = re.compile(r"<!-- the (output|value) of (.+?) -->\n(?:```text\n(.*?)```|((?:\|[^\n]*\n)+))", re.S)
+
+
+def shown_outputs() -> list[tuple]:
+    """(page, 'output' or 'value', the command or Python expression, the text shown) for every block a page marks
+    with ``<!-- the output of COMMAND -->`` (a ``qropt`` command's printout, in a text block) or ``<!-- the value of
+    EXPRESSION -->`` (a Python expression's string, e.g. a Markdown table)."""
+    return [
+        (page.name, kind, what.strip(), block or table)
+        for page in PAGES
+        for kind, what, block, table in SHOWN.findall(page.read_text())
+    ]
+
+
+def test_the_pages_mark_their_shown_outputs():
+    assert {page for page, *_ in shown_outputs()} >= {"README.md", "studies.md"}
+
+
+@pytest.mark.parametrize("page, kind, what, text", shown_outputs(), ids=lambda v: str(v)[:40])
+def test_a_shown_output_is_current(page, kind, what, text, workdir):
+    if kind == "output":
+        exe = shutil.which("qropt")
+        r = subprocess.run(
+            what.replace("qropt ", f"{shlex.quote(exe)} ", 1), shell=True, cwd=workdir, capture_output=True, text=True
+        )
+        assert r.returncode == 0, r.stderr[-2000:]
+        got = r.stdout
+    else:
+        import qropt
+
+        got = str(eval(what, {"qropt": qropt}))
+    assert got.strip() == text.strip(), f"{page}: the shown {kind} of {what} is stale:\n{got}"
