@@ -391,17 +391,13 @@ def test_the_round_trip():
 
 
 def test_what_cannot_take_them_says_so():
-    """The compiled kernel and the dynamics figure raise, naming the load."""
+    """The compiled kernel raises, naming the load."""
     m = qropt.Whitworth(r1=0.2, r2=0.5, r5=0.5, r6=1.0)
     from qropt.dynamics import compiled
     from qropt.dynamics.inverse import system_of
-    from qropt.io import plots
 
     with pytest.raises(UnsupportedLoad, match="compiled.*gravity"):
         compiled.parts(m, system_of(m, Masses(density=1.0)), np.array([0.1]), 1.0, 0.0, (1.0, -9.81), 1.0)
-
-    with pytest.raises(UnsupportedLoad, match="figure.*gravity"):
-        plots.dynamics_figure(m, 2.0, Masses(density=1.0), Loads(gravity=(1.0, -9.81)))
 
 
 def test_the_servos_profile_takes_them():

@@ -352,28 +352,92 @@ def polygons(args, m) -> int:
     return 0
 
 
-def _loads_of(args):
-    """The loads of ``analyze --dynamics``: a loads file (--loads), or --force, --friction and --gravity."""
+LOADS_FILE_HELP = (
+    "a JSON or TOML file of the loads (qropt.Loads.to_dict: cutting_force, friction, forces, torques with their "
+    "windows, gravity, working, pin_friction)"
+)
+
+
+def loads_arguments(parser, flags: bool = True, instead: str = "") -> None:
+    """The loads' options, one set for every command that computes or draws dynamics: with ``flags``, --force,
+    --friction and --gravity G [GY] (``loads_of`` builds the loads from them); always --point-mass JOINT KG
+    (repeatable; ``point_masses``) and --loads FILE (``read_loads``), ``instead`` saying what the file replaces."""
+    if flags:
+        parser.add_argument("--force", type=real, help="cutting force on the working stroke, N (default 0)")
+        parser.add_argument("--friction", type=real, help="the slide's friction coefficient (default 0)")
+        parser.add_argument(
+            "--gravity",
+            type=real,
+            nargs="+",
+            metavar="G",
+            help="gravity, m/s^2: one number g along -y (e.g. 9.81), or GX GY in the frame (0 -9.81; a vertical "
+            "slotter: -9.81 0); default none",
+        )
+    parser.add_argument(
+        "--point-mass",
+        dest="points",
+        nargs=2,
+        action="append",
+        metavar=("JOINT", "KG"),
+        help="a point mass at a joint (repeatable), added to the body that carries it",
+    )
+    parser.add_argument(
+        "--loads",
+        dest="loads_file",
+        metavar="FILE",
+        help=LOADS_FILE_HELP + (" instead of --force, --friction and --gravity" if flags else "") + instead,
+    )
+
+
+def read_loads(path: str):
+    """The ``qropt.Loads`` of a JSON or TOML file (``Loads.to_dict``); a one-line error naming the file where it
+    does not read, does not parse or is not loads."""
     from qropt.dynamics.model import Loads
 
-    if args.loads_file is None:
-        if len(args.gravity) > 2:
-            raise CliError(f"--gravity takes one number (along -y) or two (gx gy), got {len(args.gravity)}")
-        gravity = args.gravity[0] if len(args.gravity) == 1 else tuple(args.gravity)
-        return Loads(args.force, friction=args.friction, gravity=gravity)
-    if args.force or args.friction or args.gravity != [0.0]:
-        raise CliError("give the loads in the --loads file or by --force, --friction and --gravity, not both")
-    text = validate.read_text(args.loads_file, "loads file")
-    if str(args.loads_file).lower().endswith(".toml"):
+    text = validate.read_text(path, "loads file")
+    if str(path).lower().endswith(".toml"):
         import tomllib
 
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as e:
-            raise CliError(f"the loads file {args.loads_file} is not TOML: {e}") from None
+            raise CliError(f"the loads file {path} is not TOML: {e}") from None
     else:
-        data = validate.json_document(text, f"the loads file {args.loads_file}")
-    return Loads.from_dict(data)
+        data = validate.json_document(text, f"the loads file {path}")
+    try:
+        return Loads.from_dict(data)
+    except QroptError as e:
+        raise type(e)(f"the loads file {path}: {e}") from None
+
+
+def loads_of(args):
+    """The loads the options state (``loads_arguments``): the --loads file, or --force, --friction and --gravity;
+    None where none of them is given."""
+    from qropt.dynamics.model import Loads
+
+    force, friction, gravity = (getattr(args, k, None) for k in ("force", "friction", "gravity"))
+    flagged = force is not None or friction is not None or gravity is not None
+    if args.loads_file is not None:
+        if flagged:
+            raise CliError("give the loads in the --loads file or by --force, --friction and --gravity, not both")
+        return read_loads(args.loads_file)
+    if not flagged:
+        return None
+    if gravity is not None and len(gravity) > 2:
+        raise CliError(f"--gravity takes one number (along -y) or two (gx gy), got {len(gravity)}")
+    g = 0.0 if gravity is None else gravity[0] if len(gravity) == 1 else tuple(gravity)
+    return Loads(force or 0.0, friction=friction or 0.0, gravity=g)
+
+
+def point_masses(args) -> dict:
+    """--point-mass JOINT KG, as joint -> kg (the last one given for a joint)."""
+    out = {}
+    for joint, kg in getattr(args, "points", None) or []:
+        try:
+            out[joint] = real(kg)
+        except argparse.ArgumentTypeError as e:
+            raise CliError(f"--point-mass {joint} {kg}: {e}") from None
+    return out
 
 
 def _loads_words(loads) -> str:
@@ -392,16 +456,16 @@ def dynamics(args, m) -> int:
     force and moment and the flywheel for --cs, at --omega2 (SI); --plot, --csv (the turn degree by degree) and
     --json as for the kinematics."""
     from qropt.dynamics.cycle import CycleDynamics
-    from qropt.dynamics.model import Counterweight, Masses
+    from qropt.dynamics.model import Counterweight, Loads, Masses
 
     try:
         cw = None
         if args.counterweight is not None:
             mass, radius, at = args.counterweight
             cw = Counterweight(real(mass), real(radius), angle(at))
-        points = {joint: real(kg) for joint, kg in args.points or []}
+        points = point_masses(args)
         masses = Masses.bars(args.density, args.ram_mass, block=args.block_mass, counterweight=cw, points=points)
-        loads = _loads_of(args)
+        loads = loads_of(args) or Loads()
     except (QroptError, argparse.ArgumentTypeError) as e:
         raise CliError(str(e)) from None
     cd = CycleDynamics(m, args.omega2, args.alpha2, masses, loads)
@@ -514,7 +578,11 @@ def parser() -> argparse.ArgumentParser:
     a.add_argument("--json", action="store_true", help="print JSON instead of text")
     a.add_argument("--table", type=angle, help="full-cycle table step (deg, or rad with suffix)")
     a.add_argument("--csv", help="file for the full-cycle table ('-' for standard output)")
-    a.add_argument("--plot", help="PNG file: mechanism at theta2 beside x, v, a over the cycle")
+    a.add_argument(
+        "--plot",
+        help="PNG file: mechanism at theta2 beside x, v, a over the cycle (with --dynamics: its joint forces and "
+        "applied loads as arrows beside the torque and the joint forces over the turn)",
+    )
     a.add_argument("--from", dest="design", help="a design file (qropt synth --save, or --json output) to analyse")
     a.add_argument("--polygons", action="store_true", help="the equations term by term; with --plot, the polygons")
     a.add_argument("--dynamics", action="store_true", help="crank torque, joint forces, shaking and flywheel (SI)")
@@ -527,32 +595,7 @@ def parser() -> argparse.ArgumentParser:
         metavar=("MASS", "RADIUS", "ANGLE"),
         help="a crank counterweight: MASS kg at RADIUS m, ANGLE from the crank pin (e.g. 180deg)",
     )
-    a.add_argument("--force", type=real, default=0.0, help="cutting force on the working stroke, N")
-    a.add_argument("--friction", type=real, default=0.0, help="the slide's friction coefficient")
-    a.add_argument(
-        "--gravity",
-        type=real,
-        nargs="+",
-        metavar="G",
-        default=[0.0],
-        help="gravity, m/s^2: one number g along -y (e.g. 9.81), or GX GY in the frame (0 -9.81; a vertical "
-        "slotter: -9.81 0)",
-    )
-    a.add_argument(
-        "--point-mass",
-        dest="points",
-        nargs=2,
-        action="append",
-        metavar=("JOINT", "KG"),
-        help="a point mass at a joint (repeatable), added to the body that carries it",
-    )
-    a.add_argument(
-        "--loads",
-        dest="loads_file",
-        metavar="FILE",
-        help="a JSON or TOML file of the loads (qropt.Loads.to_dict: forces, torques, windows, gravity, working) "
-        "instead of --force, --friction and --gravity",
-    )
+    loads_arguments(a)
     a.add_argument("--cs", type=real, default=0.05, help="coefficient of speed fluctuation for the flywheel")
     units_argument(a, "the length unit of the parameters (a design file states its own; --units may repeat it)")
     _export_arguments(a, "at --theta2")
@@ -573,6 +616,7 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--time-limit", dest="time_limit", type=real, help=TIME_LIMIT_HELP)
     s.add_argument("--json", action="store_true", help="print the Result as JSON")
     s.add_argument("--plot", help="PNG file: the best design over its cycle")
+    loads_arguments(s, flags=False, instead=" instead of the problem file's (its dynamic objectives and bounds)")
     _export_arguments(s, "at theta2 = 0 (the crank along +x)")
     s.set_defaults(run=cmd_synth)
     f = sub.add_parser(
@@ -844,6 +888,23 @@ def _importable(file) -> None:
             sys.path.insert(0, str(d))
 
 
+def stated_dynamics(problem, args) -> dict:
+    """The changes --loads FILE and --point-mass make to a problem: its loads replaced, point masses added to its
+    masses (``Problem.replace`` keywords)."""
+    from qropt.dynamics.model import Masses
+
+    changes = {}
+    loads = loads_of(args)
+    if loads is not None:
+        changes["loads"] = loads
+    points = point_masses(args)
+    if points:
+        masses = problem.masses if problem.masses is not None else Masses()
+        masses = masses if isinstance(masses, Masses) else Masses.from_dict(masses)
+        changes["masses"] = masses.replace(points={**masses.points, **points})
+    return changes
+
+
 def cmd_synth(args):
     from qropt.synthesis.solver import solve
 
@@ -860,6 +921,7 @@ def cmd_synth(args):
         if (changes.get("objective", problem.objective)) != "min_size":
             raise CliError("--size applies to the min_size objective only (give --objective min_size)")
         changes["size"] = args.size
+    changes.update(stated_dynamics(problem, args))
     if changes:
         problem = problem.replace(**changes)
     if args.starts is not None and args.starts < 0:

@@ -14,7 +14,7 @@ EXAMPLES = (
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from qropt.cli import TIME_LIMIT_HELP, objective_help, real, units_argument
+    from qropt.cli import TIME_LIMIT_HELP, loads_arguments, objective_help, real, units_argument
     from qropt.studies._design import TYPES
     from qropt.synthesis import criteria
     from qropt.units import DEFAULT
@@ -44,9 +44,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--omega2", type=real, default=1.0, help="crank speed [rad/s] (default 1)")
     parser.add_argument("--density", type=real, help="links as uniform bars of this many kg per metre (dynamics)")
     parser.add_argument("--ram-mass", dest="ram_mass", type=real, help="the ram's mass, kg (dynamics)")
-    parser.add_argument("--force", type=real, help="cutting force on the working stroke, N (dynamics)")
-    parser.add_argument("--friction", type=real, help="the slide's friction coefficient (dynamics)")
-    parser.add_argument("--gravity", type=real, help="gravity along -y, m/s^2 (dynamics)")
+    loads_arguments(parser, instead=" (dynamics: every type's solve)")
     parser.add_argument(
         "--balance",
         nargs=2,
@@ -84,17 +82,18 @@ def conditions_of(args) -> dict:
 
 
 def dynamics_of(args) -> tuple:
-    """(masses, loads) from the dynamics flags, each None where none of its flags is given."""
-    from qropt.dynamics.model import Counterweight, Loads, Masses
+    """(masses, loads) from the dynamics flags (the loads as ``qropt.cli.loads_of`` reads them), each None where
+    none of its flags is given."""
+    from qropt.cli import loads_of, point_masses
+    from qropt.dynamics.model import Counterweight, Masses
 
-    masses = loads = None
+    masses = None
     balance = getattr(args, "balance", None)
-    if args.density is not None or args.ram_mass is not None or balance:
+    points = point_masses(args)
+    if args.density is not None or args.ram_mass is not None or balance or points:
         cw = Counterweight.balancing(*balance) if balance else None
-        masses = Masses.bars(args.density or 0.0, args.ram_mass or 0.0, counterweight=cw)
-    if args.force is not None or args.gravity is not None or args.friction is not None:
-        loads = Loads(args.force or 0.0, friction=args.friction or 0.0, gravity=args.gravity or 0.0)
-    return masses, loads
+        masses = Masses.bars(args.density or 0.0, args.ram_mass or 0.0, counterweight=cw, points=points)
+    return masses, loads_of(args)
 
 
 def run(args) -> int:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import matplotlib
 
@@ -12,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.colors import to_rgba  # noqa: E402
 from matplotlib.patches import Polygon  # noqa: E402
+from matplotlib.transforms import offset_copy  # noqa: E402
 
 from qropt.errors import InvalidParameter  # noqa: E402
 from qropt.io import drawing  # noqa: E402
@@ -200,26 +202,217 @@ def cycle_figure(m: Mechanism, theta2: float = math.radians(60), omega2: float =
     return fig
 
 
+LOAD_COLOUR = "darkred"  # the applied loads' arrows and names; the joint forces take tab10's colours
+SPOTS = (0.25, 0.5, 0.75)  # where a torque may be drawn between two joints of its body, from one to the other
+
+
+class Drawn(NamedTuple):
+    """One applied load at the figure's crank angle: its short name ("F1", "T1"), the load, the body it acts on,
+    its point (the mechanism's unit; a torque's: on its body between two of its joints, clear of them and of the
+    forces), the force (fx, fy) (N) or torque (N m) acting there, and whether its window is open (where it is
+    shut, ``value`` is what it would be open)."""
+
+    name: str
+    load: object
+    body: str
+    point: tuple
+    value: object
+    on: bool
+
+
+def applied_loads(m: Mechanism, theta2: float, omega2: float, masses=None, loads=None) -> list[Drawn]:
+    """Every ``Force`` and ``Torque`` of ``loads`` at crank angle theta2 (rad) and omega2 (rad/s), as the exact
+    dynamics apply them (``qropt.dynamics.applied.resolve`` and ``evaluate``): forces F1, F2, ... and torques T1,
+    T2, ... in the loads' order. A load whose window is shut there carries the value it would have open."""
+    import dataclasses
+
+    from qropt import units as units_
+    from qropt.dynamics import applied
+    from qropt.dynamics.inverse import _triples, _working, linkage_of, system_of, working_way
+    from qropt.dynamics.model import Force, Masses, Window
+    from qropt.kinematics.ops import JET, Jet
+
+    if loads is None or not (loads.forces or loads.torques):
+        return []
+    t = np.array([float(theta2)])
+    s = system_of(m, Masses() if masses is None else masses)
+    link = linkage_of(m)
+    k = units_.to_metres(m.units)
+    pts = _triples(m.evaluate(JET, Jet.seed(t, omega2, 0.0)), k)
+    working = _working(m, t, omega2, working_way(m, loads, omega2))
+    joint = m.output_joint()
+    x = pts[joint][0][0] / k if joint is not None else None
+    resolved = applied.resolve(m, s, link, loads)
+
+    def at(pairs):
+        return applied.evaluate(m, s, pairs, pts, t, working, x, 1.0, abs(omega2))
+
+    always = Window()
+    opened = [(dataclasses.replace(ld, window=always), body) for ld, body in resolved]
+    joints = {b.name: b.joints for b in link.bodies()}
+    out, counts = [], {"F": 0, "T": 0}
+    for (load, body), ap, open_ap in zip(resolved, at(resolved), at(opened), strict=True):
+        kind = "F" if isinstance(load, Force) else "T"
+        counts[kind] += 1
+        on = bool(load.window.active(t, working, x)[0])
+        use = ap if on else open_ap
+        if kind == "F":
+            point = (float(use.point[0][0]) / k, float(use.point[1][0]) / k)
+            value = np.array([float(np.ravel(use.force[0])[0]), float(np.ravel(use.force[1])[0])])
+        else:
+            xy = np.array([(np.ravel(pts[j][0][0])[0], np.ravel(pts[j][1][0])[0]) for j in joints[body]]) / k
+            # on the body between two of its joints, clear of its joints and of the forces' points
+            spots = [xy[i] + f * (xy[j] - xy[i]) for i in range(len(xy)) for j in range(i, len(xy)) for f in SPOTS]
+            busy = np.vstack([xy, *(np.array([o.point]) for o in out)])
+            best = max(spots, key=lambda p: float(np.min(np.hypot(*(busy - p).T))))
+            point = (float(best[0]), float(best[1]))
+            value = float(np.ravel(use.torque)[0])
+        out.append(Drawn(f"{kind}{counts[kind]}", load, body, point, value, on))
+    return out
+
+
+def _load_words(d: Drawn) -> str:
+    """A drawn load for the legend: where, how and how much."""
+    if isinstance(d.value, float):
+        return f"{d.name} on the {d.body}: {d.value:.4g} N m" + ("" if d.on else " (off here)")
+    how = d.load.direction if isinstance(d.load.direction, str) else "fixed direction"
+    return f"{d.name} at {d.load.where}, {how}: {np.hypot(*d.value):.4g} N" + ("" if d.on else " (off here)")
+
+
+def _load_label(ax, text: str, at, alpha: float):
+    """A load's name beside the point ``at`` (data), where ``LoadLabels`` finds room when the figure is drawn."""
+    return ax.annotate(
+        text,
+        at,
+        textcoords="offset points",
+        xytext=(4, 4),
+        fontsize=8,
+        color=LOAD_COLOUR,
+        alpha=alpha,
+        zorder=7,
+        bbox={"fc": "white", "ec": "none", "pad": 0.5, "alpha": 0.8},
+    )
+
+
+def _draw_force(ax, d: Drawn, scale: float) -> tuple:
+    """A force as an arrow from its point, to the joint forces' scale, named by its size beside its head; faded
+    where its window is shut. (head (data), the name)."""
+    at = np.asarray(d.point, float)
+    head = at + scale * d.value
+    alpha = 1.0 if d.on else 0.35
+    ax.annotate(
+        "",
+        xy=head,
+        xytext=at,
+        arrowprops={"arrowstyle": "-|>", "color": LOAD_COLOUR, "lw": 2.4, "alpha": alpha, "shrinkA": 0, "shrinkB": 0},
+        zorder=6,
+    )
+    text = f"{d.name} {float(np.hypot(*d.value)):.4g} N" + ("" if d.on else " (off)")
+    return head, _load_label(ax, text, head, alpha)
+
+
+def _draw_torque(ax, d: Drawn, radius: float) -> tuple:
+    """A torque as a curved arrow (counter-clockwise for a positive one) around its point on its body, named by
+    its size beside the arc's opening; faded where its window is shut. (the opening (data), the name)."""
+    c = np.asarray(d.point, float)
+    alpha = 1.0 if d.on else 0.35
+    a = np.radians(np.linspace(40.0, 320.0, 60))
+    arc = c + radius * np.column_stack([np.cos(a), np.sin(a)])
+    ax.plot(arc[:, 0], arc[:, 1], color=LOAD_COLOUR, lw=2.0, alpha=alpha, zorder=6)
+    head, before = (arc[-1], arc[-4]) if d.value >= 0 else (arc[0], arc[3])
+    ax.annotate(
+        "",
+        xy=head,
+        xytext=before,
+        arrowprops={"arrowstyle": "-|>", "color": LOAD_COLOUR, "lw": 2.0, "alpha": alpha, "shrinkA": 0, "shrinkB": 0},
+        zorder=6,
+    )
+    opening = c + (radius, 0.0)
+    return opening, _load_label(ax, f"{d.name} {d.value:.4g} N m" + ("" if d.on else " (off)"), opening, alpha)
+
+
+def _quiet_corner(ax, lines) -> tuple:
+    """The corner of the axis (0 or 1 across, 0 or 1 up) whose box (a third across, a sixth up) the fewest points
+    along ``lines`` (polylines, data) fall in; the upper left where they tie."""
+    (xa, xb), (ya, yb) = ax.get_xlim(), ax.get_ylim()
+    pts = [np.asarray(p, float).reshape(-1, 2) for p in lines]
+    pts += [np.linspace(p[k], p[k + 1], 25) for p in pts for k in range(len(p) - 1)]
+    xy = np.vstack(pts) if pts else np.zeros((0, 2))
+    fx, fy = (xy[:, 0] - xa) / (xb - xa), (xy[:, 1] - ya) / (yb - ya)
+
+    def crowd(c):
+        across = fx <= 1 / 3 if c[0] == 0 else fx >= 2 / 3
+        up = fy >= 5 / 6 if c[1] == 1 else fy <= 1 / 6
+        return int(np.count_nonzero(across & up))
+
+    return min([(0, 1), (1, 1), (0, 0), (1, 0)], key=crowd)
+
+
+def _draw_gravity(ax, g: tuple, corner: tuple) -> None:
+    """Gravity's direction as a small arrow "g" with its size in a corner of the drawing (``_quiet_corner``)."""
+    from matplotlib.text import OffsetFrom
+
+    size = math.hypot(*g)
+    u = np.array(g) / size
+    at = (0.06 if corner[0] == 0 else 0.94, 0.9 if corner[1] == 1 else 0.1)
+    anchor = OffsetFrom(ax, at)
+    ax.annotate(
+        "",
+        xy=tuple(14 * u),
+        xycoords=anchor,
+        xytext=tuple(-14 * u),
+        textcoords=anchor,
+        arrowprops={"arrowstyle": "-|>", "color": LOAD_COLOUR, "lw": 1.8},
+        zorder=7,
+    )
+    ax.annotate(
+        f"g {size:.3g} m/s^2",
+        at,
+        xycoords="axes fraction",
+        textcoords="offset points",
+        xytext=(20 if corner[0] == 0 else -20, 0),
+        ha="left" if corner[0] == 0 else "right",
+        va="center",
+        fontsize=8,
+        color=LOAD_COLOUR,
+        zorder=7,
+        bbox={"fc": "white", "ec": "none", "pad": 0.5, "alpha": 0.8},
+    )
+
+
+def _pin_friction_words(pf) -> str:
+    r = f", pins r {pf.radius:g} m" if pf.radius is not None else ""
+    at = f", at {', '.join(pf.joints)}" if pf.joints else ""
+    return f"pin friction mu {pf.mu:g}{r}{at} (in the joint forces)"
+
+
 def dynamics_figure(m: Mechanism, omega2: float, masses=None, loads=None, theta2: float = math.radians(60), n=721):
-    """Figure: the mechanism at theta2 with the force each joint passes on (arrows to one scale, newtons) (left);
-    the crank torque and every joint force's magnitude over a turn (right), strokes shaded."""
-    if loads is not None:
-        loads.require_plain("the dynamics figure")
+    """Figure: the mechanism at theta2 with the force each joint passes on (arrows to one scale, newtons), the
+    applied forces (arrows to the same scale from their points, named F1, F2, ... with their size), the torques
+    (curved arrows, T1, ...), gravity's direction ("g", in the emptiest corner) and, in the legend, what each load
+    is (a load whose window is shut at theta2 faded, "off") (left); the crank torque and every joint force's
+    magnitude over a turn (right), strokes shaded."""
     _mechanism(m)
     drawing.check(m)
+    d = m.dynamics(np.array([theta2]), omega2, masses=masses, loads=loads)
+    drawn = applied_loads(m, theta2, omega2, masses, loads)
     fig = plt.figure(figsize=(12, 6))
     ax0 = fig.add_subplot(1, 2, 1)
     x0, x1, y0, y1 = draw_mechanism(ax0, m, theta2, color="0.35")
-    d = m.dynamics(np.array([theta2]), omega2, masses=masses, loads=loads)
+    span = max(x1 - x0, y1 - y0)
     pos = m.positions(np.array([theta2])).points
     forces = {k: v[0] for k, v in d.joint_forces.items() if k in pos or k == "slide"}
-    biggest = max([float(np.hypot(*f)) for f in forces.values()] + [1e-300])
-    scale = 0.25 * max(x1 - x0, y1 - y0) / biggest  # the largest force drawn a quarter of the drawing
+    pushes = [dl for dl in drawn if not isinstance(dl.value, float)]
+    biggest = max([float(np.hypot(*f)) for f in forces.values()] + [float(np.hypot(*p.value)) for p in pushes] + [0.0])
+    scale = 0.25 * span / max(biggest, 1e-300)  # the largest force drawn a quarter of the drawing
     colours = plt.get_cmap("tab10")
-    tips = []
+    tips, names, anchors = [], [], []
+    shapes = drawing.at(drawing.scene(m), theta2)
+    lines = [s.points for s in shapes]  # what the drawing holds, for gravity's corner
     for i, (k, f) in enumerate(sorted(forces.items())):
         at = pos[m.output_joint()][0] if k == "slide" else pos[k][0]
         tips.append(at + scale * f)
+        lines.append([at, at + scale * f])
         ax0.annotate(
             "",
             xy=at + scale * f,
@@ -228,14 +421,38 @@ def dynamics_figure(m: Mechanism, omega2: float, masses=None, loads=None, theta2
             zorder=6,
         )
         ax0.plot([], [], color=colours(i % 10), label=f"{k}: {np.hypot(*f):.4g} N")
-    tips = np.array(tips)
-    pad = 0.05 * max(x1 - x0, y1 - y0)
-    ax0.set_xlim(min(x0, tips[:, 0].min()) - pad, max(x1, tips[:, 0].max()) + pad)
-    ax0.set_ylim(min(y0, tips[:, 1].min()) - pad, max(y1, tips[:, 1].max()) + pad)
-    ax0.legend(fontsize=7, loc="best", ncol=2, framealpha=0.9)
+    for dl in drawn:
+        if isinstance(dl.value, float):
+            r = 0.06 * span
+            at, name = _draw_torque(ax0, dl, r)
+            tips += [np.array(dl.point) + (-r, -r), np.array(dl.point) + (r, r)]
+            lines.append([tips[-2], tips[-1]])
+        else:
+            at, name = _draw_force(ax0, dl, scale)
+            tips.append(at)
+            lines.append([dl.point, at])
+        names.append(name)
+        anchors.append(at)
+        ax0.plot([], [], color=LOAD_COLOUR, lw=2.4, alpha=1.0 if dl.on else 0.35, label=_load_words(dl))
+    if loads is not None and loads.pin_friction is not None and loads.pin_friction.active:
+        ax0.plot([], [], color="none", label=_pin_friction_words(loads.pin_friction))
+    tips = np.array(tips).reshape(-1, 2)
+    pad = 0.05 * span
+    ax0.set_xlim(min(x0, tips[:, 0].min(initial=x0)) - pad, max(x1, tips[:, 0].max(initial=x1)) + pad)
+    ax0.set_ylim(min(y0, tips[:, 1].min(initial=y0)) - pad, max(y1, tips[:, 1].max(initial=y1)) + pad)
+    g = (0.0, 0.0) if loads is None else loads.gravity_vector
+    if g[0] or g[1]:
+        _draw_gravity(ax0, g, _quiet_corner(ax0, lines))
+    if names:  # the loads' names placed after the joints' (which keep clear of them as drawn first), clear of both
+        placer = JointLabels(names, anchors, [0.0] * len(names), shapes)
+        placer.set_zorder(5.95)
+        ax0.add_artist(placer)
+    below = offset_copy(ax0.transAxes, fig=fig, y=-36, units="points")  # under the tick labels and the x label
+    ax0.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=below, ncol=2, framealpha=0.9)
+    what = "joint forces on the driven body" + (" and the applied loads (dark red)" if drawn else "")
     ax0.set_title(
         f"{type(m).__name__} at theta2 = {math.degrees(theta2):.1f} deg, torque {d.torque[0]:.4g} N m\n"
-        "joint forces on the driven body, to one scale",
+        f"{what}, to one scale",
         fontsize=10,
     )
     ax0.set_xlabel(f"x [{m.units}]")

@@ -136,7 +136,7 @@ def _table5(m) -> list[float]:
     ]
 
 
-def _paper(tick) -> str:
+def _paper(tick, loads=None, points=None) -> str:
     from qropt import family, reachable, solve
     from qropt.examples import paper_mechanism, paper_problem
     from qropt.io import plots
@@ -219,7 +219,7 @@ def _paper(tick) -> str:
         + _table(["theta2 [deg]", "x [m]", "v [m/s]", "a [m/s^2]"], rows)
     )
     tick()
-    parts.append(_forces(m))
+    parts.append(_forces(m, loads=loads, points=points, source="as given"))
     g_lo = analytic.paper_transmission_at_dead_centres(0.1, 0.225, roots[0].r3, 0.275)
     exact = [
         math.degrees(roots[0].theta2a),
@@ -242,18 +242,129 @@ def _paper(tick) -> str:
 # The report's assumptions for the forces (the paper gives none): steel bars 20 mm x 10 mm, a 20 kg ram, a 1000 N
 # cutting force on the working stroke, gravity, and a flywheel for a speed fluctuation of 5 % at 10 rad/s.
 FORCES = {"area": 2e-4, "ram": 20.0, "force": 1000.0, "gravity": 9.81, "omega2": 10.0, "cs": 0.05}
+STROKE_WORDS = {"working": "on the working stroke", "return": "on the return stroke", "both": "always"}
 
 
-def _forces(m) -> str:
-    """Forces and torque of the chosen design under the stated assumptions (FORCES)."""
+def _amount(v, unit: str, against: str, units: str) -> str:
+    """A load's magnitude: a constant, or a table's rows, range and abscissa."""
+    if not isinstance(v, tuple):
+        return f"{v:.6g} {unit}"
+    lo, hi = min(r[1] for r in v), max(r[1] for r in v)
+    by = f"x [{units}]" if against == "x" else "theta2"
+    rows = "; ".join(
+        f"{(r[0] if against == 'x' else math.degrees(r[0])):.4g}{'' if against == 'x' else ' deg'}: {r[1]:.4g}"
+        for r in v[:6]
+    )
+    more = f"; ... ({len(v)} rows)" if len(v) > 6 else ""
+    return f"{lo:.4g} .. {hi:.4g} {unit}, a table against {by} ({rows}{more})"
+
+
+def _window(w, units: str) -> str:
+    """Where a load acts, in words (``qropt.Window``)."""
+    if w.theta2 is not None:
+        a, b = (math.degrees(v) for v in w.theta2)
+        return f"theta2 from {a:.4g} to {b:.4g} deg"
+    if w.x is not None:
+        x = f"x from {w.x[0]:.4g} to {w.x[1]:.4g} {units}"
+        return x if w.stroke == "both" else f"{x}, {STROKE_WORDS[w.stroke]}"
+    return STROKE_WORDS[w.stroke]
+
+
+def _direction(d) -> str:
+    if d == "against":
+        return "against its point's velocity"
+    if d == "slide":
+        return "along the slide line's +x (signed)"
+    return f"fixed: ({d[0]:.4g}, {d[1]:.4g}), {math.degrees(math.atan2(d[1], d[0])):.4g} deg from +x"
+
+
+def loads_table(loads, masses=None, units: str = "m") -> str:
+    """The loads as a table: the cutting force, the slide's and the pins' friction, the follower's torque, each
+    force (F1, F2, ... as the dynamics figure names them: its point, direction, magnitude and window) and torque
+    (T1, ...), gravity, the named working stroke and the point masses (``masses.points``); ``units``: the
+    mechanism's length unit (windows and tables against x)."""
+    rows = []
+    f = loads.cutting_force
+    if isinstance(f, tuple) or f:
+        rows.append(
+            (
+                "cutting force",
+                "the ram",
+                "against the ram's motion",
+                _amount(f, "N", "x", units),
+                "on the working stroke",
+            )
+        )
+    if loads.friction:
+        rows.append(("slide friction", "the slide", "against the ram's velocity", f"mu {loads.friction:.4g}", "always"))
+    if loads.follower_torque:
+        rows.append(
+            (
+                "follower torque",
+                "the follower",
+                "against its working swing",
+                f"{loads.follower_torque:.6g} N m",
+                "on the working stroke",
+            )
+        )
+    for i, v in enumerate(loads.forces, 1):
+        rows.append(
+            (
+                f"F{i}",
+                v.where,
+                _direction(v.direction),
+                _amount(v.magnitude, "N", v.against, units),
+                _window(v.window, units),
+            )
+        )
+    for i, v in enumerate(loads.torques, 1):
+        amount = _amount(v.magnitude, "N m", v.against, units)
+        rows.append((f"T{i}", f"the {v.on}", "counter-clockwise positive", amount, _window(v.window, units)))
+    gx, gy = loads.gravity_vector
+    if gx or gy:
+        angle = math.degrees(math.atan2(gy, gx))
+        rows.append(
+            (
+                "gravity",
+                "every body's centre of mass",
+                f"({gx:.4g}, {gy:.4g}), {angle:.4g} deg from +x",
+                f"{math.hypot(gx, gy):.4g} m/s^2",
+                "always",
+            )
+        )
+    pf = loads.pin_friction
+    if pf is not None:
+        where = "every pin" + (f" (r {pf.radius:.4g} m)" if pf.radius is not None else "")
+        where += "".join(f"; {j}: mu {mu:.4g}, r {r:.4g} m" for j, (mu, r) in pf.joints.items())
+        rows.append(("pin friction", where, "against each pin's relative rotation", f"mu {pf.mu:.4g}", "always"))
+    if loads.working is not None:
+        rows.append(("working stroke", "the ram", f"moves {loads.working}", "", "(named: the strokes take equal time)"))
+    for joint, kg in (masses.points if masses is not None else {}).items():
+        rows.append(("point mass", joint, "", f"{kg:.6g} kg", ""))
+    if not rows:
+        return "<p>No loads: the forces are the inertia's alone.</p>"
+    return _table(["load", "at / on", "direction", "magnitude", "acts"], rows)
+
+
+def _forces(m, masses=None, loads=None, omega2=None, points=None, source: str = "as given", loads_from=None) -> str:
+    """Forces and torque of a design over the turn, with its loads' table and the dynamics figure (the applied
+    loads drawn as arrows): under the report's assumptions (``FORCES``) for what is not given (masses None: the
+    assumed steel bars and ram; loads None: the assumed cutting force and gravity), ``source`` naming where the
+    given ones come from ("the problem's"; ``loads_from``, the loads', where it differs); ``points``: point masses
+    (joint -> kg) added to the masses."""
     from qropt.dynamics.cycle import CycleDynamics
     from qropt.dynamics.model import Loads, Masses
     from qropt.io import plots
 
     f = FORCES
-    masses = Masses.steel(f["area"], f["ram"])
-    loads = Loads(f["force"], gravity=f["gravity"])
-    cd = CycleDynamics(m, f["omega2"], 0.0, masses, loads)
+    loads_from = source if loads_from is None else loads_from
+    masses_assumed, loads_assumed = masses is None, loads is None
+    masses = Masses.steel(f["area"], f["ram"]) if masses_assumed else masses
+    if points:
+        masses = masses.replace(points={**masses.points, **points})
+    loads = Loads(f["force"], gravity=f["gravity"]) if loads_assumed else loads
+    omega2 = f["omega2"] if omega2 is None else omega2
+    cd = CycleDynamics(m, omega2, 0.0, masses, loads)
     ex, fw = cd.extremes(), cd.flywheel(f["cs"])
     rows = [
         ("peak crank torque [N m]", ex.peak_torque.value, math.degrees(ex.peak_torque.theta2)),
@@ -271,15 +382,46 @@ def _forces(m) -> str:
         ("energy a turn [J]", fw.energy_per_turn, ""),
         ("energy on the working stroke [J]", fw.working_energy, ""),
     ]
+    if masses_assumed:
+        said = (
+            "The paper gives no masses. Assumed here: steel links (7850 kg/m^3) of a 20 mm x 10 mm section "
+            f"({masses.density:.4g} kg/m, uniform bars; the follower a bar over its longer arm), a {f['ram']:g} kg ram"
+        )
+    else:
+        said = f"The masses are {html.escape(source)}: links {masses.density:.4g} kg/m (uniform bars)"
+        said += f", ram {masses.ram:g} kg" + (f", crank-pin block {masses.block:g} kg" if masses.block else "")
+        cw = masses.counterweight
+        said += f", a counterweight of {cw.mass:.4g} kg at {cw.radius:.4g} m" if cw is not None and not cw.free else ""
+    if masses.points:
+        said += ", point masses " + ", ".join(f"{k} {v:g} kg" for k, v in masses.points.items())
+    if loads_assumed:
+        said += f"; a {f['force']:g} N cutting force resisting the working stroke, gravity {f['gravity']:g} m/s^2"
+    else:
+        said += f"; the loads are {html.escape(loads_from)} (the table)"
+    if masses_assumed and loads_assumed:
+        heading = "assumed masses and load"
+    elif not masses_assumed and not loads_assumed and loads_from == source:
+        heading = f"{source} masses and loads"
+    else:
+        heading = ("assumed masses" if masses_assumed else f"{source} masses") + ", "
+        heading += (
+            "assumed load"
+            if loads_assumed
+            else f"loads {loads_from}"
+            if loads_from == "as given"
+            else f"{loads_from} loads"
+        )
+    figure = plots.dynamics_figure(m, omega2, masses, loads, math.radians(60))
     return (
-        "<h2>Forces and torque (assumed masses and load)</h2>"
-        f"<p>The paper gives no masses. Assumed here: steel links (7850 kg/m^3) of a 20 mm x 10 mm section "
-        f"({masses.density:.4g} kg/m, uniform bars; the follower a bar over its longer arm), a {f['ram']:g} kg ram, "
-        f"a {f['force']:g} N cutting force resisting the working stroke, gravity {f['gravity']:g} m/s^2, "
-        f"omega2 = {f['omega2']:g} rad/s. Exact over the turn (inverse dynamics from the same loop code; the torque "
-        "agrees with the power balance to rounding).</p>"
+        f"<h2>Forces and torque ({html.escape(heading)})</h2>"
+        f"<p>{said}; omega2 = {omega2:g} rad/s. Exact over the turn (inverse dynamics from the same loop code; the "
+        "torque agrees with the power balance to rounding).</p>"
+        "<h3>The loads</h3>"
+        + loads_table(loads, masses, m.units)
         + _table(["quantity", "value", "at theta2 [deg]"], rows)
-        + _png(plots.dynamics_figure(m, f["omega2"], masses, loads, math.radians(60)))
+        + "<p>At theta2 = 60 deg: each joint's force on the driven body and the applied loads (F1, T1, ... as in "
+        "the table; a load off at that angle faded), to one scale; over the turn: the crank torque and the joint "
+        "forces.</p>" + _png(figure)
     )
 
 
@@ -327,14 +469,23 @@ def _polygons(m) -> str:
     )
 
 
-def _problem(problem) -> str:
+def _problem(problem, loads_from: str = "the problem's") -> str:
+    """A problem's design; with its forces and torque under its masses and loads where it states either
+    (``loads_from``: where its loads come from, for the words)."""
     from qropt import solve
+    from qropt.dynamics.model import Loads, Masses
 
     r = solve(problem)
     title = f"{problem.mechanism.__name__}: objective {problem.objective}, lengths in {problem.units}"
-    return f"<h1>{html.escape(problem.name or problem.mechanism.__name__)}</h1>" + _design_section(
+    out = f"<h1>{html.escape(problem.name or problem.mechanism.__name__)}</h1>" + _design_section(
         title, r, list(problem.free)
     )
+    if r.success and (problem.masses is not None or problem.loads is not None):
+        settled = problem.settled(r)
+        masses = settled.masses if settled.masses is not None else Masses()
+        loads = settled.loads if settled.loads is not None else Loads()
+        out += _forces(r.mechanism, masses, loads, problem.omega2, source="the problem's", loads_from=loads_from)
+    return out
 
 
 def design_page(m, theta2: float = 0.0, omega2: float = 1.0) -> str:
@@ -377,18 +528,36 @@ def design_page(m, theta2: float = 0.0, omega2: float = 1.0) -> str:
     return f"<!DOCTYPE html><html><head>{head}</head><body>{body}</body></html>\n"
 
 
-def render(problem=None, path=None, progress=None) -> str:
+def render(problem=None, path=None, progress=None, *, loads=None, points=None) -> str:
     """The report's HTML (also written to ``path`` if given): the paper's project, or the given problem's design.
 
-    progress: callable() after each section."""
+    progress: callable() after each section; loads (``qropt.Loads``): instead of the report's assumed load (the
+    paper's project) or the problem's loads; points: point masses (joint -> kg) added to the masses. The paper's
+    design is checked against them before any section is computed."""
+    from qropt.dynamics.model import Loads, Masses
     from qropt.synthesis.problem import Problem
 
     if problem is not None and not isinstance(problem, Problem):
         raise InvalidParameter(f"render takes a qropt.Problem or None, got {type(problem).__name__}")
+    if loads is not None and not isinstance(loads, Loads):
+        raise InvalidParameter(f"render's loads are a qropt.Loads or None, got {type(loads).__name__}")
     if path is not None:
         report_path(path)  # before any section is computed
     tick = progress if callable(progress) else (lambda: None)
-    body = _paper(tick) if problem is None else _problem(problem)
+    if problem is not None and (loads is not None or points):
+        masses = problem.masses if problem.masses is not None else Masses()
+        stated = {"masses": masses.replace(points={**masses.points, **points})} if points else {}
+        problem = problem.replace(**stated, **({"loads": loads} if loads is not None else {}))
+    if problem is None and (loads is not None or points):
+        from qropt.examples import paper_mechanism
+
+        f = FORCES  # an unknown joint or body fails here, in one line, before the sections
+        masses = Masses.steel(f["area"], f["ram"]).replace(points=dict(points or {}))
+        paper_mechanism().dynamics([math.radians(60)], f["omega2"], masses=masses, loads=loads)
+    if problem is None:
+        body = _paper(tick, loads, points)
+    else:
+        body = _problem(problem, "the problem's" if loads is None else "as given")
     title = "qropt report" if problem is None else f"qropt report: {problem.name or problem.mechanism.__name__}"
     head = f"<meta charset='utf-8'><title>{html.escape(title)}</title><style>{CSS}</style>"
     text = f"<!DOCTYPE html><html><head>{head}</head><body>{body}</body></html>\n"
