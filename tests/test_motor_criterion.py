@@ -83,3 +83,28 @@ def test_the_problem_carries_its_drive_and_says_when_it_needs_one():
         _problem("min_rms_motor_torque", None)
     with pytest.raises(ProblemError, match="drive"):
         qropt.Problem.from_dict({**p.to_dict(), "drive": {"ratio": -2.0}})
+
+
+def test_the_command_line_designs_by_the_motor(capsys):
+    from qropt import cli
+
+    argv = ["design", "--tr", "1.5", "--stroke", "0.3", "--objective", "min_rms_motor_torque", "--density", "3.14"]
+    argv += ["--ram-mass", "20", "--force", "1000", "--omega2", "10", "--types", "crank-shaper"]
+    assert cli.main([*argv, "--drive", "15", "0.9"]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if "RMS motor torque" in x)
+    masses, loads = qropt.Masses.bars(3.14, 20.0), Loads(1000.0)
+    r = qropt.design(
+        1.5,
+        0.3,
+        objective="min_rms_motor_torque",
+        masses=masses,
+        loads=loads,
+        omega2=10.0,
+        drive=Drive(15.0, 0.9),
+        types=["crank-shaper"],
+    )
+    assert float(line.split()[-1]) == pytest.approx(r.rows[0].result.objective, rel=1e-3)
+    for bad, words in ((["--drive", "15", "1.5"], "efficiency"), ([], "needs the drive")):
+        assert cli.main([*argv, *bad]) != 0
+        err = capsys.readouterr().err
+        assert words in err and len(err.strip().splitlines()) == 1

@@ -46,6 +46,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--ram-mass", dest="ram_mass", type=real, help="the ram's mass, kg (dynamics)")
     loads_arguments(parser, instead=" (dynamics: every type's solve)")
     parser.add_argument(
+        "--drive",
+        nargs="+",
+        type=real,
+        metavar=("RATIO", "EFFICIENCY"),
+        help="the gearbox: ratio (motor speed / crank speed) and efficiency (default 1), for min_rms_motor_torque",
+    )
+    parser.add_argument(
         "--balance",
         nargs=2,
         type=real,
@@ -104,6 +111,14 @@ def run(args) -> int:
     types = None if args.types is None else [cli_type(t) if ":" in t else t for t in args.types]
     n_types = len(args.types or TYPES)
     masses, loads = dynamics_of(args)
+    drive = None
+    if args.drive is not None:
+        from qropt.dynamics.drive import Drive
+        from qropt.errors import InvalidParameter
+
+        if len(args.drive) > 2:
+            raise InvalidParameter(f"--drive takes RATIO [EFFICIENCY], got {len(args.drive)} numbers")
+        drive = Drive(*args.drive)
     with progress_bar("types", total=n_types, unit="type") as bar:
         cmp = design(
             args.tr,
@@ -119,6 +134,7 @@ def run(args) -> int:
             units=args.units,
             masses=masses,
             loads=loads,
+            drive=drive,
             workers=args.workers,
             time_limit=args.time_limit,
         )
@@ -154,9 +170,11 @@ def run(args) -> int:
         print("  dynamics at omega2 (N m; N):")
         for r in dynamic:
             c = r.criteria
+            motor = c.get("rms_motor_torque")
             print(
                 f"  {r.type:20s} peak torque {c['peak_torque']:10.4g}  RMS torque {c['rms_torque']:10.4g}  "
                 f"peak shaking force {c['shaking_force']:10.4g}"
+                + ("" if motor is None else f"  RMS motor torque {motor:10.4g}")
             )
     for r in cmp.rows:
         cw = r.result.counterweight if r.success else None
