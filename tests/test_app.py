@@ -232,7 +232,8 @@ def test_design_options_come_from_the_registries(client):
     assert by["footprint"] == {**by["footprint"], "objective": "min_size", "size": "footprint", "dynamic": False}
     assert [t["type"] for t in o["types"] if t["built_in"]] == list(ROWS)
     (user,) = [t for t in o["types"] if t["type"] == USER]  # other tests of this process may register types too
-    assert user == {"name": "watt-sixbar-shaper", "type": USER, "class": "WattSixBarShaper", "built_in": False}
+    assert user | {"name": "watt-sixbar-shaper", "type": USER, "class": "WattSixBarShaper", "built_in": False} == user
+    assert user["ram"] == "D" and "D" in user["joints"]  # where loads act: its declared bodies
     assert o["time_limit"] == 120
 
 
@@ -478,3 +479,126 @@ def test_types_say_which_parameter_is_which_link(client):
     info = {t["type"]: t for t in client.get("/api/types").get_json()}
     assert info["slider-crank"]["summary"].startswith("Offset slider-crank (r2 crank, r3 rod, e slide-line offset)")
     assert all(t["summary"] for t in info.values())
+
+
+SLIDER = {"r2": 0.1, "r3": 0.41, "e": 0.05, "sigma_slider": 1.0}
+GENERAL_MASSES = {"density": 1.57, "ram": 20.0, "points": {"C": 2.0}}
+GENERAL_LOADS = {  # as the panel sends them: a force at 150 deg, one against the crank pin's motion, a torque
+    "cutting_force": 1000.0,
+    "friction": 0.05,
+    "gravity": [-9.81, 0.0],  # a vertical machine: gravity along -x
+    "follower_torque": 0.0,
+    "forces": [
+        {"at": "C", "magnitude": 300.0, "direction": [-math.sqrt(3) / 2, 0.5], "window": "always"},
+        {"at": "A", "magnitude": 50.0, "direction": "against", "window": "return"},
+    ],
+    "torques": [{"on": "rod", "magnitude": 5.0, "window": "working"}],
+    "pin_friction": {"mu": 0.1, "radius": 0.02},
+}
+
+
+def test_analyze_with_general_loads_equals_the_library(client):
+    """The panel's loads as Loads.from_dict reads them: the crank torque at theta2, every joint force, the peak and
+    RMS torque, the flywheel, the efficiency of the working stroke and of the turn (m.efficiency) and the motor's
+    peak and RMS torque (m.drive_check) are the library's for the same Loads, Masses and Drive."""
+    body = {"type": "slider-crank", "params": SLIDER, "theta2": 1.2, "omega2": 10.0}
+    body |= {"masses": GENERAL_MASSES, "loads": GENERAL_LOADS, "drive": {"ratio": 10.0, "efficiency": 0.9}}
+    r = client.post("/api/analyze", json=body)
+    assert r.status_code == 200, r.get_json()
+    a = r.get_json()
+    assert (a["joints"], a["bodies"], a["ram"]) == (["A", "C", "O2"], ["crank", "rod", "ram"], "C")
+    m = mechanism_type("slider-crank")(**SLIDER)
+    masses, loads = Masses.from_dict(GENERAL_MASSES), Loads.from_dict(GENERAL_LOADS)
+    assert len(loads.forces) == 2 and loads.torques and loads.pin_friction.mu == 0.1 and masses.points == {"C": 2.0}
+    dy = a["dynamics"]
+    at = m.dynamics([1.2], 10.0, masses=masses, loads=loads)
+    assert dy["at"]["torque"] == pytest.approx(at.torque[0], rel=1e-12)
+    for k, f in at.joint_forces.items():
+        assert dy["at"]["joint_forces"][k] == pytest.approx(f[0].tolist(), abs=1e-12 * max(1.0, np.hypot(*f[0])))
+    ex = m.dynamic_extremes(10.0, masses=masses, loads=loads)
+    assert dy["peak_torque"]["value"] == pytest.approx(ex.peak_torque.value, rel=1e-12)
+    assert dy["rms_torque"] == pytest.approx(ex.rms_torque, rel=1e-12)
+    assert dy["flywheel"]["inertia"] == pytest.approx(m.flywheel(10.0, 0.05, masses=masses, loads=loads).inertia)
+    eff = m.efficiency(10.0, masses=masses, loads=loads)
+    assert dy["efficiency"]["working"]["efficiency"] == pytest.approx(eff.working.efficiency, rel=1e-12)
+    assert dy["efficiency"]["turn"]["efficiency"] == pytest.approx(eff.turn.efficiency, rel=1e-12)
+    assert 0 < eff.turn.efficiency < 1 and dy["efficiency"]["turn"]["friction"] == pytest.approx(eff.turn.friction)
+    dc = m.drive_check(qropt.Drive(10.0, 0.9), 10.0, masses=masses, loads=loads)
+    assert dy["drive"]["peak_torque"]["value"] == pytest.approx(dc.peak_torque.value, rel=1e-12)
+    assert dy["drive"]["rms_torque"] == pytest.approx(dc.rms_torque, rel=1e-12)
+    # the loads change the torque (they are applied, not dropped), and the live answer applies them too
+    plain = client.post("/api/analyze", json=body | {"loads": {"cutting_force": 1000.0}, "drive": None}).get_json()
+    assert plain["dynamics"]["at"]["torque"] != pytest.approx(at.torque[0], rel=1e-3)
+    assert "efficiency" not in plain["dynamics"] and "drive" not in plain["dynamics"]
+    live = client.post("/api/analyze", json=body | {"extremes": False}).get_json()["dynamics"]
+    assert live["at"]["torque"] == pytest.approx(at.torque[0], rel=1e-12) and "peak_torque" not in live
+
+
+@pytest.mark.parametrize(
+    "change, words",
+    [
+        ({"loads": {"forces": [{"at": "Z", "magnitude": 100.0}]}}, "the force at Z: SliderCrank has no joint 'Z'"),
+        ({"loads": {"torques": [{"on": "lever", "magnitude": 5.0}]}}, "the torque on lever: SliderCrank has no body"),
+        ({"loads": {"cutting_force": -5.0}}, "cutting_force (N) must be zero or positive, got -5"),
+        ({"masses": {"density": 1.0, "points": {"C": -2.0}}}, "the point mass at C (kg) must be zero or positive"),
+        ({"masses": {"density": 1.0, "points": {"Q": 2.0}}}, "SliderCrank has no joint 'Q'"),
+        ({"loads": {"pin_friction": {"mu": -0.1, "radius": 0.01}}}, "pin friction: mu (a coefficient) must be zero"),
+        ({"loads": {"forces": [{"at": "C", "magnitude": 1.0, "window": "sometimes"}]}}, "a window is named one of"),
+        ({"drive": {"ratio": -10.0}}, "the drive's ratio (motor speed / crank speed) must be positive"),
+        ({"drive": {"ratio": 10.0, "efficiency": 1.5}}, "the drive's efficiency must lie in (0, 1]"),
+        ({"masses": None, "drive": {"ratio": 10.0}}, "loads and a drive act with a mass model"),
+    ],
+)
+def test_a_bad_load_is_a_400_naming_it(client, change, words):
+    """A load, point mass or drive the library refuses or cannot apply: 400, one line naming it, marked as the
+    panel's (field "loads") for the page to say beside it; never dropped."""
+    body = {"type": "slider-crank", "params": SLIDER, "theta2": 1.0, "omega2": 10.0, "masses": {"density": 1.0}}
+    for extremes in (False, True):
+        r = client.post("/api/analyze", json=body | change | {"extremes": extremes})
+        assert r.status_code == 400, r.get_json()
+        e = r.get_json()
+        assert words in e["error"] and "\n" not in e["error"] and e["field"] == "loads", e
+
+
+def test_design_with_general_loads_and_a_drive(client):
+    """The Design page's loads and drive: min_rms_motor_torque (offered as needing the drive) with the panel's
+    forces, gravity vector and point mass gives the row's RMS motor torque of its design as the library computes
+    it; a load a ticked type cannot take, pin friction (which the NLP cannot state) and the motor objective
+    without a drive are 400s naming them, before any job."""
+    from qropt.dynamics.drive import rms_motor_torque
+
+    (o,) = [o for o in client.get("/api/design/options").get_json()["objectives"] if o["drive"]]
+    assert o["objective"] == "min_rms_motor_torque" and o["dynamic"]
+    rows = {t["name"]: t for t in client.get("/api/design/options").get_json()["types"]}
+    assert rows["crank-shaper"]["joints"] == ["A", "C", "O2", "O4"] and rows["crank-shaper-rod"]["ram"] == "D"
+    loads = {k: v for k, v in GENERAL_LOADS.items() if k not in ("pin_friction", "torques")}
+    body = {"time_ratio": 1.5, "stroke": 0.3, "objective": "min_rms_motor_torque", "omega2": 10.0}
+    body |= {"types": ["slider-crank"], "masses": GENERAL_MASSES, "loads": loads, "time_limit": 10}
+    body |= {"drive": {"ratio": 10.0, "efficiency": 0.9}}
+    r = client.post("/api/design", json=body)
+    assert r.status_code == 200, r.get_json()
+    (row,) = r.get_json()["rows"]
+    assert row["mechanism"] == "slider-crank", row
+    m = mechanism_type("slider-crank")(**row["params"])
+    cd = CycleDynamics(m, 10.0, 0.0, Masses.from_dict(GENERAL_MASSES), Loads.from_dict(loads))
+    want = rms_motor_torque(cd, qropt.Drive(10.0, 0.9), split=False)
+    assert row["objective"] == pytest.approx(want, rel=1e-9) and row["rms_motor_torque"] == row["objective"]
+    for change, words in (
+        ({"types": ["slider-crank", "whitworth"], "loads": {"forces": [{"at": "C", "magnitude": 1.0}]}}, None),
+        (
+            {"types": ["crank-shaper", "whitworth"], "loads": {"forces": [{"at": "D", "magnitude": 1.0}]}},
+            "the force at D: the crank-shaper row's CrankShaper has no joint 'D'",
+        ),
+        ({"loads": {"pin_friction": {"mu": 0.1, "radius": 0.01}}}, "cannot apply pin friction"),
+        ({"drive": None}, "min_rms_motor_torque needs the drive"),
+        ({"drive": {"ratio": 0}}, "the drive's ratio (motor speed / crank speed) must be positive"),
+    ):
+        if words is None:  # C is a joint of both (a check only: no job is made)
+            from qropt.app.server import _design_input
+
+            _design_input(body | change)
+            continue
+        r = client.post("/api/jobs", json={"kind": "design", "input": body | change})
+        assert r.status_code == 400, r.get_json()
+        e = r.get_json()
+        assert words in e["error"] and e["field"] == "loads", e

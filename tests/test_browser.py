@@ -433,3 +433,145 @@ def test_pages_at_a_phone_and_a_desktop_width(browser, server, tmp_path, width):
             assert w >= 0.7 * min(width, 700) - 40, (svg, width, w)
     finally:
         pg.close()
+
+
+def _row(pg, table: str, start: str) -> str:
+    """The value cell of the first row of a table whose quantity starts with ``start``."""
+    return pg.evaluate(
+        "([t, s]) => { const r = [...document.getElementById(t).rows]"
+        ".find((r) => r.cells[0].textContent.startsWith(s)); return r ? r.cells[1].textContent : null; }",
+        [table, start],
+    )
+
+
+def _number(text: str) -> float:
+    return float(text.split()[0])
+
+
+UP_BACK = (math.cos(math.radians(150)), math.sin(math.radians(150)))
+
+
+def test_the_panel_loads_give_the_librarys_torque(page, browser, tmp_path):
+    """A force, a point mass, gravity along -x, pin friction and a drive added in the panel: the crank torque at
+    theta2, the peak torque, the efficiency and the motor's torque shown equal the library's for the same loads; a
+    load the library refuses is said beside the panel; a shared link restores the loads."""
+    from qropt.dynamics.cycle import CycleDynamics
+
+    page.select_option("#m-type", "slider-crank")
+    page.wait_for_function("window.qropt.type === 'slider-crank' && !window.qropt.inflight")
+    page.check("#m-dyn")
+    page.wait_for_function("document.getElementById('m-forces').textContent.includes('RMS torque')")
+    before = _number(_row(page, "m-forces", "crank torque"))
+    page.click("#m-more summary")
+    page.click("#m-add-forces")  # at the ram's joint C, 500 N against its motion on the working stroke
+    row = page.locator("#m-more .load-row.forces").first
+    assert row.locator("select.at").input_value() == "C"
+    row.locator("input.magnitude").fill("300")
+    row.locator("select.direction").select_option("angle")
+    row.locator("input.angle").fill("150")  # up and back, 30 degrees from -x
+    row.locator("select.window").select_option("always")
+    row.locator("select.window").dispatch_event("change")
+    page.wait_for_function("!window.qropt.inflight && !window.qropt.pending")
+    page.wait_for_function("document.getElementById('m-forces').textContent.includes('RMS torque')")
+    params, theta2 = page.evaluate("window.qropt.params"), math.radians(float(page.input_value("#m-theta-n")))
+    m = mechanism_type("slider-crank")(**params)
+    masses = qropt.Masses.bars(1.57, 20.0)
+    loads = qropt.Loads(1000.0, gravity=9.81, forces=[qropt.Force("C", 300.0, UP_BACK, "always")])
+    want = float(m.dynamics([theta2], 10.0, masses=masses, loads=loads).torque[0])
+    shown = _number(_row(page, "m-forces", "crank torque"))
+    assert shown == pytest.approx(want, rel=1e-4) and shown != pytest.approx(before, rel=1e-3)
+    peak = CycleDynamics(m, 10.0, 0.0, masses, loads).extremes().peak_torque.value
+    assert _number(_row(page, "m-forces", "peak torque")) == pytest.approx(peak, rel=1e-4)
+    # a point mass, gravity along -x (a vertical machine), pin friction and a drive
+    page.click("#m-add-points")
+    page.fill("#m-gdir", "180")
+    page.fill("#m-pin-mu", "0.1")
+    page.fill("#m-pin-r", "0.02")
+    page.fill("#m-ratio", "10")
+    page.fill("#m-eta", "0.9")
+    page.dispatch_event("#m-eta", "change")
+    page.wait_for_function("document.getElementById('m-forces').textContent.includes('motor RMS torque')")
+    page.wait_for_function("!window.qropt.inflight && !window.qropt.pending")
+    page.wait_for_function("document.getElementById('m-forces').textContent.includes('motor RMS torque')")
+    masses = qropt.Masses.bars(1.57, 20.0, points={"C": 2.0})
+    loads = qropt.Loads(
+        1000.0,
+        gravity=(-9.81, 0.0),
+        forces=[qropt.Force("C", 300.0, UP_BACK, "always")],
+        pin_friction=qropt.PinFriction(0.1, 0.02),
+    )
+    want = float(m.dynamics([theta2], 10.0, masses=masses, loads=loads).torque[0])
+    assert _number(_row(page, "m-forces", "crank torque")) == pytest.approx(want, rel=1e-4)
+    eff = m.efficiency(10.0, masses=masses, loads=loads)
+    assert _number(_row(page, "m-forces", "efficiency, working")) == pytest.approx(
+        100 * eff.working.efficiency, rel=1e-3
+    )
+    assert _number(_row(page, "m-forces", "efficiency, turn")) == pytest.approx(100 * eff.turn.efficiency, rel=1e-3)
+    dc = m.drive_check(qropt.Drive(10.0, 0.9), 10.0, masses=masses, loads=loads)
+    assert _number(_row(page, "m-forces", "motor peak torque")) == pytest.approx(dc.peak_torque.value, rel=1e-4)
+    assert _number(_row(page, "m-forces", "motor RMS torque")) == pytest.approx(dc.rms_torque, rel=1e-4)
+    assert page.inner_text("#m-more-sum") == "more loads (1 force, 1 point mass, gravity at 180°, pin friction, drive)"
+    _shot(page, tmp_path, "mechanism_loads")
+    url, shown = page.url, page.inner_text("#m-forces")
+    assert "force=C%2C300%2C150%2Calways" in url and "point=C%2C2" in url and "gdir=180" in url, url
+    other = browser.new_page(viewport={"width": 1400, "height": 1000})
+    try:  # the link restores the loads, and the numbers they give
+        other.goto(url)
+        other.wait_for_selector("body[data-ready='1']", timeout=60_000)
+        other.wait_for_function("document.getElementById('m-forces').textContent.includes('motor RMS torque')")
+        assert other.evaluate("panelState('m')") == page.evaluate("panelState('m')")
+        assert other.evaluate("document.getElementById('m-more').open")
+        assert other.inner_text("#m-forces") == shown
+    finally:
+        other.close()
+    # a load the library refuses: said beside the panel, the results marked as the last good inputs'
+    page.locator("#m-more .load-row.points input.mass").fill("-1")
+    page.dispatch_event("#m-more .load-row.points input.mass", "change")
+    page.wait_for_function("document.getElementById('m-load-msg').textContent.length > 0")
+    assert "the point mass at C (kg) must be zero or positive" in page.inner_text("#m-load-msg")
+    assert page.locator("#m-forces.stale").count() == 1
+    page.locator("#m-more .load-row.points button.remove").click()
+    page.wait_for_function("document.getElementById('m-load-msg').textContent === ''")
+
+
+def test_design_page_sends_the_panels_loads_and_drive(page, tmp_path):
+    """min_rms_motor_torque opens "more loads" with a drive; a force at a joint some ticked types lack is refused
+    beside the panel, naming the load and the type; with one type the row's RMS motor torque is the library's for
+    the panel's loads and drive."""
+    from qropt.dynamics.cycle import CycleDynamics
+    from qropt.dynamics.drive import rms_motor_torque
+    from qropt.studies._design import TYPES as ROWS
+
+    page.click("#tab-design")
+    for box in page.locator("#d-types input").all():  # design's rows (a user type another test loaded: out)
+        box.set_checked(box.get_attribute("value") in ROWS)
+    page.select_option("#d-objective", "rms_motor_torque")
+    assert page.is_checked("#d-dyn") and page.evaluate("document.getElementById('d-more').open")
+    assert page.input_value("#d-ratio") == "10" and page.input_value("#d-eta") == "0.9"
+    page.click("#d-add-forces")  # at D, the ram's joint of most types: the slider-crank and crank-shaper lack it
+    row = page.locator("#d-more .load-row.forces").first
+    assert row.locator("select.at").input_value() == "D"
+    assert row.locator("select.at option:checked").inner_text() == "D (not in 2 types)"
+    page.fill("#d-budget", "5")
+    page.click("#d-run")
+    page.wait_for_function("document.getElementById('d-load-msg').textContent.length > 0")
+    said = page.inner_text("#d-load-msg")  # (by the criterion's check or the app's, whichever sees it first)
+    assert said.startswith("slider-crank") or "the slider-crank row's" in said, said
+    assert "the force at D: " in said and "has no joint 'D'" in said, said
+    for box in page.locator("#d-types input").all():
+        box.set_checked(box.get_attribute("value") == "slider-crank")
+    assert row.locator("select.at option:checked").inner_text() == "D (not in slider-crank)"
+    row.locator("select.at").select_option("C")
+    row.locator("input.magnitude").fill("300")
+    page.click("#d-run")
+    page.wait_for_selector("#d-table tr.pick", timeout=60_000)
+    assert page.inner_text("#d-load-msg") == ""
+    (got,) = page.evaluate("window.qropt.designRows")
+    m = mechanism_type("slider-crank")(**got["params"])
+    loads = qropt.Loads(1000.0, gravity=9.81, forces=[qropt.Force("C", 300.0)])  # against its motion, working
+    cd = CycleDynamics(m, 10.0, 0.0, qropt.Masses.bars(1.57, 20.0), loads)
+    want = rms_motor_torque(cd, qropt.Drive(10.0, 0.9), split=False)
+    assert got["objective"] == pytest.approx(want, rel=1e-9)
+    head = page.locator("#d-table th").all_text_contents()
+    col = head.index("RMS motor torque [N m]")
+    assert float(page.locator("#d-table tr.pick td").nth(col).inner_text()) == pytest.approx(want, rel=1e-3)

@@ -25,11 +25,19 @@ MAX_FRAMES = 360  # frames of an animation in one answer
 
 
 class ApiError(QroptError):
-    """A request the API cannot answer: ``status`` 400 (bad input), 404 (no such thing) or 429 (busy)."""
+    """A request the API cannot answer: ``status`` 400 (bad input), 404 (no such thing) or 429 (busy); ``field``:
+    the part of the request at fault where a page shows it beside its input ("loads": the mass model and load
+    panel's masses, loads or drive), else None."""
 
-    def __init__(self, message: str, status: int = 400):
+    def __init__(self, message: str, status: int = 400, field: str | None = None):
         super().__init__(message)
         self.status = status
+        self.field = field
+
+
+def panel_error(e: Exception) -> ApiError:
+    """The mass model and load panel's error: the library's reason in one line, marked as the panel's."""
+    return ApiError(" ".join(str(e).split()), 400, "loads")
 
 
 def fields(payload, required: tuple, optional: tuple = ()) -> dict:
@@ -70,10 +78,21 @@ def report_input(payload) -> dict:
     return out
 
 
+def needs_drive(c) -> bool:
+    """Whether a criterion needs the problem's drive (``Problem(drive=...)``): the motor's RMS torque, or a
+    registered criterion that says so (``needs_drive = True``)."""
+    try:
+        from qropt.synthesis.motor import RmsMotorTorque
+    except ImportError:  # pragma: no cover - a qropt without the drive's criterion
+        RmsMotorTorque = ()
+    return isinstance(c, RmsMotorTorque) or bool(getattr(c, "needs_drive", False))
+
+
 def objectives() -> list[dict]:
     """Every objective of the criteria registry (``qropt.synthesis.criteria.CRITERIA``, a user's registered ones
     included), one entry per criterion: its ``objective`` and, for ``min_size``, the ``size`` measure; the
-    criterion's name, label and unit; ``dynamic`` where it needs a mass model or loads (and a time budget helps)."""
+    criterion's name, label and unit; ``dynamic`` where it needs a mass model or loads (and a time budget helps);
+    ``drive`` where it needs the drive (a gearbox's ratio and efficiency)."""
     from qropt.synthesis import criteria
 
     return [
@@ -85,6 +104,7 @@ def objectives() -> list[dict]:
             "unit": c.unit,
             "maximise": c.maximise,
             "dynamic": c.needs_masses,
+            "drive": needs_drive(c),
         }
         for c in criteria.CRITERIA.values()
     ]
@@ -105,14 +125,35 @@ def design_types() -> list[dict]:
     from qropt.mechanisms import TYPES as SHIPPED
     from qropt.studies._design import TYPES
 
-    out = [{"name": k, "type": k, "class": mechanism_type(v[0]).__name__, "built_in": True} for k, v in TYPES.items()]
+    out = [
+        {"name": k, "type": k, "class": mechanism_type(v[0]).__name__, "built_in": True} | row_points(k)
+        for k, v in TYPES.items()
+    ]
     for name in types():
         cls = known_type(name)
         if cls.TRAVEL != "stroke" or cls in SHIPPED:
             continue
         row = cls.__dict__.get("KIND") or cls.__name__
-        out.append({"name": row, "type": name, "class": cls.__name__, "built_in": False})
+        out.append({"name": row, "type": name, "class": cls.__name__, "built_in": False} | row_points(name))
     return out
+
+
+def points(bodies, ram) -> dict:
+    """Where loads may act: ``joints`` (a force's or a point mass's place), ``bodies`` (a torque's) and ``ram``,
+    the output's joint (None without a slider)."""
+    return {"joints": sorted({j for b in bodies for j in b.joints}), "bodies": [b.name for b in bodies], "ram": ram}
+
+
+def row_points(kind) -> dict:
+    """``points`` of a design row's type as ``design`` builds it (its options: the crank-shaper-rod's rod)."""
+    from qropt.studies._design import type_problem
+
+    p = type_problem(kind, 1.5, 1.0)
+    params = {**p.fixed, **{k: (lo + hi) / 2 for k, (lo, hi) in p.free.items()}}
+    link = p.mechanism.linkage(params)
+    if link is None:
+        return points(p.mechanism.BODIES, p.mechanism.OUTPUT_JOINT)
+    return points(link.bodies(), link.output_joint() if callable(getattr(link, "output_joint", None)) else None)
 
 
 def design_type(name) -> str:
@@ -212,6 +253,11 @@ def type_info() -> list[dict]:
     out = []
     for name in types():
         cls = known_type(name)
+        params = default_params(cls)
+        try:
+            where = design_points(cls(**params))
+        except (QroptError, TypeError):  # no valid default design: the class's own declaration
+            where = points(cls.BODIES, cls.OUTPUT_JOINT)
         out.append(
             {
                 "type": name,
@@ -219,11 +265,17 @@ def type_info() -> list[dict]:
                 "output": cls.OUTPUT,
                 "kinds": cls.kinds(),
                 "required": cls.required(),
-                "params": default_params(cls),
+                "params": params,
                 "summary": " ".join((cls.__doc__ or "").strip().split("\n\n")[0].split()),
             }
+            | where
         )
     return out
+
+
+def design_points(m: Mechanism) -> dict:
+    """``points`` of a design: its bodies and joints (which depend on its options) and the output's joint."""
+    return points(m.bodies(), m.output_joint())
 
 
 def mechanism(d: dict) -> Mechanism:
@@ -244,14 +296,17 @@ def mechanism(d: dict) -> Mechanism:
 
 def analyze(payload) -> dict:
     """``POST /api/analyze``: ``{type, params, theta2, omega2}`` (rad, rad/s; optional ``alpha2``, ``units``,
-    ``masses`` (``Masses.to_dict`` form), ``loads`` (``Loads.to_dict`` form), ``frames`` (crank angles of an
-    animation, 0-360), ``polygons`` (bool, default true), ``extremes`` (bool, default true: the exact dynamic
-    extremes and flywheel, the costly part; false while a slider moves)): the state at theta2, the cycle quantities,
-    x, v, a over the turn, the drawing at theta2, the polygons at theta2 and, with masses, the forces."""
+    ``masses`` (``Masses.to_dict`` form), ``loads`` (``Loads.to_dict`` form), ``drive`` (``Drive.to_dict`` form:
+    ``{ratio, efficiency}``; with masses), ``frames`` (crank angles of an animation, 0-360), ``polygons`` (bool,
+    default true), ``extremes`` (bool, default true: the exact dynamic extremes, flywheel, efficiency and drive,
+    the costly part; false while a slider moves)): the state at theta2, the cycle quantities, x, v, a over the
+    turn, the drawing at theta2, the polygons at theta2, where loads may act (``joints``, ``bodies``, ``ram``)
+    and, with masses, the forces (``forces``). A mass model, load or drive the library refuses or cannot apply
+    is a 400 with ``field: "loads"``."""
     d = fields(
         payload,
         ("type", "params"),
-        ("theta2", "omega2", "alpha2", "units", "masses", "loads", "frames", "polygons", "extremes"),
+        ("theta2", "omega2", "alpha2", "units", "masses", "loads", "drive", "frames", "polygons", "extremes"),
     )
     theta2 = number(d, "theta2", 0.0, low=-1e6, high=1e6)
     omega2 = number(d, "omega2", 1.0, low=-1e4, high=1e4)
@@ -281,8 +336,13 @@ def analyze(payload) -> dict:
     if show_polygons:
         shown = polygons(m, theta2, omega2, alpha2)
         out["polygons"], out["polygons_reason"] = (None, shown) if isinstance(shown, str) else (shown, "")
+    out |= design_points(m)
     if d.get("masses") is not None:
-        out["dynamics"] = forces(m, theta2, omega2, alpha2, d["masses"], d.get("loads"), extremes)
+        out["dynamics"] = forces(m, theta2, omega2, alpha2, d["masses"], d.get("loads"), extremes, d.get("drive"))
+    elif d.get("loads") is not None or d.get("drive") is not None:
+        raise ApiError(
+            "loads and a drive act with a mass model: send masses too (Masses.to_dict's form)", field="loads"
+        )
     return out
 
 
@@ -356,29 +416,82 @@ def polygons(m: Mechanism, theta2: float, omega2: float, alpha2: float) -> list[
     ]
 
 
-def forces(m: Mechanism, theta2: float, omega2: float, alpha2: float, masses, loads, extremes: bool = True) -> dict:
+def forces(
+    m: Mechanism, theta2: float, omega2: float, alpha2: float, masses, loads, extremes: bool = True, drive=None
+) -> dict:
     """With a mass model: the crank torque over the turn, the torque and every joint force at theta2 (N m, N)
-    and, with ``extremes``, the exact dynamic extremes over the turn and the flywheel (``records.dynamics``)."""
+    and, with ``extremes``, the exact dynamic extremes over the turn and the flywheel (``records.dynamics``); with
+    friction (the slide's or the pins') the efficiency of each stroke and of the turn (``m.efficiency``); with a
+    ``drive`` the motor's torque (``m.drive_check``). Every error of the masses, loads or drive is the panel's
+    (``panel_error``): a load the library cannot apply is refused, never dropped."""
     from qropt.dynamics.cycle import CycleDynamics
+    from qropt.dynamics.drive import Drive
     from qropt.dynamics.model import Loads, Masses
 
     if not isinstance(masses, dict) or (loads is not None and not isinstance(loads, dict)):
-        raise ApiError("masses and loads are objects in the form of Masses.to_dict and Loads.to_dict")
-    ms = Masses.from_dict(masses)
-    ld = Loads() if loads is None else Loads.from_dict(loads)
-    cd = CycleDynamics(m, omega2, alpha2, ms, ld)
-    if extremes:
-        out = records.dynamics(cd, ms, cd.extremes(), cd.flywheel(0.05) if alpha2 == 0 else None)
-    else:
-        out = {"type": type(m).__name__, "omega2": omega2, "alpha2": alpha2, "masses": ms.to_dict()}
-        out["loads"] = ld.to_dict()
-    th = np.linspace(0.0, 2 * math.pi, SAMPLES)
-    dy = cd.at(th)
+        raise ApiError("masses and loads are objects in the form of Masses.to_dict and Loads.to_dict", field="loads")
+    if drive is not None and not isinstance(drive, dict):
+        raise ApiError("drive is an object in the form of Drive.to_dict ({ratio, efficiency})", field="loads")
+    try:
+        ms = Masses.from_dict(masses)
+        ld = Loads() if loads is None else Loads.from_dict(loads)
+        dr = None if drive is None else Drive.from_dict(drive)
+        if dr is not None and alpha2 != 0:
+            raise ApiError("the drive is checked at a constant crank speed: alpha2 must be 0", field="loads")
+        cd = CycleDynamics(m, omega2, alpha2, ms, ld)
+        th = np.linspace(0.0, 2 * math.pi, SAMPLES)
+        dy = cd.at(th)
+        now = cd.at(np.array([theta2]))
+        if extremes:
+            out = records.dynamics(cd, ms, cd.extremes(), cd.flywheel(0.05) if alpha2 == 0 else None)
+            if alpha2 == 0 and (ld.friction or (ld.pin_friction is not None and ld.pin_friction.active)):
+                out["efficiency"] = efficiency(m.efficiency(omega2, masses=ms, loads=ld))
+            if dr is not None:
+                out["drive"] = drive_numbers(m.drive_check(dr, omega2, masses=ms, loads=ld))
+        else:
+            out = {"type": type(m).__name__, "omega2": omega2, "alpha2": alpha2, "masses": ms.to_dict()}
+            out["loads"] = ld.to_dict()
+    except ApiError:
+        raise
+    except QroptError as e:
+        raise panel_error(e) from None
     out["torque"] = {"theta2_deg": np.degrees(th).tolist(), "value": dy.torque.tolist()}
-    now = cd.at(np.array([theta2]))
     out["at"] = {
         "theta2_deg": math.degrees(theta2),
         "torque": float(now.torque[0]),
         "joint_forces": {k: [float(v[0, 0]), float(v[0, 1])] for k, v in sorted(now.joint_forces.items())},
     }
     return out
+
+
+def _finite(v):
+    return float(v) if math.isfinite(v) else None
+
+
+def efficiency(e) -> dict:
+    """``m.efficiency``'s strokes as plain data (J; an efficiency of NaN, where the loads do no work, as None)."""
+
+    def stroke(w):
+        return {
+            "input": w.input,
+            "output": w.output,
+            "friction": w.friction,
+            "pins": dict(w.pins),
+            "efficiency": _finite(w.efficiency),
+            "driven_by": w.driven_by,
+        }
+
+    return {"working": stroke(e.working), "return": stroke(e.return_stroke), "turn": stroke(e.turn)}
+
+
+def drive_numbers(dc) -> dict:
+    """``drive_check``'s figures at the motor (N m, rad/s, W; angles in degrees)."""
+    return {
+        "drive": dc.drive.to_dict(),
+        "peak_torque": {"value": dc.peak_torque.value, "theta2_deg": math.degrees(dc.peak_torque.theta2)},
+        "rms_torque": dc.rms_torque,
+        "mean_torque": dc.mean_torque,
+        "peak_power": {"value": dc.peak_power.value, "theta2_deg": math.degrees(dc.peak_power.theta2)},
+        "mean_power": dc.mean_power,
+        "motor_speed": dc.motor_speed,
+    }

@@ -32,7 +32,7 @@ def _solve(payload: dict, progress) -> dict:
 
 
 def _design(payload: dict, progress) -> dict:
-    """``design``'s arguments (masses and loads as dicts; ``time_limit`` the budget of the whole comparison): the
+    """``design``'s arguments (masses, loads and drive as dicts; ``time_limit`` the budget of the whole comparison): the
     Comparison's JSON, each row with the type its design opens as ("mechanism"), that type's parameter kinds
     ("kinds"), its certificate's global claim ("claim": with a budget, it names the strategies the budget left
     out), why it has no design in a sentence ("words", ``api.row_words``) and what makes a design doubtful
@@ -40,6 +40,7 @@ def _design(payload: dict, progress) -> dict:
     import json
 
     from qropt.app.api import row_warnings, row_words
+    from qropt.dynamics.drive import Drive
     from qropt.dynamics.model import Loads, Masses
     from qropt.mechanisms import type_reference
     from qropt.studies import design
@@ -50,6 +51,8 @@ def _design(payload: dict, progress) -> dict:
         args["masses"] = Masses.from_dict(args["masses"])
     if args.get("loads") is not None:
         args["loads"] = Loads.from_dict(args["loads"])
+    if args.get("drive") is not None:
+        args["drive"] = Drive.from_dict(args["drive"])
     total, done = len(_types(args.get("types") or list(TYPES))), [0]
 
     def step(k=1):

@@ -11,7 +11,7 @@ in one line; nothing a request sends stops the server.
 - ``GET /api/design/options``: what a design may ask for: the objectives (the criteria registry's), the types
   (``design``'s rows and the served user types) and the longest time budget
 - ``POST /api/design``: ``{time_ratio, stroke, objective}`` (optional ``bounds``, ``conditions``, ``types``,
-  ``omega2``, ``masses``, ``loads``, ``time_limit``) -> the Comparison (``Comparison.to_json``'s form)
+  ``omega2``, ``masses``, ``loads``, ``drive``, ``time_limit``) -> the Comparison (``Comparison.to_json``'s form)
 - ``POST /api/jobs``: ``{kind: solve | design | report, input}`` -> 202 and the job; ``GET /api/jobs/<id>``
   its state, progress and result; ``DELETE /api/jobs/<id>`` cancels it
 - ``POST /api/export/<dxf|svg|json>``: ``{type, params, units?, theta2?}`` -> the file
@@ -29,7 +29,8 @@ from qropt.app import api
 from qropt.app.defaults import remember
 from qropt.app.jobs import Busy, Jobs
 from qropt.cli import load_problem
-from qropt.dynamics.model import Loads, Masses
+from qropt.dynamics.drive import Drive
+from qropt.dynamics.model import Force, Loads, Masses
 from qropt.errors import QroptError
 from qropt.studies._design import task_problems
 
@@ -88,6 +89,7 @@ _DESIGN_FIELDS = (
     "units",
     "masses",
     "loads",
+    "drive",
     "time_limit",
 )
 
@@ -115,10 +117,10 @@ def _design_input(payload, max_time: float = math.inf) -> dict:
                 f"time_limit is at most {max_time:g} s, the app's limit of a job (qropt app --time-limit)"
             )
         out["time_limit"] = t
-    for k in ("bounds", "conditions", "masses", "loads"):
+    for k in ("bounds", "conditions", "masses", "loads", "drive"):
         if d.get(k) is not None:
             if not isinstance(d[k], dict):
-                raise api.ApiError(f"{k} is an object, got {type(d[k]).__name__}")
+                raise api.ApiError(f"{k} is an object, got {type(d[k]).__name__}", field=_PANEL.get(k))
             out[k] = d[k]
     if "omega2" in d:
         out["omega2"] = api.number(d, "omega2", low=-1e4, high=1e4)
@@ -129,12 +131,60 @@ def _design_input(payload, max_time: float = math.inf) -> dict:
             out[k] = d[k]
     if "bounds" in out:
         out["bounds"] = {k: tuple(v) if isinstance(v, list) else v for k, v in out["bounds"].items()}
-    task_problems(  # every argument checked here, before a job is queued
-        **{k: v for k, v in out.items() if k not in ("masses", "loads", "time_limit")},
-        masses=Masses.from_dict(out["masses"]) if "masses" in out else None,
-        loads=Loads.from_dict(out["loads"]) if "loads" in out else None,
-    )
+    try:
+        panel = {
+            "masses": Masses.from_dict(out["masses"]) if "masses" in out else None,
+            "loads": Loads.from_dict(out["loads"]) if "loads" in out else None,
+            "drive": Drive.from_dict(out["drive"]) if "drive" in out else None,
+        }
+    except QroptError as e:
+        raise api.panel_error(e) from None
+    plain = {k: v for k, v in out.items() if k not in ("masses", "loads", "drive", "time_limit")}
+    try:  # every argument checked here, before a job is queued
+        problems = task_problems(**plain, **panel)
+    except QroptError as e:
+        try:  # the same task with a plain mass model, no loads and a drive: the panel's fault if it passes
+            task_problems(**plain, masses=Masses(), loads=Loads(), drive=Drive(1.0))
+        except QroptError:
+            raise e from None
+        raise api.panel_error(e) from None
+    _loads_fit(problems, panel["masses"], panel["loads"])
     return out
+
+
+_PANEL = {"masses": "loads", "loads": "loads", "drive": "loads"}  # the request's fields the panel gives
+
+
+def _loads_fit(problems: dict, masses, loads) -> None:
+    """Each load and point mass at a joint or body of every row's type (as ``design`` builds it), else the panel's
+    400 naming the load and the row: a design checks this only when a row's solve reaches it."""
+    for row, p in problems.items():
+        where = api.row_points(row)
+        if not where["bodies"]:  # a type without a body declaration: the dynamic criteria refuse it by name
+            continue
+        name, joints, bodies = p.mechanism.__name__, where["joints"], where["bodies"]
+        for load in (*(loads.forces if loads else ()), *(loads.torques if loads else ())):
+            if isinstance(load, Force) and isinstance(load.at, str):
+                if load.at not in joints:
+                    raise api.ApiError(
+                        f"{load}: the {row} row's {name} has no joint {load.at!r}; its joints: {joints} "
+                        "(untick that type or choose another joint)",
+                        field="loads",
+                    )
+                continue
+            body = load.at[0] if isinstance(load, Force) else load.on
+            if body not in bodies:
+                raise api.ApiError(
+                    f"{load}: the {row} row's {name} has no body {body!r}; its bodies: {bodies} "
+                    "(untick that type or choose another body)",
+                    field="loads",
+                )
+        for joint in masses.points if masses else ():
+            if joint not in joints:
+                raise api.ApiError(
+                    f"the point mass at {joint}: the {row} row's {name} has no joint {joint!r}; its joints: {joints}",
+                    field="loads",
+                )
 
 
 def create_app(files=(), workers: int = 1, queue_size: int = 8, time_limit: float = 300.0):
@@ -162,7 +212,7 @@ def create_app(files=(), workers: int = 1, queue_size: int = 8, time_limit: floa
 
     @app.errorhandler(api.ApiError)
     def _api_error(e):
-        return jsonify(error=str(e)), e.status
+        return jsonify(error=str(e), **({"field": e.field} if e.field else {})), e.status
 
     @app.errorhandler(QroptError)
     def _qropt_error(e):

@@ -34,6 +34,11 @@ const HELP = {
   shaking: "peak shaking force: the largest force the mechanism puts on its frame over a turn",
   flywheel: "flywheel: the moment of inertia that keeps the crank's speed within a coefficient of fluctuation "
     + "Cs = 0.05 (plus or minus 2.5%)",
+  efficiency: "mechanical efficiency: the work the loads absorb over the work the crank gives (net of friction at "
+    + "the pins and the slide) over the working stroke and over the whole turn, at a steady omega2",
+  friction: "friction work: the energy the pins' and the slide's friction take per turn",
+  motor: "motor torque: the crank torque through the drive's gearbox, T / (i eta) where the motor drives and "
+    + "T eta / i where the crank drives it; the RMS is what heats the motor",
   objective: "objective: the quantity the solve makes as large (max_) or as small (min_) as it can",
   status: "status: optimal (certified best of its kind), feasible (meets the task, not proved best), infeasible (no "
     + "design exists within the bounds) or failed (none found)",
@@ -61,7 +66,11 @@ async function call(method, url, body) {
   const text = await r.text();
   let data = null;
   try { data = JSON.parse(text); } catch (e) { data = null; }
-  if (!r.ok) throw new Error((data && data.error) || `${r.status} ${r.statusText}`);
+  if (!r.ok) {
+    const e = new Error((data && data.error) || `${r.status} ${r.statusText}`);
+    e.field = data && data.field;  // "loads": the mass model and load panel's fault, said beside it
+    throw e;
+  }
   return data === null ? text : data;
 }
 
@@ -451,7 +460,8 @@ function table(tbl, head, rows, onPick) {
 const HELP_ROWS = [["time ratio", "time_ratio"], ["stroke", "stroke"], ["swing", "swing"], ["gamma_min", "gamma_min"],
   ["dead centres", "dead_centres"], ["peak acceleration", "peak_accel"], ["x ", "x"], ["v ", "v"], ["a ", "a"],
   ["theta4", "x"], ["omega4", "v"], ["alpha4", "a"], ["crank torque", "torque"], ["force at", "force"],
-  ["peak torque", "torque"], ["RMS torque", "rms"], ["peak shaking", "shaking"], ["flywheel", "flywheel"]];
+  ["peak torque", "torque"], ["RMS torque", "rms"], ["peak shaking", "shaking"], ["flywheel", "flywheel"],
+  ["efficiency", "efficiency"], ["friction work", "friction"], ["motor", "motor"]];
 function helpRows(tbl) {
   for (const tr of tbl.rows) {
     const text = tr.cells[0].textContent, hit = HELP_ROWS.find(([start]) => text.startsWith(start));
@@ -550,9 +560,38 @@ function showParams(type, params) {
 }
 
 // The mass model and load: one panel, built into every <div class="mass-model" data-prefix="P"> (the Mechanism
-// and Design pages), its inputs P-dyn (ticked: used), P-density, P-ram, P-force and P-gravity.
+// and Design pages), its inputs P-dyn (ticked: used), P-density, P-ram, P-force and P-gravity, and behind "more
+// loads" (P-more) the lists of forces, torques and point masses (rows in P-list-forces, -torques, -points), gravity's
+// direction P-gdir (deg from +x; -90 straight down), the slide's friction P-mu, pin friction P-pin-mu and
+// P-pin-r (every pin) and a drive P-ratio, P-eta (none while the ratio is empty). What the server refuses is said
+// in P-load-msg, beside the panel.
 const MASS_FIELDS = [["density", "links [kg/m]", 1.57, 0.1], ["ram", "ram [kg]", 20, 1],
   ["force", "cutting force [N]", 1000, 100], ["gravity", "gravity [m/s²]", 9.81, 0.1]];
+// The single inputs behind "more loads": key, label, default ("" none), step, help, and the group (a line) it is in.
+const MORE_FIELDS = [
+  ["gdir", "gravity direction [deg]", -90, 1, "the direction gravity pulls, in degrees counter-clockwise from +x: "
+    + "-90 straight down (-y); a vertical machine whose ram moves up and down has gravity along -x, 180", ""],
+  ["mu", "slide friction mu", 0, 0.01, "the ram's guide: a friction force mu |N| against the ram's velocity", ""],
+  ["pin-mu", "mu", 0, 0.01, "Coulomb friction at every pin (revolute joint): a moment mu r |F| against "
+    + "the pin's relative rotation; 0: none", "pin friction"],
+  ["pin-r", "radius [m]", 0.01, 0.001, "the radius r of every pin, for its friction moment mu r |F|", "pin friction"],
+  ["ratio", "ratio", "", 1, "a gearbox between motor and crank: motor speed / crank speed; empty: no drive", "drive"],
+  ["eta", "efficiency", 0.9, 0.01, "the gearbox's efficiency (0 to 1): the motor gives T / (i eta) where it "
+    + "drives, T eta / i where the crank drives it", "drive"],
+];
+const FIELD_TEXT = { "pin-mu": "pin friction mu", "pin-r": "pin radius", ratio: "drive ratio", eta: "drive efficiency" };
+const WINDOWS = [["working", "working"], ["return", "return"], ["always", "always"]];
+// The lists: each its add button, the heading over its rows and the button's help.
+const ROWS = {
+  forces: { add: "+ force", label: "forces: joint, N, direction, stroke", title: "a force at a joint: its magnitude "
+    + "(N), its direction (against the joint's motion, along the slide's +x, or at a fixed angle from +x) and the "
+    + "stroke it acts on" },
+  torques: { add: "+ torque", label: "torques: body, N m (counter-clockwise), stroke",
+    title: "a torque on a body (N m, counter-clockwise positive) over the strokes chosen" },
+  points: { add: "+ point mass", label: "point masses: joint, kg",
+    title: "a point mass (kg) at a joint, added to the body that carries it" },
+};
+
 function massPanel(div) {
   const p = div.dataset.prefix, fs = document.createElement("fieldset");
   fs.innerHTML = `<legend><label><input id="${p}-dyn" type="checkbox"> mass model and load</label></legend>`;
@@ -562,18 +601,232 @@ function massPanel(div) {
     label.append(`${text} `, input);
     fs.appendChild(label);
   }
+  const more = document.createElement("details");
+  more.id = `${p}-more`;
+  more.className = "more-loads";
+  more.innerHTML = `<summary id="${p}-more-sum">more loads</summary>`;
+  for (const [kind, { add, title, label }] of Object.entries(ROWS)) {
+    const list = document.createElement("div"), b = document.createElement("button");
+    list.id = `${p}-list-${kind}`;
+    list.className = "load-list";
+    list.dataset.label = label;
+    Object.assign(b, { type: "button", id: `${p}-add-${kind}`, textContent: add, title });
+    b.addEventListener("click", () => { addLoadRow(p, kind); panelChanged(p); });
+    more.append(list, b);
+  }
+  const singles = document.createElement("div"), groups = {};
+  singles.className = "load-singles";
+  for (const [k, text, value, step, help, group] of MORE_FIELDS) {
+    const label = document.createElement("label"), input = document.createElement("input");
+    Object.assign(input, { id: `${p}-${k}`, type: "number", value, step, className: "num" });
+    if (k === "ratio") input.placeholder = "none";
+    label.title = help;
+    label.append(`${text} `, input);
+    if (group && !groups[group]) {
+      groups[group] = document.createElement("div");
+      groups[group].className = "load-group";
+      groups[group].innerHTML = `<span class="group"></span>`;
+      groups[group].firstChild.textContent = group;
+      singles.appendChild(groups[group]);
+    }
+    (group ? groups[group] : singles).appendChild(label);
+  }
+  more.appendChild(singles);
+  fs.appendChild(more);
+  const msg = document.createElement("p");
+  Object.assign(msg, { id: `${p}-load-msg`, className: "msg bad load-msg" });
+  msg.setAttribute("role", "status");
+  fs.appendChild(msg);
   div.appendChild(fs);
+  fs.addEventListener("change", () => summarise(p));
 }
-// The panel's masses and loads (Masses.to_dict and Loads.to_dict forms), or null when not ticked.
+
+// The panel edited on the page that owns it: the Mechanism page analyses again, the Design page's rows go stale.
+function panelChanged(p) {
+  summarise(p);
+  if (p === "m") analyze();
+  else inputsChanged("design");
+}
+
+// Where loads may act on a panel's page: the Mechanism page's type ({joints, bodies, ram} of its design), or on the
+// Design page every ticked type's (each joint or body with the ticked types that lack it).
+function loadTargets(p) {
+  if (p === "m") {
+    const t = state.types[state.type] || {}, a = state.analysis && state.analysis.type_key === state.type ? state.analysis : t;
+    return { joints: a.joints || [], bodies: a.bodies || [], ram: a.ram || null, lack: {}, what: t.class };
+  }
+  const rows = (state.designTypes || []).filter((t) => $(`d-type-${t.name}`) && $(`d-type-${t.name}`).checked);
+  const joints = [...new Set(rows.flatMap((t) => t.joints))].sort(), bodies = [...new Set(rows.flatMap((t) => t.bodies))];
+  const lack = {};  // (joints are named in capitals, bodies in words: one map)
+  for (const [names, key] of [[joints, "joints"], [bodies, "bodies"]]) {
+    for (const n of names) {
+      const without = rows.filter((t) => !t[key].includes(n)).map((t) => t.name);
+      if (without.length) lack[n] = without;
+    }
+  }
+  const rams = rows.map((t) => t.ram).filter(Boolean);  // a new force's joint: the ram's of the most types
+  const ram = rams.sort((a, b) => rams.filter((r) => r === b).length - rams.filter((r) => r === a).length)[0] || null;
+  const what = rows.length && rows.length <= 2 ? rows.map((t) => t.name).join(", ") : "the types ticked";
+  return { joints, bodies, ram, lack, what };
+}
+
+// A select's options: the names given (each ticked type lacking it named), and its value kept even where the page's
+// type has no such name (said in the option: the server then refuses the load by name, never drops it).
+function fillSelect(sel, names, value, t) {
+  sel.innerHTML = "";
+  for (const n of names) {
+    const lack = t.lack[n] || [];
+    const o = new Option(lack.length > 1 ? `${n} (not in ${lack.length} types)` : lack.length ? `${n} (not ${lack[0]})` : n, n);
+    if (lack.length) o.title = `not in ${lack.join(", ")}: untick them, or the design refuses the load`;
+    sel.add(o);
+  }
+  if (value !== undefined && value !== null && value !== "") {
+    if (!names.includes(value)) sel.add(new Option(`${value} (not in ${t.what})`, value));
+    sel.value = value;
+  }
+}
+
+function rowInput(cls, value, step, title) {
+  const i = document.createElement("input");
+  Object.assign(i, { type: "number", step, value, className: `num ${cls}`, title });
+  return i;
+}
+function rowSelect(cls, options, value, title) {
+  const s = document.createElement("select");
+  s.className = cls;
+  s.title = title;
+  for (const [v, text] of options) s.add(new Option(text, v));
+  if (value !== undefined) s.value = value;
+  return s;
+}
+
+// One row of a list: a force {at, magnitude, direction: "against" | "slide" | angle in deg, window}, a torque
+// {on, magnitude, window} or a point mass {at, mass}.
+function addLoadRow(p, kind, v = {}) {
+  const t = loadTargets(p), row = document.createElement("div"), list = $(`${p}-list-${kind}`);
+  row.className = `load-row ${kind}`;
+  const place = document.createElement("select");
+  if (kind === "torques") {
+    place.className = "on";
+    place.title = "the body it acts on";
+    fillSelect(place, t.bodies, v.on ?? (t.bodies.find((b) => b !== "crank" && b !== "ram" && b !== "yoke") || t.bodies[0]), t);
+  } else {
+    place.className = "at";
+    place.title = "the joint it acts at";
+    fillSelect(place, t.joints, v.at ?? (t.ram || t.joints[0]), t);
+  }
+  row.appendChild(place);
+  if (kind === "forces") {
+    const dir = typeof v.direction === "number" ? "angle" : v.direction || "against";
+    const mag = rowInput("magnitude", v.magnitude ?? 500, 10, "N: a force's magnitude (its sign turns it)");
+    const d = rowSelect("direction", [["against", "against motion"], ["slide", "along slide +x"],
+      ["angle", "angle [deg]"]], dir, "its direction: against the joint's motion, along the slide's +x, or "
+      + "at a fixed angle from +x");
+    const ang = rowInput("angle", typeof v.direction === "number" ? v.direction : -90, 5, "deg from +x (-90: down)");
+    ang.hidden = dir !== "angle";
+    d.addEventListener("change", () => { ang.hidden = d.value !== "angle"; });
+    const w = rowSelect("window", WINDOWS, v.window || "working", "the stroke it acts on");
+    row.append(" ", mag, " N ", d, ang, " ", w);
+  } else if (kind === "torques") {
+    const mag = rowInput("magnitude", v.magnitude ?? 10, 1, "N m, counter-clockwise positive");
+    const w = rowSelect("window", WINDOWS, v.window || "always", "the stroke it acts on");
+    row.append(" ", mag, " N m ", w);
+  } else {
+    row.append(" ", rowInput("mass", v.mass ?? 2, 0.5, "kg at the joint"), " kg");
+  }
+  const x = document.createElement("button");
+  Object.assign(x, { type: "button", textContent: "×", className: "remove", title: "remove this row" });
+  x.setAttribute("aria-label", "remove");
+  x.addEventListener("click", () => { row.remove(); panelChanged(p); });
+  row.appendChild(x);
+  list.appendChild(row);
+  return row;
+}
+
+// The panel's selects refilled for the page's type(s), each value kept.
+function refreshTargets(p) {
+  const t = loadTargets(p);
+  for (const sel of document.querySelectorAll(`#${p}-more select.at, #${p}-more select.on`)) {
+    fillSelect(sel, sel.classList.contains("on") ? t.bodies : t.joints, sel.value, t);
+  }
+}
+
+// The panel's state as plain data: {forces, torques, points} rows and each single input (as typed).
+function panelState(p) {
+  const rows = (kind) => [...$(`${p}-list-${kind}`).children];
+  const val = (r, cls) => r.querySelector(`.${cls}`).value;
+  return {
+    forces: rows("forces").map((r) => ({ at: val(r, "at"), magnitude: val(r, "magnitude"),
+      direction: val(r, "direction") === "angle" ? Number(val(r, "angle")) : val(r, "direction"), window: val(r, "window") })),
+    torques: rows("torques").map((r) => ({ on: val(r, "on"), magnitude: val(r, "magnitude"), window: val(r, "window") })),
+    points: rows("points").map((r) => ({ at: val(r, "at"), mass: val(r, "mass") })),
+    ...Object.fromEntries(MORE_FIELDS.map(([k]) => [k, $(`${p}-${k}`).value])),
+  };
+}
+// Set the panel to a state (panelState's form; what it lacks at its default).
+function setPanel(p, st) {
+  for (const kind of Object.keys(ROWS)) {
+    $(`${p}-list-${kind}`).innerHTML = "";
+    for (const v of st[kind] || []) addLoadRow(p, kind, v);
+  }
+  for (const [k, , value] of MORE_FIELDS) $(`${p}-${k}`).value = st[k] ?? value;
+  summarise(p);
+}
+const isDefault = (p, k) => String($(`${p}-${k}`).value) === String(MORE_FIELDS.find((f) => f[0] === k)[2]);
+// "more loads (2 forces, pin friction)": what the closed section holds.
+function summarise(p) {
+  const st = panelState(p), parts = [];
+  const n = (k, one) => { if (st[k].length) parts.push(`${st[k].length} ${one}${st[k].length > 1 ? "s" : ""}`); };
+  n("forces", "force"); n("torques", "torque"); n("points", "point mass");
+  if (!isDefault(p, "gdir")) parts.push(`gravity at ${st.gdir}°`);
+  if (Number(st.mu)) parts.push("slide friction");
+  if (Number(st["pin-mu"])) parts.push("pin friction");
+  if (st.ratio !== "") parts.push("drive");
+  $(`${p}-more-sum`).textContent = parts.length ? `more loads (${parts.join(", ")})` : "more loads";
+}
+
+// A number as the library reads it: "" and text stay as given (the server says what is wrong with them).
+const asNumber = (v) => (v === "" || v === null || v === undefined ? v : (Number.isFinite(Number(v)) ? Number(v) : v));
+// A unit vector at deg degrees from +x, with the exact zeros of the axes (-90 deg: (0, -1), not (6e-17, -1)).
+function unitAt(deg) {
+  const r = deg * DEG, snap = (x) => (Math.abs(x) < 1e-12 ? 0 : x);
+  return [snap(Math.cos(r)), snap(Math.sin(r))];
+}
+
+// The panel's masses and loads (Masses.to_dict and Loads.to_dict forms) and its drive (Drive.to_dict's), or null
+// when not ticked. Everything shown is sent: the server applies it or says why it cannot.
 function massModel(p) {
   if (!$(`${p}-dyn`).checked) return null;
-  const v = (k) => Number($(`${p}-${k}`).value);
-  return { masses: { density: v("density"), ram: v("ram"), block: 0, bodies: {} },
-    loads: { cutting_force: v("force"), friction: 0, gravity: v("gravity"), follower_torque: 0 } };
+  const v = (k) => asNumber($(`${p}-${k}`).value), st = panelState(p);
+  const masses = { density: v("density"), ram: v("ram"), block: 0, bodies: {} };
+  if (st.points.length) masses.points = Object.fromEntries(st.points.map((r) => [r.at, asNumber(r.mass)]));
+  const g = v("gravity"), gdir = asNumber(st.gdir);
+  let gravity = g;
+  if (typeof gdir !== "number") gravity = [g, gdir];  // (the server says gravity's direction is not a number)
+  else if (((gdir % 360) + 360) % 360 !== 270 && typeof g === "number") gravity = unitAt(gdir).map((c) => g * c);
+  const loads = { cutting_force: v("force"), friction: asNumber(st.mu), gravity, follower_torque: 0 };
+  if (st.forces.length) {
+    loads.forces = st.forces.map((f) => ({ at: f.at, magnitude: asNumber(f.magnitude),
+      direction: typeof f.direction === "number" ? unitAt(f.direction) : f.direction, window: f.window }));
+  }
+  if (st.torques.length) loads.torques = st.torques.map((t) => ({ on: t.on, magnitude: asNumber(t.magnitude), window: t.window }));
+  const pinMu = asNumber(st["pin-mu"]);
+  if (pinMu !== 0 && pinMu !== "") loads.pin_friction = { mu: pinMu, radius: asNumber(st["pin-r"]) };
+  const out = { masses, loads };
+  if (st.ratio !== "") out.drive = { ratio: asNumber(st.ratio), efficiency: asNumber(st.eta) };
+  return out;
 }
+// The panel as a results note names its inputs: each field, and each list and single load where it has any.
 function massInputs(p) {
   if (!$(`${p}-dyn`).checked) return {};
-  return Object.fromEntries(MASS_FIELDS.map(([k, text]) => [text.split(" [")[0], $(`${p}-${k}`).value]));
+  const out = Object.fromEntries(MASS_FIELDS.map(([k, text]) => [text.split(" [")[0], $(`${p}-${k}`).value]));
+  const st = panelState(p);
+  const dirText = (d) => (typeof d === "number" ? `${d}°` : d);
+  if (st.forces.length) out.forces = st.forces.map((f) => `${f.at} ${f.magnitude} N ${dirText(f.direction)} ${f.window}`).join("; ");
+  if (st.torques.length) out.torques = st.torques.map((t) => `${t.on} ${t.magnitude} N m ${t.window}`).join("; ");
+  if (st.points.length) out["point masses"] = st.points.map((r) => `${r.at} ${r.mass} kg`).join("; ");
+  for (const [k, text] of MORE_FIELDS) if (!isDefault(p, k)) out[FIELD_TEXT[k] || text.split(" [")[0]] = st[k];
+  return out;
 }
 
 // The Mechanism page's inputs as shown (lengths in the unit, angles in degrees).
@@ -596,10 +849,18 @@ function request(frames) {
   return body;
 }
 
+// What the server refused of the panel, beside it ("" clears it).
+function panelSays(p, e) {
+  say(`${p}-load-msg`, e && e.field === "loads" ? e.message : "", true);
+}
+
 // ---- the state in the URL: the page in its hash, the Mechanism page's design in its query -------------------
 // ?type=drag-link-slider&r1=0.1&...&theta2=60&omega2=10&mass=1.57,20,1000,9.81: the parameters as the library
 // takes them (lengths in the unit, angles in rad), theta2 in deg, omega2 in rad/s, the mass model (links kg/m,
-// ram kg, cutting force N, gravity m/s²) only when it is ticked. A burst of edits (a slider dragged) is one
+// ram kg, cutting force N, gravity m/s²) only when it is ticked, and with it the panel's other loads:
+// force=D,500,against,working (joint, N, against | slide | an angle in deg, working | return | always) and
+// torque=lever,10,always (body, N m, window), one each; point=C,2 (joint, kg); gdir=-90, mu, pin=mu,radius and
+// drive=ratio,efficiency where they differ from the defaults. A burst of edits (a slider dragged) is one
 // entry of the browser's history: the first edit after a pause adds an entry, the next ones rewrite it.
 const EDIT_PAUSE = 1000;  // ms
 let lastEdit = -Infinity;
@@ -609,7 +870,16 @@ function stateQuery() {
   for (const [k, v] of Object.entries(state.params)) q.set(k, String(v));
   q.set("theta2", $("m-theta").value);
   q.set("omega2", $("m-omega").value);
-  if ($("m-dyn").checked) q.set("mass", MASS_FIELDS.map(([k]) => $(`m-${k}`).value).join(","));
+  if ($("m-dyn").checked) {
+    q.set("mass", MASS_FIELDS.map(([k]) => $(`m-${k}`).value).join(","));
+    const st = panelState("m");
+    for (const f of st.forces) q.append("force", [f.at, f.magnitude, f.direction, f.window].join(","));
+    for (const t of st.torques) q.append("torque", [t.on, t.magnitude, t.window].join(","));
+    for (const r of st.points) q.append("point", [r.at, r.mass].join(","));
+    for (const k of ["gdir", "mu"]) if (!isDefault("m", k)) q.set(k, st[k]);
+    if (!isDefault("m", "pin-mu") || !isDefault("m", "pin-r")) q.set("pin", [st["pin-mu"], st["pin-r"]].join(","));
+    if (st.ratio !== "" || !isDefault("m", "eta")) q.set("drive", [st.ratio, st.eta].join(","));
+  }
   return q;
 }
 function keepState() {
@@ -646,10 +916,44 @@ function fromURL() {
   if (q.has("mass")) {
     const m = q.get("mass").split(",").map(Number);
     if (m.length === MASS_FIELDS.length && m.every(Number.isFinite)) out.mass = m; else bad.push("mass");
+    out.panel = panelFromQuery(q, bad);
   }
-  if (bad.length) say("m-url-msg", `The link's ${bad.join(", ")} ${bad.length > 1 ? "are" : "is"} not a number: left as before.`, true);
+  if (bad.length) say("m-url-msg", `The link's ${bad.join(", ")} ${bad.length > 1 ? "do" : "does"} not read: left as before.`, true);
   return out;
 }
+// The panel's loads a link names (setPanel's form); each one that does not read is named in `bad` and left out.
+function panelFromQuery(q, bad) {
+  const nums = (text, n) => { const v = text.split(","); return v.length === n ? v : null; };
+  const finite = (x) => x !== "" && Number.isFinite(Number(x));
+  const windows = WINDOWS.map((w) => w[0]), out = { forces: [], torques: [], points: [] };
+  for (const text of q.getAll("force")) {
+    const v = nums(text, 4);
+    const dirOk = v && (["against", "slide"].includes(v[2]) || finite(v[2]));
+    if (v && v[0] && finite(v[1]) && dirOk && windows.includes(v[3])) {
+      out.forces.push({ at: v[0], magnitude: Number(v[1]), direction: finite(v[2]) ? Number(v[2]) : v[2], window: v[3] });
+    } else bad.push(`force ${text}`);
+  }
+  for (const text of q.getAll("torque")) {
+    const v = nums(text, 3);
+    if (v && v[0] && finite(v[1]) && windows.includes(v[2])) out.torques.push({ on: v[0], magnitude: Number(v[1]), window: v[2] });
+    else bad.push(`torque ${text}`);
+  }
+  for (const text of q.getAll("point")) {
+    const v = nums(text, 2);
+    if (v && v[0] && finite(v[1])) out.points.push({ at: v[0], mass: Number(v[1]) }); else bad.push(`point ${text}`);
+  }
+  for (const k of ["gdir", "mu"]) if (q.has(k)) { if (finite(q.get(k))) out[k] = Number(q.get(k)); else bad.push(k); }
+  const pair = (k, a, b, emptyFirst) => {
+    if (!q.has(k)) return;
+    const v = nums(q.get(k), 2);
+    if (v && (finite(v[0]) || (emptyFirst && v[0] === "")) && finite(v[1])) { out[a] = v[0] === "" ? "" : Number(v[0]); out[b] = Number(v[1]); }
+    else bad.push(k);
+  };
+  pair("pin", "pin-mu", "pin-r", false);
+  pair("drive", "ratio", "eta", true);
+  return out;
+}
+
 // The Mechanism page set to the design the URL names; false if it names none.
 function applyURL() {
   const u = fromURL();
@@ -658,6 +962,9 @@ function applyURL() {
   if (u.omega2 !== undefined) $("m-omega").value = u.omega2;
   $("m-dyn").checked = !!u.mass;
   if (u.mass) MASS_FIELDS.forEach(([k], i) => { $(`m-${k}`).value = u.mass[i]; });
+  state.type = u.type;  // (the panel's joints and bodies are this type's)
+  setPanel("m", u.panel || {});
+  $("m-more").open = $("m-more-sum").textContent !== "more loads";
   state.restoring = true;
   showParams(u.type, u.params);
   return true;
@@ -670,18 +977,23 @@ async function analyze() {
   state.inflight = true;
   state.pending = false;
   stopAnimation();
-  const asked = mechanismInputs();
+  const asked = mechanismInputs(), type = state.type;
   try {
     const a = await call("POST", "/api/analyze", request(0));
+    a.type_key = type;
     state.analysis = a;
     state.updates += 1;
     state.answers += 1;
     showAnalysis(a);
     fresh("mechanism", asked);
     say("m-play-msg", "");
+    panelSays("m", null);
+    const key = JSON.stringify([a.joints, a.bodies]);
+    if (key !== state.targetsKey) { state.targetsKey = key; refreshTargets("m"); }
   } catch (e) {
     state.answers += 1;
     stale("mechanism", e.message);
+    panelSays("m", e);
   } finally {
     state.inflight = false;
     if (state.pending) analyze();
@@ -697,8 +1009,14 @@ async function loadFrames() {
     const a = await call("POST", "/api/analyze", request(72));
     if (asked !== state.updates) return;  // the design moved on meanwhile
     state.frames = a.drawing;
-    if (a.dynamics) showForces(a.dynamics, Number($("m-theta").value), a.cycle.working);
-  } catch (e) { state.frames = null; }
+    if (a.dynamics) {
+      state.analysis.dynamics = a.dynamics;  // (a redraw shows the exact peaks too)
+      showForces(a.dynamics, Number($("m-theta").value), a.cycle.working);
+    }
+  } catch (e) {
+    state.frames = null;
+    if (asked === state.updates && e.field === "loads") { stale("mechanism", e.message); panelSays("m", e); }
+  }
 }
 
 function showAnalysis(a) {
@@ -758,8 +1076,23 @@ function showForces(dy, th, working) {
     rows.push(["RMS torque [N m]", fmt(dy.rms_torque, 5)]);
     rows.push(["peak shaking force [N]", fmt(dy.peak_shaking_force, 5)]);
     if (dy.flywheel) rows.push(["flywheel for Cs 0.05 [kg m²]", fmt(dy.flywheel.inertia, 5)]);
+    if (dy.efficiency) {
+      const eff = (w) => (w.efficiency === null ? "- (the loads do no work)"
+        : `${fmt(100 * w.efficiency, 4)} %` + (w.driven_by === "loads" ? " (the loads drive)" : ""));
+      rows.push(["efficiency, working stroke", eff(dy.efficiency.working)]);
+      rows.push(["efficiency, turn", eff(dy.efficiency.turn)]);
+      rows.push(["friction work per turn [J]", fmt(dy.efficiency.turn.friction, 5)]);
+    }
+    if (dy.drive) {
+      rows.push(["motor peak torque [N m]", `${fmt(dy.drive.peak_torque.value, 5)} at ${dy.drive.peak_torque.theta2_deg.toFixed(2)} deg`]);
+      rows.push(["motor RMS torque [N m]", fmt(dy.drive.rms_torque, 5)]);
+      rows.push(["motor speed [rad/s]", fmt(dy.drive.motor_speed, 5)]);
+    }
   } else {
     rows.push(["peak torque [N m]", "(when the inputs rest)"]);
+    const m = massModel("m");
+    if (m && (m.loads.friction || m.loads.pin_friction)) rows.push(["efficiency", "(when the inputs rest)"]);
+    if (m && m.drive) rows.push(["motor torque [N m]", "(when the inputs rest)"]);
   }
   table($("m-forces"), ["at theta2", "value"], rows);
   helpRows($("m-forces"));
@@ -805,7 +1138,8 @@ function openDesign(type, params) {
 // within a time budget), the rows ranked, each with its picture.
 function objectiveOptions(select, entries, first = true) {
   for (const o of entries) {
-    const text = o.objective + (o.size ? ` (${o.size})` : "") + ` — ${o.label}` + (o.dynamic ? ", mass model" : "");
+    const text = o.objective + (o.size ? ` (${o.size})` : "") + ` — ${o.label}`
+      + (o.drive ? ", mass model and drive" : o.dynamic ? ", mass model" : "");
     const opt = new Option(text, o.criterion);
     opt.dataset.dynamic = o.dynamic ? "1" : "";
     select.add(opt);
@@ -820,9 +1154,15 @@ function chosenObjective(select) {
 }
 
 // A dynamic objective needs the mass model and gets a time budget (30 s) unless one was typed; a kinematic one none.
+// One that needs the drive also opens "more loads" and gives the drive a ratio of 10 if it has none.
 function designObjectiveChanged() {
   const o = state.objectives[$("d-objective").value], b = $("d-budget");
   if (o.dynamic) $("d-dyn").checked = true;
+  if (o.drive) {
+    $("d-more").open = true;
+    if ($("d-ratio").value === "") $("d-ratio").value = 10;
+    summarise("d");
+  }
   if (!b.dataset.typed) b.value = o.dynamic ? 30 : "";
 }
 
@@ -868,9 +1208,11 @@ async function runDesign(ev) {
     state.designRows = c.rows;
     showDesign(c, input);
     fresh("design", asked);
+    panelSays("d", null);
   } catch (e) {
     $("d-progress").textContent = "";
     stale("design", e.message);
+    panelSays("d", e);
   } finally {
     $("d-run").disabled = false;
   }
@@ -887,7 +1229,8 @@ function showDesign(c, input) {
     ["peak_accel", `peak accel ${at} [${unitText(u.peak_accel)}]`]];
   if (!cols.some((col) => col[0] === obj.criterion)) {
     const deg = obj.unit === "rad";
-    cols.push([obj.criterion, `${obj.label} [${deg ? "deg" : unitText(u[obj.criterion])}]`, deg ? (v) => fmt(v / DEG, 4) : fmt]);
+    const unit = deg ? "deg" : unitText(u[obj.criterion] || obj.unit.replace(/length/g, length));
+    cols.push([obj.criterion, `${obj.label} [${unit}]`, deg ? (v) => fmt(v / DEG, 4) : fmt]);
   }
   if (input.masses && obj.criterion !== "peak_torque") cols.push(["peak_torque", `peak torque [${u.peak_torque}]`]);
   const head = ["#", "type", "status", ...cols.map((col) => col[1]), `parameters [${length}; angles in deg]`,
@@ -953,7 +1296,7 @@ async function designPictures(rows, obj, u) {
     card.querySelector("strong").textContent = r.type;
     const deg = obj.unit === "rad";
     card.querySelector("span").textContent = `${obj.label} ${fmt(deg ? r[obj.criterion] / DEG : r[obj.criterion], 4)}`
-      + `${deg ? " deg" : " " + unitText(u[obj.criterion])}, ${r.status}` + ((r.warnings || []).length ? ", doubtful" : "");
+      + `${deg ? " deg" : " " + unitText(u[obj.criterion] || obj.unit)}, ${r.status}` + ((r.warnings || []).length ? ", doubtful" : "");
     const svg = el("svg", { role: "img" }, card);
     card.addEventListener("click", () => openDesign(r.mechanism, r.params));
     box.appendChild(card);
@@ -1325,6 +1668,8 @@ async function start() {
   $("s-objective").add(new Option("none — any design meeting the task", ""));
   objectiveOptions($("s-objective"), options.objectives.filter((o) => !o.dynamic));  // (a file's dynamic one is added)
   designTypes(options.types);
+  state.designTypes = options.types;
+  $("d-types").addEventListener("change", () => refreshTargets("d"));
   $("d-budget").max = options.time_limit;
   $("d-objective").addEventListener("change", designObjectiveChanged);
   $("d-budget").addEventListener("input", () => { $("d-budget").dataset.typed = "1"; });
@@ -1341,7 +1686,8 @@ async function start() {
   $("m-type").addEventListener("change", () => showParams($("m-type").value, state.types[$("m-type").value].params));
   $("m-theta").addEventListener("input", () => { $("m-theta-n").value = $("m-theta").value; analyze(); });
   $("m-theta-n").addEventListener("change", () => { $("m-theta").value = $("m-theta-n").value; analyze(); });
-  for (const id of ["m-omega", "m-dyn", "m-density", "m-ram", "m-force", "m-gravity"]) $(id).addEventListener("change", analyze);
+  $("m-omega").addEventListener("change", analyze);
+  document.querySelector(".mass-model[data-prefix='m']").addEventListener("change", analyze);  // every input of the panel
   $("m-play").addEventListener("click", play);
   $("design-form").addEventListener("submit", runDesign);
   $("s-type").addEventListener("change", typeChanged);
