@@ -90,35 +90,60 @@ def evaluate(m, s, resolved, pts, t, working, x, sense: float, rate: float, ends
     ``sense``: the sign that turns the rates into the motion's direction (1 for the actual motion's rates, the sense
     of rotation for rates per unit crank angle), ``rate``: |omega2| (rad/s), or 1 per unit crank angle; ``ends``:
     the way (+1 or -1 along x) the output moves at each angle where its stroke is given (a stroke closed at its
-    dead centres), which a force against the output's velocity resists where the output is at rest, or None."""
-    bodies = {b.name: b for b in s.bodies}
+    dead centres), which a force against the output's velocity resists where the output is at rest, or None.
+    ``geometry`` and then ``act``."""
     size = max(float(np.max(np.hypot(px[0], py[0]))) for px, py in pts.values())
-    rest = AT_REST * rate * max(size, 1e-300)
+    return act(s, resolved, geometry(s, resolved, pts), t, working, x, sense, rest(size, rate), ends)
+
+
+def rest(size: float, rate: float) -> float:
+    """The speed (m/s, or m per unit crank angle) below which a point is at rest, for a mechanism whose joints lie
+    within ``size`` (m) of the origin at crank speed ``rate``."""
+    return AT_REST * rate * max(size, 1e-300)
+
+
+def geometry(s, resolved, pts, coords=None) -> list[tuple]:
+    """Each resolved load's point (x, y) (m), the point's velocity (x, y) and its body's angular velocity, from the
+    joints' triples ``pts``: numbers, arrays or CasADi expressions alike (the compiled dynamics computes them in its
+    kernel). A torque's point is its body's origin, its velocity zero. ``coords``: per load, the body point's
+    (x, y) in its frame to use instead of the load's own (the kernel's inputs), or None."""
+    bodies = {b.name: b for b in s.bodies}
     out = []
-    for load, name in resolved:
+    for i, (load, name) in enumerate(resolved):
         b = bodies[name]
         (ox, oy), rot = frame(b, pts)
         spin = rot[2]
+        if not isinstance(load, Force):
+            out.append(((ox[0], oy[0]), (0.0, 0.0), spin))
+        elif isinstance(load.at, str):
+            px, py = pts[load.at][0][0], pts[load.at][1][0]
+            out.append(((px, py), (ox[1] - spin * (py - oy[0]), oy[1] + spin * (px - ox[0])), spin))
+        else:
+            p, v, _, _ = body_motion(b, load.at[1:] if coords is None else coords[i], pts)
+            out.append((p, v, spin))
+    return out
+
+
+def act(s, resolved, geo, t, working, x, sense: float, still: float, ends=None) -> list[Applied]:
+    """The resolved loads at crank angles t from their ``geometry`` (numpy, arrays or numbers): each one's amount
+    (its magnitude or table times its window) and its force's direction; ``still``: the speed below which a point
+    is at rest (``rest``); the other arguments as ``evaluate``'s."""
+    out = []
+    for (load, name), ((px, py), (vx, vy), spin) in zip(resolved, geo, strict=True):
         arg = x if load.against == "x" else np.mod(t, TWO_PI)
         amount = level(load.magnitude, arg) * load.window.active(t, working, x)
         if not isinstance(load, Force):
             zero = np.zeros(t.shape)
-            out.append(Applied(name, (ox[0] + zero, oy[0] + zero), (zero, zero), (zero, zero), amount, spin))
+            out.append(Applied(name, (px + zero, py + zero), (zero, zero), (zero, zero), amount, spin))
             continue
-        if isinstance(load.at, str):
-            (px, py) = (pts[load.at][0][0], pts[load.at][1][0])
-            v = (ox[1] - spin * (py - oy[0]), oy[1] + spin * (px - ox[0]))
-        else:
-            (px, py), v, _, _ = body_motion(b, load.at[1:], pts)
-        px, py = np.broadcast_to(px, t.shape), np.broadcast_to(py, t.shape)
-        vx, vy = np.broadcast_to(v[0], t.shape), np.broadcast_to(v[1], t.shape)
+        px, py, vx, vy = (_full(v, t.shape) for v in (px, py, vx, vy))
         d = load.direction
         if d == "against":
             speed = np.hypot(vx, vy)
-            moving = speed > rest
-            inv = np.where(moving, -sense / np.where(moving, speed, 1.0), 0.0)
+            moving = speed > still
+            inv = np.divide(-sense, speed, out=np.zeros(t.shape), where=moving)  # 0 at rest
             fx, fy = amount * vx * inv, amount * vy * inv
-            if ends is not None and b.kind in ("ram", "yoke"):  # at a dead centre: the limit along its stroke
+            if ends is not None and s.kind(name) in ("ram", "yoke"):  # at a dead centre: the limit along its stroke
                 fx = np.where(moving, fx, -amount * ends)
         elif d == "slide":
             fx, fy = amount, np.zeros(t.shape)
@@ -127,6 +152,22 @@ def evaluate(m, s, resolved, pts, t, working, x, sense: float, rate: float, ends
             fx, fy = amount * (d[0] / n), amount * (d[1] / n)
         out.append(Applied(name, (px, py), (vx, vy), (fx, fy), 0.0, spin))
     return out
+
+
+def _full(v, shape):
+    """v as an array of the given shape (itself where it is one)."""
+    return v if getattr(v, "shape", None) == shape else np.broadcast_to(v, shape)
+
+
+def rows(s, ap: Applied, centre) -> list[tuple]:
+    """What a load takes off the Newton-Euler system's right-hand side (known external loads leave it), as
+    (row, value): its force (fx, fy) on its body's x and y rows and its moment about the body's centre of mass
+    ``centre`` (x, y) (m), (p - G) x F plus its torque, on the moment row (a point ram has none)."""
+    r = s.rows[ap.body]
+    (fx, fy), (px, py) = ap.force, ap.point
+    if s.kind(ap.body) == "ram":
+        return [(r, fx), (r + 1, fy)]
+    return [(r, fx), (r + 1, fy), (r + 2, (px - centre[0]) * fy - (py - centre[1]) * fx + ap.torque)]
 
 
 def edges(m, loads: Loads) -> list[float]:
@@ -161,4 +202,4 @@ def edges(m, loads: Loads) -> list[float]:
     return sorted(angles)
 
 
-__all__ = ["Applied", "carrier", "resolve", "evaluate", "edges", "joints_of"]
+__all__ = ["Applied", "carrier", "resolve", "evaluate", "geometry", "act", "rows", "rest", "edges", "joints_of"]

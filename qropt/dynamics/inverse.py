@@ -10,12 +10,14 @@ massive crank-pin block and its slot. A massless block (the default) passes its 
 the lever along the slot's normal. Friction on the slide (mu |N| against the ram's velocity) makes the system
 depend on N; as the system is linear in a load on the ram, N has a closed form (``friction_load``), the same in
 the exact analysis and in the NLP. General loads (forces at points, torques on bodies, a gravity vector:
-``applied``) are known external forces and moments on the right-hand side, solved on the jets in numpy. SI units
+``applied``) are known external forces and moments on the right-hand side: the compiled kernel solves them as it
+solves the shorthands (``compiled``), the jets and numpy where it cannot (pin friction, a singular angle). SI units
 throughout.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -24,7 +26,7 @@ import numpy as np
 from qropt import units as units_
 from qropt.dynamics import applied, compiled
 from qropt.dynamics.elimination import Elimination, Parts, pivots
-from qropt.dynamics.model import BodyMass, Loads, Masses, slender_bar, union
+from qropt.dynamics.model import BodyMass, Loads, Masses, Window, slender_bar, union
 from qropt.dynamics.rigid import body_motion, is_zero, shaking
 from qropt.errors import DegenerateMechanism, InvalidParameter, PinLocked, SlideLocked, UnsupportedLoad
 from qropt.kinematics.ops import JET, Jet
@@ -271,6 +273,7 @@ class _System:
                 if not (c.receiver == block.name and c.kind == "pin")
             ]
         self.bodies = bodies
+        self.kinds = {b.name: b.kind for b in bodies}  # the system's bodies' kinds (``kind``)
         self.conns = conns
         self.ground = set(link.ground_joints())
         rows, n = {}, 0
@@ -307,7 +310,7 @@ class _System:
         return self.rows["follower"] + 2 if "follower" in self.rows else None
 
     def kind(self, body: str) -> str:
-        return next(b.kind for b in self.bodies if b.name == body)
+        return self.kinds[body]
 
     def assemble(self, P, kin, g, sqrt):
         """The Newton-Euler system as entries: ({(row, column): value}, {row: value}), the values numpy arrays
@@ -435,17 +438,20 @@ def _loaded(m, s: _System, t, omega2, alpha2, loads, working=None, keep=None) ->
         known = np.where(working, loads.cutting_force * way, 0.0)
     elif out_body is None and loads.follower_torque and m.OUTPUT == "follower":
         known = np.where(working, loads.follower_torque * way, 0.0)
-    general = applied.resolve(m, s, linkage_of(m), loads) if loads.general else None
-    # the compiled kernel takes the shorthands only: general loads take the jets and numpy
-    # (and pin friction, which needs the elimination itself: ``keep``)
+    general = _resolved(m, s, loads) if loads.forces or loads.torques or isinstance(loads.gravity, tuple) else None
+    ends = np.where(working, way, -way) if forced and way else None
+    extra = None if general is None else (loads, general, working, ends)
+    # the compiled kernel, general loads included; pin friction needs the elimination itself (``keep``): the jets
+    # and numpy, as every angle where the kernel's rows are not finite
     a = (
         None
-        if general is not None or keep is not None
-        else compiled.parts(m, s, t, omega2, alpha2, loads.gravity, k, known, table or sliding, loads)
+        if keep is not None
+        else compiled.parts(m, s, t, omega2, alpha2, loads.gravity, k, known, table or sliding, loads, extra)
     )
-    if a is None:
-        ends = np.where(working, way, -way) if forced and way else None
-        extra = None if general is None else (loads, general, working, ends)
+    if a is None and keep is None:  # rows the kernel found not finite: the jets give them, singular angles as NaN
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            a = _numpy_parts(m, s, t, omega2, alpha2, loads.gravity, k, known, extra, keep)
+    elif a is None:
         a = _numpy_parts(m, s, t, omega2, alpha2, loads.gravity, k, known, extra, keep)
     # along x, through the ram's point (no moment about a yoke's centre on its line)
     load = np.where(working, loads.force_at(a.x_out), 0.0) * way if table else None
@@ -454,6 +460,17 @@ def _loaded(m, s: _System, t, omega2, alpha2, loads, working=None, keep=None) ->
     if not sliding:
         return a, load, None, None
     return a, load, guide_col, _velocity_sign(a, working, way, forced)
+
+
+def _resolved(m, s: _System, loads: Loads) -> list[tuple]:
+    """``applied.resolve`` of the loads on m, kept on the system (of one mechanism and mass model) for the loads
+    last asked (the same object: a cycle's solves share it)."""
+    cached = s.__dict__.get("_resolved")
+    if cached is not None and cached[0] is loads:
+        return cached[1]
+    out = applied.resolve(m, s, linkage_of(m), loads)
+    s.__dict__["_resolved"] = (loads, out)
+    return out
 
 
 def _singular(m) -> DegenerateMechanism:
@@ -882,12 +899,8 @@ def _apply(m, s: _System, t, omega2, k, pts, kin, rows, loads, resolved, working
     joint = m.output_joint()
     x = pts[joint][0][0] / k if joint is not None else None
     for ap in applied.evaluate(m, s, resolved, pts, t, working, x, 1.0, abs(omega2), ends):
-        r, (gx, gy) = s.rows[ap.body], kin[ap.body][0]
-        (fx, fy), (px, py) = ap.force, ap.point
-        sub(r, fx)
-        sub(r + 1, fy)
-        if s.kind(ap.body) != "ram":
-            sub(r + 2, (px - gx) * fy - (py - gy) * fx + ap.torque)
+        for r, v in applied.rows(s, ap, kin[ap.body][0]):
+            sub(r, v)
 
 
 def _pairs(a, b, n) -> np.ndarray:
@@ -957,6 +970,24 @@ def generalised(m, theta2, *, masses=None, loads=None, sense: float = 1.0) -> Ge
     return Generalised(t, M, dM, Q)
 
 
+def loads_at(m, theta2, omega2: float, masses=None, loads=None, *, opened: bool = False) -> tuple:
+    """Each force and torque of ``loads`` at crank angles theta2 (rad) and omega2 (rad/s) as the exact analysis
+    applies them: (the (load, body) pairs of ``applied.resolve``, their ``applied.Applied``, where the output is on
+    its working stroke (a bool array), the output's x (the mechanism's unit) or None). ``opened``: every window
+    open (what a load shut there would carry)."""
+    t = m._angles(theta2)
+    loads = Loads() if loads is None else loads
+    s = system_of(m, Masses() if masses is None else masses)
+    k = units_.to_metres(m.units)
+    pts = _triples(m.evaluate(JET, Jet.seed(t, omega2, 0.0)), k)
+    working = _working(m, t, omega2, working_way(m, loads, omega2))
+    joint = m.output_joint()
+    x = pts[joint][0][0] / k if joint is not None else None
+    resolved = applied.resolve(m, s, linkage_of(m), loads)
+    pairs = [(dataclasses.replace(ld, window=Window()), b) for ld, b in resolved] if opened else resolved
+    return resolved, applied.evaluate(m, s, pairs, pts, t, working, x, 1.0, abs(omega2)), working, x
+
+
 def working_way(m, loads: Loads, omega2: float) -> str | None:
     """The way the output moves on the working stroke: the slow stroke's ('+x' or '-x'), or where the strokes take
     equal time (TR = 1) the one the loads name (``Loads.working``); None where neither decides and no load needs it.
@@ -994,4 +1025,13 @@ def _working(m, t, omega2, way=None) -> np.ndarray:
     return decreasing if way == "-x" else ~decreasing
 
 
-__all__ = ["Dynamics", "Generalised", "PinLocked", "inverse_dynamics", "generalised", "body_masses", "linkage_of"]
+__all__ = [
+    "Dynamics",
+    "Generalised",
+    "PinLocked",
+    "inverse_dynamics",
+    "generalised",
+    "body_masses",
+    "linkage_of",
+    "loads_at",
+]

@@ -222,36 +222,23 @@ class Drawn(NamedTuple):
 
 def applied_loads(m: Mechanism, theta2: float, omega2: float, masses=None, loads=None) -> list[Drawn]:
     """Every ``Force`` and ``Torque`` of ``loads`` at crank angle theta2 (rad) and omega2 (rad/s), as the exact
-    dynamics apply them (``qropt.dynamics.applied.resolve`` and ``evaluate``): forces F1, F2, ... and torques T1,
+    dynamics apply them (``qropt.dynamics.inverse.loads_at``): forces F1, F2, ... and torques T1,
     T2, ... in the loads' order. A load whose window is shut there carries the value it would have open."""
-    import dataclasses
-
     from qropt import units as units_
-    from qropt.dynamics import applied
-    from qropt.dynamics.inverse import _triples, _working, linkage_of, system_of, working_way
-    from qropt.dynamics.model import Force, Masses, Window
-    from qropt.kinematics.ops import JET, Jet
+    from qropt.dynamics.inverse import linkage_of, loads_at
+    from qropt.dynamics.model import Force
 
     if loads is None or not (loads.forces or loads.torques):
         return []
     t = np.array([float(theta2)])
-    s = system_of(m, Masses() if masses is None else masses)
+    resolved, shown, working, x = loads_at(m, t, omega2, masses, loads)
+    _, opened, _, _ = loads_at(m, t, omega2, masses, loads, opened=True)
     link = linkage_of(m)
+    where = m.positions(t).points
     k = units_.to_metres(m.units)
-    pts = _triples(m.evaluate(JET, Jet.seed(t, omega2, 0.0)), k)
-    working = _working(m, t, omega2, working_way(m, loads, omega2))
-    joint = m.output_joint()
-    x = pts[joint][0][0] / k if joint is not None else None
-    resolved = applied.resolve(m, s, link, loads)
-
-    def at(pairs):
-        return applied.evaluate(m, s, pairs, pts, t, working, x, 1.0, abs(omega2))
-
-    always = Window()
-    opened = [(dataclasses.replace(ld, window=always), body) for ld, body in resolved]
     joints = {b.name: b.joints for b in link.bodies()}
     out, counts = [], {"F": 0, "T": 0}
-    for (load, body), ap, open_ap in zip(resolved, at(resolved), at(opened), strict=True):
+    for (load, body), ap, open_ap in zip(resolved, shown, opened, strict=True):
         kind = "F" if isinstance(load, Force) else "T"
         counts[kind] += 1
         on = bool(load.window.active(t, working, x)[0])
@@ -260,7 +247,7 @@ def applied_loads(m: Mechanism, theta2: float, omega2: float, masses=None, loads
             point = (float(use.point[0][0]) / k, float(use.point[1][0]) / k)
             value = np.array([float(np.ravel(use.force[0])[0]), float(np.ravel(use.force[1])[0])])
         else:
-            xy = np.array([(np.ravel(pts[j][0][0])[0], np.ravel(pts[j][1][0])[0]) for j in joints[body]]) / k
+            xy = np.array([where[j][0] for j in joints[body]])
             # on the body between two of its joints, clear of its joints and of the forces' points
             spots = [xy[i] + f * (xy[j] - xy[i]) for i in range(len(xy)) for j in range(i, len(xy)) for f in SPOTS]
             busy = np.vstack([xy, *(np.array([o.point]) for o in out)])
