@@ -20,7 +20,11 @@ import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+PAGES = [
+    ROOT / "README.md",
+    *sorted((ROOT / "docs").glob("*.md")),
+    *sorted((ROOT / "docs" / "tutorials").glob("*.md")),
+]
 NUMBER = r"(?<![\w.])[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?(?:\.\.\.)?(?![\w.])"
 TOKEN = re.compile(rf"""('[^']*'|"[^"]*")|({NUMBER})""")  # a quoted string (left as it is) or a number
 ROOT_MARK = re.compile(r"repository root", re.I)

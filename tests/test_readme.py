@@ -26,7 +26,11 @@ ROOT = Path(__file__).resolve().parent.parent
 OUTPUT_FLAGS = ("--plot", "--csv", "--animate", "--dxf", "--svg", "--save", "-o")
 
 
-PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+PAGES = [
+    ROOT / "README.md",
+    *sorted((ROOT / "docs").glob("*.md")),
+    *sorted((ROOT / "docs" / "tutorials").glob("*.md")),
+]
 
 
 def shell_lines(page: Path) -> list[str]:
