@@ -3,15 +3,14 @@ the synthesis NLP, as CasADi expressions: the same rules as ``qropt.dynamics.app
 body carries a joint's load, each direction kind, windows and tables), written for a point of the formulation
 (``Kin``: the output x in the mechanism's unit, every joint's coordinates and their derivatives in theta2).
 
-Velocities are per unit crank angle (SI, m/rad); a force's power at omega2 is ``F . v omega2``. A window's edge and a
-force against a velocity are steps in the design and the crank angle: the NLP states them with ``if_else`` and the
-exact certificate (which splits at the edges) decides.
+Each load is an ``applied.Applied`` of expressions, its velocities per unit crank angle (SI, m/rad); a force's power
+at omega2 is ``F . v omega2``. A window's edge and a force against a velocity are steps in the design and the crank
+angle: the NLP states them with ``if_else`` and the exact certificate (which splits at the edges) decides.
 """
 
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import casadi
 
@@ -20,18 +19,6 @@ from qropt.dynamics.model import Force, Loads
 from qropt.dynamics.rigid import body_motion, frame
 
 TWO_PI = 2 * math.pi
-
-
-class Load(NamedTuple):
-    """One load at one crank angle: the body it acts on, its point (x, y) (m), the point's velocity per unit crank
-    angle (m/rad), the force (N), the torque (N m) and the body's turning rate per unit crank angle."""
-
-    body: str
-    point: tuple
-    velocity: tuple
-    force: tuple
-    torque: object
-    spin: object
 
 
 def resolved(link, system, loads: Loads) -> list[tuple]:
@@ -81,7 +68,7 @@ def active(window, out, working, moving):
     return on
 
 
-def at(s, pairs, out, working, way: float, omega2: float, tables: dict) -> list[Load]:
+def at(s, pairs, out, working, way: float, omega2: float, tables: dict) -> list[exact.Applied]:
     """The resolved loads (``resolved``) at one point of the formulation ``s`` (``_Symbolic``); ``way`` the working
     stroke's direction along x (+1 or -1) at this omega2 (rad/s)."""
     bodies = {b.name: b for b in s.bodies}
@@ -100,7 +87,7 @@ def at(s, pairs, out, working, way: float, omega2: float, tables: dict) -> list[
         spin = rot[2]
         amount = magnitude(load, out, tables) * active(load.window, out, working, moving)
         if not isinstance(load, Force):
-            out_list.append(Load(name, (ox[0], oy[0]), (0, 0), (0, 0), amount, spin))
+            out_list.append(exact.Applied(name, (ox[0], oy[0]), (0, 0), (0, 0), amount, spin))
             continue
         if isinstance(load.at, str):
             px, py = s.point(out, load.at)
@@ -120,8 +107,8 @@ def at(s, pairs, out, working, way: float, omega2: float, tables: dict) -> list[
         else:
             n = math.hypot(*d)
             force = (amount * (d[0] / n), amount * (d[1] / n))
-        out_list.append(Load(name, (px, py), v, force, 0, spin))
+        out_list.append(exact.Applied(name, (px, py), v, force, 0, spin))
     return out_list
 
 
-__all__ = ["Load", "resolved", "magnitude", "active", "at"]
+__all__ = ["resolved", "magnitude", "active", "at"]
