@@ -17,7 +17,8 @@ import time
 
 from benchmarks.report import save
 from qropt.app import api, create_app
-from qropt.app.defaults import SHIPPED
+from qropt.app.defaults import default_params
+from qropt.mechanisms import REGISTRY
 
 SECONDS, STEP_MS = 5.0, 5
 ARGS = ["--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background-networking", "--disable-sync"]
@@ -26,7 +27,10 @@ ARGS = ["--no-sandbox", "--disable-gpu", "--no-first-run", "--disable-background
 def in_process(repeat: int = 30) -> dict:
     """Median ms of one /api/analyze answer (no masses; with polygons), per type."""
     out = {}
-    for kind, params in SHIPPED.items():
+    for kind, cls in REGISTRY.items():
+        params = default_params(cls)
+        if not params:
+            continue
         body = {"type": kind, "params": params, "theta2": 1.0, "omega2": 10.0}
         api.analyze(body)
         times = []

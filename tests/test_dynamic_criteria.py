@@ -277,13 +277,15 @@ def test_min_peak_bearing_force_with_a_cutting_force_solves_and_its_peak_is_the_
 def test_the_crank_rocker_sliders_least_peak_torque_falls_as_its_transmission_bound_loosens():
     """At TR 2.135, 0.1797 m (a task of ``benchmarks.tasks``, steel bars and a 20 kg ram) the crank-rocker slider's
     least peak torque falls as a gamma_min bound is loosened, the bound active each time (without a bound the row
-    finds 45.166 N m at gamma_min 4.18 deg, docs/benchmarks.md). Without the evolution's descents and with 2 Sobol
-    starts per two free parameters (a default solve: 8), which give the same designs here in less time."""
+    finds 45.166 N m at gamma_min 4.18 deg, docs/benchmarks.md). Bounds at and above the transmission guard's 10 deg
+    (below it the guarded multi-start runs too), without the evolution's descents and with 1 Sobol start per two
+    free parameters (a default solve: 8), which give the same designs here (45.9363 N m at 15 deg with 2 starts
+    too, 45.4775 at 10 deg with 2 and with 8) in less time."""
     import math
 
     masses, loads = qropt.Masses.steel(4e-4, ram=20.0), qropt.Loads(1000.0)
     got = []
-    for deg in (10.0, 5.0):
+    for deg in (15.0, 10.0):
         p = type_problem(
             "crank-rocker-slider",
             2.135,
@@ -294,7 +296,7 @@ def test_the_crank_rocker_sliders_least_peak_torque_falls_as_its_transmission_bo
             omega2=10.0,
             conditions={"gamma_min": math.radians(deg)},
         )
-        r = qropt.Solver(evolution=False, starts_n=2).solve(p)
+        r = qropt.Solver(evolution=False, starts_n=1).solve(p)
         assert r.status == "optimal", r.message
         assert r.quantities["gamma_min"] == pytest.approx(math.radians(deg), abs=1e-7)  # the bound is active
         th = np.linspace(0.0, 2 * np.pi, 20001)  # the certified peak against the torque on a dense grid
@@ -302,7 +304,7 @@ def test_the_crank_rocker_sliders_least_peak_torque_falls_as_its_transmission_bo
         assert r.objective * (1 - 1e-5) <= peak <= r.objective * (1 + 1e-12)
         got.append(r.objective)
     assert got[1] < got[0]  # looser bound, lower torque
-    assert got == pytest.approx([45.477, 45.176], abs=1e-3)
+    assert got == pytest.approx([45.936, 45.477], abs=1e-3)
 
 
 def test_the_whitworths_least_peak_torque_at_a_drawn_task_is_the_best_known():
