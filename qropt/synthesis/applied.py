@@ -1,7 +1,8 @@
 """The general loads (``Loads.forces``, ``Loads.torques``, a gravity vector, ``Masses.points``) at one crank angle of
-the synthesis NLP, as CasADi expressions: the same rules as ``qropt.dynamics.applied`` on the exact side (which
-body carries a joint's load, each direction kind, windows and tables), written for a point of the formulation
-(``Kin``: the output x in the mechanism's unit, every joint's coordinates and their derivatives in theta2).
+the synthesis NLP, as CasADi expressions: which body carries a load and where its point is and how fast it moves
+are ``qropt.dynamics.applied``'s (``resolve``, ``geometry``); the rules that give its amount and direction (windows,
+tables, each direction kind) are the exact side's written for a point of the formulation (``Kin``: the output x in
+the mechanism's unit, every joint's coordinates and their derivatives in theta2).
 
 Each load is an ``applied.Applied`` of expressions, its velocities per unit crank angle (SI, m/rad); a force's power
 at omega2 is ``F . v omega2``. A window's edge and a force against a velocity are steps in the design and the crank
@@ -16,7 +17,6 @@ import casadi
 
 from qropt.dynamics import applied as exact
 from qropt.dynamics.model import Force, Loads
-from qropt.dynamics.rigid import body_motion, frame
 
 TWO_PI = 2 * math.pi
 
@@ -79,21 +79,14 @@ def at(s, pairs, out, working, way: float, omega2: float, tables: dict) -> list[
         size = casadi.fmax(size, casadi.sqrt(px * px + py * py))
     rest = exact.AT_REST * size
     moving = way * out.v * omega2
+    pts = {j: tuple(tuple(s.point(out, j, k)[i] for k in range(3)) for i in (0, 1)) for j in s.f.joint_index}
     out_list = []
-    for load, name in pairs:
-        b = bodies[name]
-        pts = s.triples(out, b)
-        (ox, oy), rot = frame(b, pts)
-        spin = rot[2]
+    for (load, name), ((px, py), v, spin) in zip(pairs, exact.geometry(s.system(), pairs, pts), strict=True):
         amount = magnitude(load, out, tables) * active(load.window, out, working, moving)
         if not isinstance(load, Force):
-            out_list.append(exact.Applied(name, (ox[0], oy[0]), (0, 0), (0, 0), amount, spin))
+            out_list.append(exact.Applied(name, (px, py), (0, 0), (0, 0), amount, spin))
             continue
-        if isinstance(load.at, str):
-            px, py = s.point(out, load.at)
-            v = (ox[1] - spin * (py - oy[0]), oy[1] + spin * (px - ox[0]))
-        else:
-            (px, py), v, _, _ = body_motion(b, load.at[1:], pts)
+        b = bodies[name]
         d = load.direction
         if d == "against" and b.kind in ("ram", "yoke"):  # along the slide: against the stroke's way
             along = casadi.sign(moving) if working is None else (1.0 if working else -1.0)

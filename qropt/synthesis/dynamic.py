@@ -19,6 +19,7 @@ import casadi
 import numpy as np
 
 from qropt import units as units_
+from qropt.dynamics import applied as exact_loads
 from qropt.dynamics.applied import carrier
 from qropt.dynamics.model import slender_bar, union
 from qropt.dynamics.rigid import body_motion
@@ -308,20 +309,21 @@ class _Symbolic:
         rows = dict(rows)
         gx, gy = self.gravity()
 
-        def add(body, fx, fy, at, moment=0):
+        def add(body, fx, fy, at):
             r, G = s.rows[body], kin[body][0]
             rows[r] = rows.get(r, 0.0) + fx
             rows[r + 1] = rows.get(r + 1, 0.0) + fy
             if s.kind(body) != "ram":
-                rows[r + 2] = rows.get(r + 2, 0.0) + (at[0] - G[0]) * fy - (at[1] - G[1]) * fx + moment
+                rows[r + 2] = rows.get(r + 2, 0.0) + (at[0] - G[0]) * fy - (at[1] - G[1]) * fx
 
         for b in s.bodies if tilted else ():
             mass = kin[b.name][3]
             add(b.name, -mass * gx, -mass * gy, kin[b.name][0])
         for body, mass, p, _, a in self.particles(out):
             add(body, mass * (a[0] * w2 - gx), mass * (a[1] * w2 - gy), p)
-        for load in self.general(out, working):
-            add(load.body, -load.force[0], -load.force[1], load.point, -load.torque)
+        for load in self.general(out, working):  # known loads leave the right-hand side
+            for r, v in exact_loads.rows(s, load, kin[load.body][0]):
+                rows[r] = rows.get(r, 0.0) - v
         return entries, rows
 
     def no_lock(self):
