@@ -8,7 +8,7 @@ condition ``max_rms_motor_torque`` (the motor's rated torque).
 Its value is the RMS crank torque's rule applied to the motor's torque (``drive.rms_motor_torque(..., split=False)``:
 Gauss-Legendre on each stroke, the nodes moving with the dead centres), which the NLP states and the certificate
 evaluates exactly. ``drive_check`` also splits the strokes where the crank torque changes sign (the motor's torque
-has a kink there): the two agree to about 1e-5 relative.
+has a kink there), which this rule does not.
 """
 
 from __future__ import annotations
