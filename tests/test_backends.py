@@ -73,6 +73,27 @@ def test_the_solvers_of_a_formulation_share_its_derivatives():
                 assert x.get_function(f"nlp_{name}").__hash__() == first[option].__hash__()  # the same function
 
 
+def test_a_quasi_newton_backend_shares_what_it_has():
+    """IPOPT's limited-memory Hessian (``Solver(ipopt_options={"ipopt.hessian_approximation": "limited-memory"})``)
+    builds no Hessian of the Lagrangian: its solver shares the gradient and Jacobian, built first or given, and an
+    exact-Hessian solver of the same formulation after it builds and shares the Hessian; both reach the optimum."""
+    form = _form(1.0)
+    form.objective = None
+    form.nlp = {"x": form.w_sym, "p": form.p_sym, "f": form.f_sym, "g": form.g_sym}
+    quasi = Ipopt({"ipopt.hessian_approximation": "limited-memory"})
+    for b in (quasi, Ipopt(), quasi.near()):
+        run = b.run(form, np.array([0.5, 0.5]), 2.0, *BOX)
+        assert run.f == pytest.approx(1.0, rel=1e-9), b.options
+    assert set(backends._DERIVATIVES[form]) == set(backends.DERIVATIVES)
+    assert not quasi.solver(form).has_function("nlp_hess_l")
+    for option, name in backends.DERIVATIVES.items():
+        if option != "hess_lag":
+            assert (
+                quasi.solver(form).get_function(f"nlp_{name}").__hash__()
+                == backends._DERIVATIVES[form][option].__hash__()
+            )
+
+
 def test_a_run_whose_linear_solves_once_overflowed_ends():
     """The Whitworth by peak torque under a transmission guard of 10 deg, at TR 2.848, 0.834 m, from one of its Sobol
     starts: the KKT system of iteration 32 is solved to a step of norm 1e111, and with IPOPT's default of up to 10

@@ -6,12 +6,14 @@ line and a non-zero exit."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
 import qropt
 from qropt import cli
 
+SHAPER_FILE = Path(__file__).parents[1] / "problems" / "crank_shaper_torque.toml"  # 3.14 kg/m bars, a 20 kg ram
 SHAPER = ["crank-shaper", "--r1", "0.2", "--r2", "0.08", "--r4", "0.5"]
 LOADS = qropt.Loads(
     forces=[
@@ -107,42 +109,23 @@ def test_design_with_a_loads_file(loads_json, capsys, tmp_path):
 def test_synth_with_a_loads_file(tmp_path, capsys):
     """--loads replaces the problem file's loads and --point-mass adds to its masses: the objective is the exact
     peak torque of the design under them."""
-    problem = qropt.Problem(
-        "crank-shaper",
-        free={"r1": (0.05, 2.0), "r2": (0.02, 1.0), "r4": (0.05, 2.0)},
-        targets={"time_ratio": 1.5, "stroke": 0.3},
-        objective="min_peak_torque",
-        masses=qropt.Masses.steel(4e-4, ram=20.0),
-        loads=qropt.Loads(1000.0),
-        omega2=10.0,
-    )
-    file = tmp_path / "shaper.toml"
-    file.write_text(problem.to_toml())
     loads = qropt.Loads(forces=[qropt.Force("C", 600.0), qropt.Force("A", 150.0, (0.0, -1.0), "always")])
     path = tmp_path / "loads.json"
     path.write_text(json.dumps(loads.to_dict()))
-    assert cli.main(["synth", str(file), "--loads", str(path), "--point-mass", "A", "1.5", "--json"]) == 0
+    assert cli.main(["synth", str(SHAPER_FILE), "--loads", str(path), "--point-mass", "A", "1.5", "--json"]) == 0
     r = json.loads(capsys.readouterr().out)
     m = qropt.CrankShaper(**r["params"])
-    masses = qropt.Masses.steel(4e-4, ram=20.0, points={"A": 1.5})
+    masses = qropt.Masses.bars(3.14, 20.0, points={"A": 1.5})  # the file's masses and the point mass
     exact = m.dynamic_extremes(10.0, masses=masses, loads=loads).peak_torque.value
     assert r["objective"] == pytest.approx(exact, rel=1e-6)
 
 
 def test_report_of_a_problem_with_a_loads_file(loads_json, tmp_path, capsys):
-    problem = qropt.Problem(
-        "crank-shaper",
-        free={"r1": (0.05, 2.0), "r2": (0.02, 1.0), "r4": (0.05, 2.0)},
-        targets={"time_ratio": 1.5, "stroke": 0.3},
-        objective="min_peak_torque",
-        masses=qropt.Masses.steel(4e-4, ram=20.0),
-        loads=qropt.Loads(1000.0),
-        omega2=10.0,
-    )
-    file = tmp_path / "shaper.toml"
-    file.write_text(problem.to_toml())
     out = tmp_path / "shaper.html"
-    assert cli.main(["report", str(file), "--loads", str(loads_json), "--point-mass", "A", "1.5", "-o", str(out)]) == 0
+    assert (
+        cli.main(["report", str(SHAPER_FILE), "--loads", str(loads_json), "--point-mass", "A", "1.5", "-o", str(out)])
+        == 0
+    )
     text = out.read_text()
     assert "Forces and torque (the problem&#x27;s masses, loads as given)" in text
     for cell in ("<td>F1</td><td>C</td>", "<td>F2</td><td>(lever, 0.35, 0)</td>", "<td>T1</td><td>the lever</td>"):

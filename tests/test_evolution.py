@@ -18,6 +18,7 @@ from qropt.synthesis.search import Settings
 from qropt.synthesis.search.descended import descended
 
 SHORT = Settings(evolution_generations=20, descent_evals=200)  # a short evolution, short descents
+FEW = Settings(evolution_generations=10, descent_evals=100)  # shorter still
 
 KW = {"objective": "min_peak_torque", "masses": MASSES, "loads": LOADS, "omega2": OMEGA2}
 
@@ -133,20 +134,20 @@ def test_the_evolution_options_are_true_or_false():
 def test_more_evolutions_add_their_ends_to_the_first_ones():
     """``Solver(evolutions=2)`` runs the evolution from seeds 0 and 1: the first is the one evolution of
     ``Solver(evolutions=1)``, so with no certified design (IPOPT gets no iteration) its best end is at least as
-    good, and better where the second seed's basin is; the claim names both seeds. Shortened (20 generations, 200
+    good, and better where the second seed's basin is; the claim names both seeds. Shortened (10 generations, 100
     evaluations)."""
     from qropt import Solver
 
     problem = type_problem("crank-shaper-rod", 1.6, 0.3, **KW)
-    kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": SHORT}
+    kw = {"starts_n": 0, "ipopt_options": {"ipopt.max_iter": 0}, "settings": FEW}
     one = Solver(**kw, evolutions=1).solve(problem, use_analytic=False, diagnose=False)
     two = Solver(**kw, evolutions=2)
     assert Solver(**two.options()).evolutions == 2  # the options rebuild an equal Solver (a worker's)
     r = two.solve(problem, use_analytic=False, diagnose=False)
     assert one.status == r.status == "feasible", (one.message, r.message)
-    assert "2 differential evolutions (seeds 0-1) of 20 generations" in r.certificate.global_claim
+    assert "2 differential evolutions (seeds 0-1) of 10 generations" in r.certificate.global_claim
     assert r.objective <= one.objective * (1 + 1e-12)
-    second = descents.descended(problem, 20, 1, settings=SHORT)
+    second = descents.descended(problem, 20, 1, settings=FEW)
     assert r.objective <= second[0].value * (1 + 1e-12)
 
 

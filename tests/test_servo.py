@@ -290,12 +290,19 @@ def test_readme_examples():
 
 
 # ---- the full inertia (masses and loads) -----------------------------------------------------------------------
-def test_a_profile_with_every_links_inertia_is_checked_by_the_inverse_dynamics():
+GENERAL = qropt.Loads(
+    forces=[qropt.Force("C", 100.0, "against", "working")], torques=[qropt.Torque("rod", 0.5)], gravity=(3.0, -9.0)
+)
+
+
+@pytest.mark.parametrize("loads", [qropt.Loads(100.0, gravity=9.81), GENERAL], ids=["cut and gravity", "general"])
+def test_a_profile_with_every_links_inertia_is_checked_by_the_inverse_dynamics(loads):
     """With a mass model the torque is M alpha2 + M' omega2^2 / 2 + Q, linear in omega2^2: the profile's torque at
     its samples equals the Newton-Euler inverse dynamics run at the same crank angle, speed and acceleration, and a
-    binding torque limit holds to the profile's O(h^2) discretisation."""
+    binding torque limit holds to the profile's O(h^2) discretisation; under the cutting force and gravity, and
+    under general loads (a force, a torque on the rod, a tilted gravity)."""
     m = qropt.SliderCrank(r2=0.1, r3=0.4, e=0.05)  # TR 1.04: the servo's working arc is the slow stroke
-    masses, loads = qropt.Masses.bars(2.0, 5.0), qropt.Loads(100.0, gravity=9.81)
+    masses = qropt.Masses.bars(2.0, 5.0)
     free = qropt.speed_profile(m, omega_max=20, v_cut=0.5, a_max=40, alpha_max=400, v_max=2, masses=masses, loads=loads)
     sp = qropt.speed_profile(
         m, omega_max=20, v_cut=0.5, a_max=40, alpha_max=400, v_max=2, masses=masses, loads=loads, torque_max=12.0

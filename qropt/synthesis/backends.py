@@ -139,10 +139,16 @@ class Ipopt:
             opts = {**WARM, **self.options} if warm else dict(self.options)
             if scale != 1.0:
                 opts["ipopt.obj_scaling_factor"] = scale
-            shared = _DERIVATIVES.get(form)
-            kept[key] = casadi.nlpsol("qropt_warm" if warm else "qropt", "ipopt", form.nlp, {**opts, **(shared or {})})
-            if shared is None:
-                _DERIVATIVES[form] = {k: kept[key].get_function(f"nlp_{n}") for k, n in DERIVATIVES.items()}
+            shared = _DERIVATIVES.setdefault(form, {})
+            kept[key] = s = casadi.nlpsol("qropt_warm" if warm else "qropt", "ipopt", form.nlp, {**opts, **shared})
+            # a quasi-Newton solver (IPOPT's hessian_approximation limited-memory) has no Hessian to give
+            shared.update(
+                {
+                    k: s.get_function(f"nlp_{n}")
+                    for k, n in DERIVATIVES.items()
+                    if k not in shared and s.has_function(f"nlp_{n}")
+                }
+            )
         return kept[key]
 
     def run(self, form, w0, p, lbx, ubx, warm: bool = False) -> Run:
