@@ -535,9 +535,10 @@ def test_the_panel_loads_give_the_librarys_torque(page, browser, tmp_path):
 
 
 def test_design_page_sends_the_panels_loads_and_drive(page, tmp_path):
-    """min_rms_motor_torque opens "more loads" with a drive; a force at a joint some ticked types lack is refused
-    beside the panel, naming the load and the type; with one type the row's RMS motor torque is the library's for
-    the panel's loads and drive."""
+    """min_rms_motor_torque opens "more loads" with a drive; a new force is at "ram" (each type's ram joint); a
+    force at a joint some ticked types lack is refused beside the panel, naming the load and the type; with one type
+    the row's RMS motor torque, with the force at "ram", is the library's for the panel's loads and drive at the
+    type's ram joint."""
     from qropt.dynamics.cycle import CycleDynamics
     from qropt.dynamics.drive import rms_motor_torque
     from qropt.studies._design import TYPES as ROWS
@@ -548,9 +549,10 @@ def test_design_page_sends_the_panels_loads_and_drive(page, tmp_path):
     page.select_option("#d-objective", "rms_motor_torque")
     assert page.is_checked("#d-dyn") and page.evaluate("document.getElementById('d-more').open")
     assert page.input_value("#d-ratio") == "10" and page.input_value("#d-eta") == "0.9"
-    page.click("#d-add-forces")  # at D, the ram's joint of most types: the slider-crank and crank-shaper lack it
+    page.click("#d-add-forces")  # at "ram": each type's ram joint (C or D)
     row = page.locator("#d-more .load-row.forces").first
-    assert row.locator("select.at").input_value() == "D"
+    assert row.locator("select.at").input_value() == "ram"
+    row.locator("select.at").select_option("D")  # the slider-crank and crank-shaper lack it
     assert row.locator("select.at option:checked").inner_text() == "D (not in 2 types)"
     page.fill("#d-budget", "5")
     page.click("#d-run")
@@ -561,7 +563,7 @@ def test_design_page_sends_the_panels_loads_and_drive(page, tmp_path):
     for box in page.locator("#d-types input").all():
         box.set_checked(box.get_attribute("value") == "slider-crank")
     assert row.locator("select.at option:checked").inner_text() == "D (not in slider-crank)"
-    row.locator("select.at").select_option("C")
+    row.locator("select.at").select_option("ram")  # the slider-crank's C
     row.locator("input.magnitude").fill("300")
     page.click("#d-run")
     page.wait_for_selector("#d-table tr.pick", timeout=60_000)

@@ -361,6 +361,39 @@ def test_a_four_bar_has_no_ram_position():
         m.dynamics(np.array([0.3]), 2.0, loads=Loads(torques=[Torque("follower", ((0.0, 1.0), (1.0, 2.0)))]))
 
 
+def test_a_force_at_the_ram_is_at_each_types_output_joint():
+    """Force("ram", ...) acts at the output's joint whatever the type names it (C or D): in every type ``design``
+    compares, the crank torque and the joint forces equal those of the same force at that joint; ``design`` over
+    types whose rams are C and D takes it, each row the row of the cutting-force shorthand; a four-bar, without a
+    ram, refuses it by name."""
+    from qropt.studies._design import TYPES, type_problem
+
+    t, masses = np.linspace(0.0, 2 * np.pi, 37), Masses.bars(3.0, 10.0)
+    joints = set()
+    for kind in TYPES:
+        cls = type_problem(kind, 1.5, 0.3).mechanism
+        m = cls(**cls.EXAMPLE)
+        joint = m.output_joint()
+        joints.add(joint)
+        at = {
+            j: m.dynamics(t, 10.0, masses=masses, loads=Loads(forces=[Force(j, 500.0, (0.3, -1.0), "always")]))
+            for j in ("ram", joint)
+        }
+        np.testing.assert_array_equal(at["ram"].torque, at[joint].torque)
+        for k, v in at[joint].joint_forces.items():
+            np.testing.assert_array_equal(at["ram"].joint_forces[k], v)
+    assert joints == {"C", "D"}
+    kw = dict(objective="min_peak_torque", types=["crank-shaper", "slot-ram-shaper"], masses=masses, omega2=10.0)
+    ram = qropt.design(1.5, 0.3, loads=Loads(forces=[Force("ram", 1000.0)]), **kw)
+    short = qropt.design(1.5, 0.3, loads=Loads(1000.0), **kw)
+    assert [(r.type, r.result.status) for r in ram.rows] == [(r.type, r.result.status) for r in short.rows]
+    for a, b in zip(ram.rows, short.rows, strict=True):
+        assert a.result.status == "optimal" and a.result.objective == pytest.approx(b.result.objective, rel=1e-9)
+    m = qropt.FourBar(r1=1.0, r2=0.3, r3=1.0, r4=0.8)
+    with pytest.raises(InvalidParameter, match="the force at ram: FourBar has no ram; its joints"):
+        m.dynamics(np.array([0.3]), 2.0, loads=Loads(forces=[Force("ram", 1.0)]))
+
+
 def test_the_round_trip():
     loads = Loads(
         cutting_force=((0.0, 10.0), (0.5, 30.0)),

@@ -29,6 +29,7 @@ from qropt.app import api
 from qropt.app.defaults import remember
 from qropt.app.jobs import Busy, Jobs
 from qropt.cli import load_problem
+from qropt.dynamics.applied import RAM
 from qropt.dynamics.drive import Drive
 from qropt.dynamics.model import Force, Loads, Masses
 from qropt.errors import QroptError
@@ -165,6 +166,13 @@ def _loads_fit(problems: dict, masses, loads) -> None:
         name, joints, bodies = p.mechanism.__name__, where["joints"], where["bodies"]
         for load in (*(loads.forces if loads else ()), *(loads.torques if loads else ())):
             if isinstance(load, Force) and isinstance(load.at, str):
+                if load.at == RAM and RAM not in joints:
+                    if where["ram"] is None:
+                        raise api.ApiError(
+                            f"{load}: the {row} row's {name} has no ram (untick that type or choose a joint)",
+                            field="loads",
+                        )
+                    continue
                 if load.at not in joints:
                     raise api.ApiError(
                         f"{load}: the {row} row's {name} has no joint {load.at!r}; its joints: {joints} "

@@ -4,10 +4,13 @@ load ``Q`` read). SI units: points in metres, the ram's position for windows and
 
 A joint's load acts on the body that carries the joint (``carrier``): the output body (the ram, the yoke) for the
 output's joint, else the first body in the linkage's order whose joints include it (the crank-pin block aside).
+A force at "ram" (``RAM``) is at the output's joint, whatever the type names it (C or D), unless the type has a
+joint of that name.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from typing import NamedTuple
 
 import numpy as np
@@ -18,6 +21,7 @@ from qropt.dynamics.rigid import body_motion, frame
 from qropt.errors import InvalidParameter
 
 AT_REST = 1e-9  # a point is at rest where its speed is below this times |omega2| times the mechanism's size
+RAM = "ram"  # a force's joint that names the output's, in every type
 EDGE_GRID = 720  # crank angles where the ram's crossings of a window's or a table's x are bracketed
 
 
@@ -52,13 +56,18 @@ def carrier(m, link, joint: str) -> str:
 
 
 def resolve(m, s, link, loads: Loads) -> list[tuple]:
-    """Each force and torque with the body it acts on, checked against the mechanism: (load, body). InvalidParameter
-    naming the load for an unknown joint or body, a body the system does not hold (a massless block), a torque on
-    the ram (it does not turn) or a window or table on the ram's position without a ram."""
+    """Each force and torque with the body it acts on, checked against the mechanism: (load, body), a force at
+    ``RAM`` given the output's joint. InvalidParameter naming the load for an unknown joint or body, a body the
+    system does not hold (a massless block), a torque on the ram (it does not turn) or a window or table on the
+    ram's position without a ram."""
     names = [b.name for b in link.bodies()]
     held = {b.name for b in s.bodies}
     out = []
     for load in (*loads.forces, *loads.torques):
+        if isinstance(load, Force) and load.at == RAM and RAM not in joints_of(link):
+            if m.output_joint() is None:
+                raise InvalidParameter(f"{load}: {type(m).__name__} has no ram; its joints: {joints_of(link)}")
+            load = dataclasses.replace(load, at=m.output_joint())
         at = load.at if isinstance(load, Force) else (load.on,)
         if isinstance(load, Force) and isinstance(at, str):
             try:

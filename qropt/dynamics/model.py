@@ -342,7 +342,8 @@ def _against(what, v) -> str:
 
 @dataclass(frozen=True)
 class Force:
-    """A force (N) at a point: ``at`` a joint's name or a body's point (body, x, y) in the body's frame (m).
+    """A force (N) at a point: ``at`` a joint's name ("ram": the output's joint, C or D by type, in every type
+    with a ram or yoke) or a body's point (body, x, y) in the body's frame (m).
     ``direction``: "against" (opposing the point's velocity; zero where it is at rest), "slide" (along the slide
     line's +x, signed by the magnitude) or a vector (fx, fy) in the frame (its direction; the magnitude's sign
     turns it). ``magnitude``: a constant or a table ((x or theta2, N), ...) against the ram's position x (the

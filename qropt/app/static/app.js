@@ -649,41 +649,54 @@ function panelChanged(p) {
 }
 
 // Where loads may act on a panel's page: the Mechanism page's type ({joints, bodies, ram} of its design), or on the
-// Design page every ticked type's (each joint or body with the ticked types that lack it).
+// Design page every ticked type's (each joint or body with the ticked types that lack it). A force's joints
+// (forceJoints) begin on the Design page with "ram": each type's output joint, whatever the type names it.
 function loadTargets(p) {
   if (p === "m") {
     const t = state.types[state.type] || {}, a = state.analysis && state.analysis.type_key === state.type ? state.analysis : t;
-    return { joints: a.joints || [], bodies: a.bodies || [], ram: a.ram || null, lack: {}, what: t.class };
+    const joints = a.joints || [];
+    const ram = a.ram || null;
+    return { joints, forceJoints: joints, bodies: a.bodies || [], ram, ramJoint: ram, lack: { joints: {}, bodies: {} }, what: t.class };
   }
   const rows = (state.designTypes || []).filter((t) => $(`d-type-${t.name}`) && $(`d-type-${t.name}`).checked);
   const joints = [...new Set(rows.flatMap((t) => t.joints))].sort(), bodies = [...new Set(rows.flatMap((t) => t.bodies))];
-  const lack = {};  // (joints are named in capitals, bodies in words: one map)
+  const lack = { joints: {}, bodies: {} };
   for (const [names, key] of [[joints, "joints"], [bodies, "bodies"]]) {
     for (const n of names) {
       const without = rows.filter((t) => !t[key].includes(n)).map((t) => t.name);
-      if (without.length) lack[n] = without;
+      if (without.length) lack[key][n] = without;
     }
   }
-  const rams = rows.map((t) => t.ram).filter(Boolean);  // a new force's joint: the ram's of the most types
-  const ram = rams.sort((a, b) => rams.filter((r) => r === b).length - rams.filter((r) => r === a).length)[0] || null;
+  const noRam = rows.filter((t) => !t.ram).map((t) => t.name);
+  if (noRam.length) lack.joints.ram = noRam;
+  const forceJoints = noRam.length < rows.length && !joints.includes("ram") ? ["ram", ...joints] : joints;
+  const rams = rows.map((t) => t.ram).filter(Boolean);  // a new point mass's joint: the ram's of the most types
+  const ramJoint = rams.sort((a, b) => rams.filter((r) => r === b).length - rams.filter((r) => r === a).length)[0] || null;
   const what = rows.length && rows.length <= 2 ? rows.map((t) => t.name).join(", ") : "the types ticked";
-  return { joints, bodies, ram, lack, what };
+  return { joints, forceJoints, bodies, ram: forceJoints[0] === "ram" ? "ram" : ramJoint, ramJoint, lack, what };
 }
 
-// A select's options: the names given (each ticked type lacking it named), and its value kept even where the page's
-// type has no such name (said in the option: the server then refuses the load by name, never drops it).
-function fillSelect(sel, names, value, t) {
+// A select's options: the names given (each ticked type lacking it named: ``lack``, the names' map), and its value
+// kept even where the page's type has no such name (said in the option: the server then refuses the load by name,
+// never drops it).
+function fillSelect(sel, names, value, t, lacks) {
   sel.innerHTML = "";
   for (const n of names) {
-    const lack = t.lack[n] || [];
+    const lack = lacks[n] || [];
     const o = new Option(lack.length > 1 ? `${n} (not in ${lack.length} types)` : lack.length ? `${n} (not ${lack[0]})` : n, n);
     if (lack.length) o.title = `not in ${lack.join(", ")}: untick them, or the design refuses the load`;
+    else if (n === "ram" && !t.joints.includes("ram")) o.title = "the ram's joint of each type (C or D)";
     sel.add(o);
   }
   if (value !== undefined && value !== null && value !== "") {
     if (!names.includes(value)) sel.add(new Option(`${value} (not in ${t.what})`, value));
     sel.value = value;
   }
+}
+
+// The joints a row's select offers: a force's (with "ram" on the Design page) or a point mass's.
+function jointsOf(t, kind) {
+  return kind === "forces" ? t.forceJoints : t.joints;
 }
 
 function rowInput(cls, value, step, title) {
@@ -709,11 +722,11 @@ function addLoadRow(p, kind, v = {}) {
   if (kind === "torques") {
     place.className = "on";
     place.title = "the body it acts on";
-    fillSelect(place, t.bodies, v.on ?? (t.bodies.find((b) => b !== "crank" && b !== "ram" && b !== "yoke") || t.bodies[0]), t);
+    fillSelect(place, t.bodies, v.on ?? (t.bodies.find((b) => b !== "crank" && b !== "ram" && b !== "yoke") || t.bodies[0]), t, t.lack.bodies);
   } else {
     place.className = "at";
     place.title = "the joint it acts at";
-    fillSelect(place, t.joints, v.at ?? (t.ram || t.joints[0]), t);
+    fillSelect(place, jointsOf(t, kind), v.at ?? ((kind === "forces" ? t.ram : t.ramJoint) || t.joints[0]), t, t.lack.joints);
   }
   row.appendChild(place);
   if (kind === "forces") {
@@ -747,7 +760,8 @@ function addLoadRow(p, kind, v = {}) {
 function refreshTargets(p) {
   const t = loadTargets(p);
   for (const sel of document.querySelectorAll(`#${p}-more select.at, #${p}-more select.on`)) {
-    fillSelect(sel, sel.classList.contains("on") ? t.bodies : t.joints, sel.value, t);
+    const on = sel.classList.contains("on"), kind = sel.closest(".load-row").classList.contains("forces") ? "forces" : "points";
+    fillSelect(sel, on ? t.bodies : jointsOf(t, kind), sel.value, t, on ? t.lack.bodies : t.lack.joints);
   }
 }
 
