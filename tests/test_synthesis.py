@@ -67,6 +67,29 @@ def test_new_targets_reuse_the_nlp():
     assert r.params["r3"] == pytest.approx(max(s.r3 for s in analytic.drag_link_r3(1.8, 0.1, 0.225, 0.275)), abs=1e-9)
 
 
+def test_the_nlps_of_the_last_two_dynamic_tasks_are_kept():
+    """A dynamic NLP bakes its masses, loads and omega2 in: a Solver that solves under many loads keeps the NLPs of
+    the last two dynamic tasks (its memory bounded) and every kinematic one, builds a dropped task's again and gives
+    it the same design."""
+    from qropt.studies._design import type_problem
+
+    solver = Solver()
+    kw = {"objective": "min_peak_torque", "masses": qropt.Masses.bars(2.0, 10.0), "omega2": 10.0}
+    tasks = [type_problem("crank-shaper", 1.5, 0.3, loads=qropt.Loads(f), **kw) for f in (500.0, 600.0, 700.0)]
+    first = solver.solve(tasks[0])
+    one = solver.formulations
+    solver.solve(type_problem("crank-shaper", 1.5, 0.3))
+    kinematic = solver.formulations - one
+    assert one > 0 and kinematic > 0
+    solver.solve(tasks[1])
+    assert solver.formulations == 2 * one + kinematic
+    solver.solve(tasks[2])  # the first task's NLPs dropped
+    assert solver.formulations == 2 * one + kinematic
+    again = solver.solve(tasks[0])
+    assert solver.formulations == 2 * one + kinematic
+    assert (again.status, again.objective, again.params) == (first.status, first.objective, first.params)
+
+
 # ---- random tasks with closed-form answers, cold multi-start ----------------------------------------
 @pytest.mark.parametrize("kind", list(TASKS))
 def test_cold_multistart_reaches_the_analytic_optimum(kind):

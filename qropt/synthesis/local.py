@@ -72,11 +72,26 @@ def _dynamic_key(problem) -> tuple:
     return (repr(problem.masses), repr(problem.loads), problem.omega2, *baked)
 
 
+def _task_of(problem, dynamic: tuple) -> tuple | None:
+    """The dynamic task an NLP belongs to (its objective and ``_dynamic_key``: the masses, loads and omega2 it
+    bakes in), or None for an NLP that bakes no masses."""
+    used = [criteria.of_problem(problem)] + [c for k, c in criteria.bounds().items() if k in problem.conditions]
+    if not any(c is not None and c.needs_masses for c in used):
+        return None
+    return (problem.objective, *dynamic)
+
+
 class Formulations:
-    """The NLPs of a Solver, one per problem structure, built on first use (immutable; numbers are passed)."""
+    """The NLPs of a Solver, one per problem structure, built on first use (immutable; numbers are passed). A
+    dynamic NLP bakes its masses, loads and omega2 in: those of the KEPT_TASKS dynamic tasks used last are kept,
+    an older task's dropped (each such NLP holds tens of megabytes; a process that designs under many loads would
+    otherwise hold them all)."""
+
+    KEPT_TASKS = 2  # a front between two dynamic objectives alternates between two tasks
 
     def __init__(self, samples: int, extra: int):
         self.samples, self.extra, self._built = samples, extra, {}
+        self._tasks: dict = {}  # dynamic task -> the keys of its NLPs, the least recently used first
 
     def __len__(self):
         return len(self._built)
@@ -88,6 +103,7 @@ class Formulations:
         c = problem.conditions
         bounds = tuple(k for k in c if k not in ("grashof", "linear", "ratio"))
         cond = (c.get("grashof"), bounds, repr(c.get("linear")), repr(c.get("ratio")))
+        dynamic = _dynamic_key(problem)
         key = (
             problem.mechanism,
             tuple(problem.free),
@@ -102,8 +118,14 @@ class Formulations:
             range_target,
             sense,
             guarded,
-            *_dynamic_key(problem),
+            *dynamic,
         )
+        task = _task_of(problem, dynamic)
+        if task is not None:
+            self._tasks[task] = self._tasks.pop(task, set()) | {key}
+            while len(self._tasks) > self.KEPT_TASKS:
+                for old in self._tasks.pop(next(iter(self._tasks))):
+                    self._built.pop(old, None)
         f = self._built.get(key)
         if f is None:
             f = self._built[key] = Formulation(

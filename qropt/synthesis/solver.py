@@ -32,7 +32,8 @@ RANGE_FREE = (RowKind.DEAD_CENTRE, RowKind.ORIENTATION, RowKind.TARGET)  # rows 
 
 
 class Solver:
-    """Owns the NLP formulations (built once per problem structure), the backend and the options of every solve.
+    """Owns the NLP formulations (built once per problem structure; a dynamic one's kept while its task is one of
+    the last two, ``Formulations``), the backend and the options of every solve.
 
     tolerances: {'feasibility': largest accepted violation, 'gap': certified minus NLP epigraph value that
     ends the exchange loop}; ipopt_options: merged into IPOPT's (names as CasADi takes them, 'ipopt.tol'; runs
@@ -115,7 +116,7 @@ class Solver:
     def __repr__(self):
         return (
             f"Solver(tolerances={self.tolerances}, samples={self.samples}, extra={self.extra}, "
-            f"starts_n={self.starts_n}, backend={self.backend.name}, formulations built={self.formulations})"
+            f"starts_n={self.starts_n}, backend={self.backend.name}, formulations held={self.formulations})"
         )
 
     def options(self) -> dict:
@@ -146,7 +147,7 @@ class Solver:
 
     @property
     def formulations(self) -> int:
-        """How many NLPs this Solver has built."""
+        """How many NLPs this Solver holds (``Formulations``: every kinematic one, the last dynamic tasks')."""
         return len(self._formulations)
 
     def local(self, problem, values0, branch, targets, **kw) -> Candidate:
