@@ -73,12 +73,10 @@ def _dynamic_key(problem) -> tuple:
 
 
 def _task_of(problem, dynamic: tuple) -> tuple | None:
-    """The dynamic task an NLP belongs to (its objective and ``_dynamic_key``: the masses, loads and omega2 it
-    bakes in), or None for an NLP that bakes no masses."""
+    """The dynamic task an NLP belongs to (``_dynamic_key``: the masses, loads and omega2 it bakes in, whatever its
+    objective), or None for an NLP that bakes no masses."""
     used = [criteria.of_problem(problem)] + [c for k, c in criteria.bounds().items() if k in problem.conditions]
-    if not any(c is not None and c.needs_masses for c in used):
-        return None
-    return (problem.objective, *dynamic)
+    return dynamic if any(c is not None and c.needs_masses for c in used) else None
 
 
 class Formulations:
@@ -87,7 +85,7 @@ class Formulations:
     an older task's dropped (each such NLP holds tens of megabytes; a process that designs under many loads would
     otherwise hold them all)."""
 
-    KEPT_TASKS = 2  # a front between two dynamic objectives alternates between two tasks
+    KEPT_TASKS = 2  # two load cases compared in turn
 
     def __init__(self, samples: int, extra: int):
         self.samples, self.extra, self._built = samples, extra, {}

@@ -32,8 +32,9 @@ RANGE_FREE = (RowKind.DEAD_CENTRE, RowKind.ORIENTATION, RowKind.TARGET)  # rows 
 
 
 class Solver:
-    """Owns the NLP formulations (built once per problem structure; a dynamic one's kept while its task is one of
-    the last two, ``Formulations``), the backend and the options of every solve.
+    """Owns the NLP formulations (built once per problem structure; a dynamic one kept while its masses, loads and
+    omega2 are those of one of the last two dynamic tasks, ``Formulations``), the backend and the options of every
+    solve.
 
     tolerances: {'feasibility': largest accepted violation, 'gap': certified minus NLP epigraph value that
     ends the exchange loop}; ipopt_options: merged into IPOPT's (names as CasADi takes them, 'ipopt.tol'; runs
