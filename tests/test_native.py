@@ -130,6 +130,24 @@ def test_the_refinement_in_c_equals_numpys(cls, cache):
 
 
 @needs_compiler
+def test_the_driver_keeps_the_buffers_of_at_most_kept_request_lists(cache):
+    """Each new request list (a kernel's plan, made anew for each design) gets buffers of its own; the driver keeps
+    those of at most KEPT lists, so that a long process does not hold them all, and a list's extremes do not
+    depend on what it kept."""
+    _, m = random_mechanisms("slider-crank", 1, seed=5)[0]
+    k, p = m._kernel, m._vector
+    d = driver.build(k._switch("cycle").f, "cycle_refine")
+    rows, sgn, *_ = k._plan(k.cycle_requests)
+    q = np.ascontiguousarray(m._grid)
+    h = 2 * np.pi / q.shape[1]
+    first = d.refine(q, h, rows, sgn, p)[0].copy()
+    for _ in range(driver.Driver.KEPT + 5):
+        again = d.refine(q, h, rows.copy(), sgn.copy(), p)[0]
+        np.testing.assert_array_equal(again, first)
+    assert 0 < len(d._local.calls) <= driver.Driver.KEPT
+
+
+@needs_compiler
 @pytest.mark.parametrize("kind", ["slider-crank", "crank-shaper", "whitworth", "four-bar", "coupler-slider"])
 def test_compiled_dynamics_equal_the_jets_route(kind, cache):
     """The inverse dynamics once compiled (kinematics, bodies, the Newton-Euler elimination in one C call per

@@ -77,7 +77,9 @@ def _pointer(a: np.ndarray) -> int:
 
 class Driver:
     """The C loop of one kernel group's refinement (``refine``), with its buffers kept per request list and grid,
-    per thread (ctypes runs the call without Python's lock)."""
+    per thread (ctypes runs the call without Python's lock), for at most KEPT of them."""
+
+    KEPT = 64  # request lists whose buffers are kept
 
     def __init__(self, lib: ctypes.CDLL):
         self._refine = lib.qropt_refine
@@ -98,6 +100,8 @@ class Driver:
             calls = self._local.calls = {}
         call = calls.get(key)
         if call is None:
+            if len(calls) >= self.KEPT:
+                calls.clear()
             cap = rows.size * (n // 2 + 1)
             out, starts = np.empty((5, cap)), np.empty(rows.size + 2, np.int64)
             fixed = (_pointer(rows), _pointer(sgn), rows.size)
