@@ -61,22 +61,17 @@ class Candidate:
         return self.t_ipopt
 
 
-def _dynamic_key(problem) -> tuple:
-    """What a criterion bakes into its NLP: a dynamic one the masses, the loads and omega2; any one what its
-    ``baked`` says (nothing otherwise)."""
+def _dynamic_key(problem) -> tuple[tuple, tuple | None]:
+    """What a criterion bakes into its NLP (any one what its ``baked`` says; a dynamic one also the masses, the loads
+    and omega2), and the dynamic task the NLP belongs to: that key where a criterion needs masses (whatever the
+    objective), else None."""
     used = [criteria.of_problem(problem)] + [c for k, c in criteria.bounds().items() if k in problem.conditions]
     used = [c for c in used if c is not None]
     baked = tuple(b for c in used for b in c.baked(problem))
     if not any(c.needs_masses for c in used):
-        return baked
-    return (repr(problem.masses), repr(problem.loads), problem.omega2, *baked)
-
-
-def _task_of(problem, dynamic: tuple) -> tuple | None:
-    """The dynamic task an NLP belongs to (``_dynamic_key``: the masses, loads and omega2 it bakes in, whatever its
-    objective), or None for an NLP that bakes no masses."""
-    used = [criteria.of_problem(problem)] + [c for k, c in criteria.bounds().items() if k in problem.conditions]
-    return dynamic if any(c is not None and c.needs_masses for c in used) else None
+        return baked, None
+    key = (repr(problem.masses), repr(problem.loads), problem.omega2, *baked)
+    return key, key
 
 
 class Formulations:
@@ -101,7 +96,7 @@ class Formulations:
         c = problem.conditions
         bounds = tuple(k for k in c if k not in ("grashof", "linear", "ratio"))
         cond = (c.get("grashof"), bounds, repr(c.get("linear")), repr(c.get("ratio")))
-        dynamic = _dynamic_key(problem)
+        dynamic, task = _dynamic_key(problem)
         key = (
             problem.mechanism,
             tuple(problem.free),
@@ -118,7 +113,6 @@ class Formulations:
             guarded,
             *dynamic,
         )
-        task = _task_of(problem, dynamic)
         if task is not None:
             self._tasks[task] = self._tasks.pop(task, set()) | {key}
             while len(self._tasks) > self.KEPT_TASKS:
