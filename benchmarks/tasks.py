@@ -7,13 +7,15 @@ worst row time, the statuses, and the median and worst ``design()`` time over th
 ``results/tasks.json`` and ``results/tasks.md``.
 
 Run: ``python -m benchmarks.tasks [--tasks 12] [--objectives max_gamma_min min_peak_accel] [--dynamic]
-[--workers K]`` (repository root). ``--dynamic`` adds ``min_peak_torque`` with the default mass model below;
-``--workers`` solves each task's rows in K worker processes (``design(..., workers=K)``; results/tasks_workers.json).
+[--workers K] [--gamma-min DEG]`` (repository root). ``--dynamic`` adds ``min_peak_torque`` with the default mass
+model below; ``--workers`` solves each task's rows in K worker processes (``design(..., workers=K)``;
+results/tasks_workers.json); ``--gamma-min`` bounds every row's transmission angle (results/tasks_gamma<DEG>.json).
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import statistics
 import time
 
@@ -38,10 +40,10 @@ def tasks(n: int, seed: int = SEED) -> list[tuple[float, float]]:
     return [(round(float(1.1 + 1.9 * a), 3), round(float(0.05 * 100**b), 4)) for a, b in u]
 
 
-def run_objective(objective: str, task_list, dynamic: bool, workers: int | None = None) -> dict:
+def run_objective(objective: str, task_list, dynamic: bool, workers: int | None = None, conditions=None) -> dict:
     solver = Solver()
     kw = {"masses": MASSES, "loads": LOADS, "omega2": OMEGA2} if dynamic else {}
-    kw["workers"] = workers
+    kw["workers"], kw["conditions"] = workers, conditions
     tr, s = task_list[0]
     t = time.perf_counter()
     design(tr, s, objective=objective, solver=solver, **kw)
@@ -110,18 +112,23 @@ def main(argv=None) -> int:
     )
     ap.add_argument("--dynamic", action="store_true", help="also min_peak_torque (steel links, 20 kg ram, 1000 N)")
     ap.add_argument("--workers", type=int, help="solve each task's rows in this many worker processes")
+    ap.add_argument("--gamma-min", type=float, help="a transmission bound (deg) for every row")
     args = ap.parse_args(argv)
+    bound = None if args.gamma_min is None else {"gamma_min": math.radians(args.gamma_min)}
     task_list = tasks(args.tasks)
     print(f"{len(task_list)} tasks: " + ", ".join(f"({a:g}, {b:g})" for a, b in task_list))
     results = {}
     for obj in args.objectives:  # a dynamic objective named here runs with the default masses too
-        results[obj] = run_objective(obj, task_list, dynamic=criteria.of(obj).needs_masses, workers=args.workers)
+        dynamic = criteria.of(obj).needs_masses
+        results[obj] = run_objective(obj, task_list, dynamic, args.workers, bound)
     if args.dynamic and "min_peak_torque" not in results:
-        results["min_peak_torque"] = run_objective("min_peak_torque", task_list, dynamic=True, workers=args.workers)
+        results["min_peak_torque"] = run_objective("min_peak_torque", task_list, True, args.workers, bound)
     table = markdown(results, len(task_list))
     print(table)
     name = "tasks" if args.workers is None else "tasks_workers"
-    save(f"{name}.json", {"tasks": task_list, "seed": SEED, "workers": args.workers, "results": results})
+    name += "" if args.gamma_min is None else f"_gamma{args.gamma_min:g}"
+    saved = {"tasks": task_list, "seed": SEED, "workers": args.workers, "gamma_min_deg": args.gamma_min}
+    save(f"{name}.json", {**saved, "results": results})
     (RESULTS / f"{name}.md").write_text(table)
     return 0
 

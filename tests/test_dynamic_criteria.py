@@ -10,7 +10,7 @@ import pytest
 import qropt
 from qropt.studies._design import type_problem
 from qropt.synthesis import analytic, criteria
-from qropt.synthesis.formulation import Formulation
+from qropt.synthesis.formulation import COVERED, Formulation
 from tests.randmech import random_mechanisms
 
 MASSES = qropt.Masses.bars(2.0, 5.0, counterweight=qropt.Counterweight(0.3, 0.05))
@@ -371,6 +371,25 @@ def test_every_lifted_extreme_starts_at_a_stationary_point_of_the_torque():
         assert abs(t[1] - t[0]) / (2 * h) < 1e-4 * scale, np.degrees(angle)  # dT/dtheta2 = 0 (N m/rad)
 
 
+def test_relifting_moves_only_the_lifts_no_largest_extreme_has():
+    """Between exchange rounds a largest extreme of the torque without a lifted angle takes one that is at no
+    largest extreme; lifts near one (within COVERED) stay where the NLP put them."""
+    p, m = _whitworth_238()
+    a, _ = m.stroke_angles()
+    f = Formulation(p, {"sigma_slider": 1.0}, 1 if a >= 2 * np.pi - a else -1)
+    top, _, _ = f.lifted_start(p, _WHITWORTH_238)
+    peaks = list(dict.fromkeys(top))
+    assert len(peaks) == 3
+    off = peaks[1] + 0.5 * COVERED  # the second peak's lift a little off it; a lower extreme's, far from any peak
+    lower = peaks[2] + 1.0
+    w = f.pack(_WHITWORTH_238, (0.0, np.pi), phi=[peaks[0], off, lower, peaks[0]])
+    phi = f.w_blocks.split(f.relifted(w, p, _WHITWORTH_238))["phi"]
+    assert list(phi) == [peaks[0], off, peaks[2], peaks[0]]
+    assert f.relifted(f.pack(_WHITWORTH_238, (0.0, np.pi), phi=phi), p, _WHITWORTH_238) == pytest.approx(
+        f.pack(_WHITWORTH_238, (0.0, np.pi), phi=phi), abs=0.0
+    )
+
+
 def test_a_solve_from_the_whitworths_best_design_stays_there():
     """From its least peak torque (7,241.4249 N m, the best of multi-starts of 64, 64 and 128 Sobol starts) a
     local solve ends there; with its fourth lift started where the torque was not stationary it ended at
@@ -449,3 +468,42 @@ def test_a_design_certified_under_the_transmission_guard_is_continued_to_the_pro
     th = np.linspace(0.0, 2 * np.pi, 20001)
     peak = np.abs(m.dynamics(th, 10.0, masses=masses, loads=loads).torque).max()
     assert value * (1 - 1e-5) <= peak <= value * (1 + 1e-12)
+
+
+_COUPLER_START = {  # the fourth Sobol start of the coupler slider's row at TR 1.423, 0.5 m (a 30 deg bound)
+    "r1": 0.37644777284899716,
+    "r2": 0.16623169045508182,
+    "r3": 0.2642721983281384,
+    "r4": 0.40674295024807927,
+    "r5": 0.04182900053258713,
+    "r6": 0.7367629320347397,
+    "h": 0.483613570106132,
+    "beta": 2.683402082490516,
+}
+
+
+def test_the_exchange_lifts_the_largest_extremes_of_each_design_it_meets():
+    """From this start the NLP's lifted angles ended the first rounds at lower extremes of the torque, and its two
+    peaks were left to the samples: each round's design slipped past them (the gap 1e-4 to 1e-2 of the peak, round
+    after round) and the local solve ended after 30 rounds without a design. Lifted again at each design's largest
+    extremes, the rounds converge: a certified design whose peak is the dense grid's, below the 125.1094 N m the
+    row's full search gave before."""
+    from benchmarks.tasks import LOADS, MASSES
+
+    p = type_problem(
+        "coupler-slider",
+        1.423,
+        0.5,
+        objective="min_peak_torque",
+        conditions={"gamma_min": np.radians(30.0)},
+        masses=MASSES,
+        loads=LOADS,
+        omega2=10.0,
+    )
+    solver = qropt.Solver()
+    c = solver.local(p, _COUPLER_START, {"sigma": -1.0, "sigma_slider": 1.0}, dict(p.targets), orientation=1)
+    assert c.ok and c.rounds < solver.max_rounds
+    d = c.mechanism.dynamics(np.linspace(0.0, 2 * np.pi, 36000, endpoint=False), 10.0, masses=MASSES, loads=LOADS)
+    peak = np.abs(d.torque).max()
+    assert c.info["certified"] == pytest.approx(peak, rel=1e-6)
+    assert peak < 125.1094

@@ -34,6 +34,7 @@ TWO_PI = 2.0 * math.pi
 BASE_SAMPLES = 8  # uniform sample angles of the epigraphs; the exchange loop adds what binds
 EXTRA_SAMPLES = 8  # slots for the exchange loop's angles
 EXTREME_SLACK = 1e-6  # of the travel: how far the output may pass a dead centre's in the NLP (the certifier: 0)
+COVERED = 0.05  # rad: a lifted angle this near an extreme is at it (``relifted``)
 MONOTONE = 2  # lifted turn-back angles per stroke of a guarded NLP (placed where the certifier finds a turn-back)
 TURN_GRID = 362  # points per stroke where a design's turn-backs are looked for (the start of the lifted angles)
 TURN_NEAR = 0.05  # rad: a turn-back found this close to a lifted one is that one, moved
@@ -609,6 +610,29 @@ class Formulation:
             return (phi or None), box, (self.turn_start(m, theta) if guarded else None)
         except QroptError:
             return None, None, None
+
+    def relifted(self, w, problem, values: dict, build=None) -> np.ndarray:
+        """w with each lifting criterion's largest extremes at the design ``values`` lifted: a largest extreme no
+        lifted angle is at (to COVERED rad) takes a lifted angle that is at none of them, largest first; the lifts at
+        one stay (w unchanged where every largest extreme has a lift, or the design does not build). A lift the last
+        round held at a lower extreme leaves a peak to the samples, which the next design slips past round after
+        round; a lift at a lower peak that rises as the design moves keeps it."""
+        wanted, _, _ = self.lifted_start(problem, values, build)
+        if wanted is None:
+            return w
+        b = self.w_blocks.split(w)
+        phi, i = np.array(b["phi"], float), 0
+        for c in dict.fromkeys(c for c, _ in self.lifts):
+            n = sum(1 for c2, _ in self.lifts if c2 is c)
+            now, top = phi[i : i + n], list(dict.fromkeys(wanted[i : i + n]))
+            near = np.abs((now[:, None] - np.array(top)[None, :] + math.pi) % TWO_PI - math.pi) < COVERED
+            free = [k for k in range(n) if not near[k].any()]
+            for j in (j for j in range(len(top)) if not near[:, j].any()):
+                if free:
+                    now[free.pop(0)] = top[j]
+            i += n
+        b["phi"] = phi
+        return self.w_blocks.join(**b)
 
     def box_angles(self, box=None) -> list:
         """The lifted box sides' angles (BOX_SIDES order) from a BoundingBox's angles."""

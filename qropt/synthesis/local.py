@@ -289,6 +289,8 @@ class LocalSolve:
             if form.n_box and m is not None:  # each box side lifted at the coordinate that reaches it now
                 box = m.bounding_box()
                 w = form.with_box(w, box)
+            if form.n_lift and m is not None:  # every largest extreme of this design lifted
+                w = form.relifted(w, c.problem or problem, c.values, designs)
             p = form.param_vector(problem, targets, samples, fractions, box=box, caps=caps)
             w = form.epigraph_start(w, p) if info.get("gap", 0) > 0 or not info.get("ok") else w
         c.mechanism, c.info = m, info
