@@ -28,6 +28,7 @@ from qropt.errors import QroptError
 from qropt.kinematics.closures import RIGHT_ANGLE, transmission_cos
 from qropt.kinematics.ops import CASADI
 from qropt.synthesis import criteria
+from qropt.synthesis.certificate import angle_gap
 from qropt.synthesis.criteria import Role
 
 TWO_PI = 2.0 * math.pi
@@ -496,7 +497,7 @@ class Formulation:
             lo, _, arc = spans[s]
             t = lo + fraction * arc
             slots = np.arange(s * MONOTONE, (s + 1) * MONOTONE)
-            gaps = np.abs((now[slots] - t + math.pi) % TWO_PI - math.pi)
+            gaps = angle_gap(now[slots], t)
             i = slots[int(np.argmin(gaps))]
             if gaps.min() > TURN_NEAR:  # a new turn-back: in place of the slot that holds least
                 i = slots[fastest(against(s, now[slots]))]
@@ -604,12 +605,15 @@ class Formulation:
             m = (build or type(problem).build)(problem, values, self.branch)
             box = m.bounding_box() if self.n_box else None
             phi = []
-            for c in dict.fromkeys(c for c, _ in self.lifts):
-                n = sum(1 for c2, _ in self.lifts if c2 is c)
+            for c, n in self._lift_groups():
                 phi += criteria.repeated(c.lift_start(self, problem, m, n), n)
             return (phi or None), box, (self.turn_start(m, theta) if guarded else None)
         except QroptError:
             return None, None, None
+
+    def _lift_groups(self) -> list:
+        """(criterion, how many lifts) in the order of the lifted angles (each criterion's lifts are adjacent)."""
+        return [(c, sum(1 for c2, _ in self.lifts if c2 is c)) for c in dict.fromkeys(c for c, _ in self.lifts)]
 
     def relifted(self, w, problem, values: dict, build=None) -> np.ndarray:
         """w with each lifting criterion's largest extremes at the design ``values`` lifted: a largest extreme no
@@ -622,10 +626,9 @@ class Formulation:
             return w
         b = self.w_blocks.split(w)
         phi, i = np.array(b["phi"], float), 0
-        for c in dict.fromkeys(c for c, _ in self.lifts):
-            n = sum(1 for c2, _ in self.lifts if c2 is c)
+        for _, n in self._lift_groups():
             now, top = phi[i : i + n], list(dict.fromkeys(wanted[i : i + n]))
-            near = np.abs((now[:, None] - np.array(top)[None, :] + math.pi) % TWO_PI - math.pi) < COVERED
+            near = angle_gap(now[:, None], np.array(top)[None, :]) < COVERED
             free = [k for k in range(n) if not near[k].any()]
             for j in (j for j in range(len(top)) if not near[:, j].any()):
                 if free:
