@@ -1,11 +1,14 @@
 """Every ``qropt`` command the README and the docs/*.md pages show (each once, the README's first, then the
-pages' in name order), run as a subprocess of the installed executable from a directory outside the repository
-(holding a copy of ``problems/``, which the commands name): exit code 0, and every file the command names written
-and not empty (a folder it names: its files). A command that names a running Dask scheduler runs after the
-README's background lines (those ending in ``&``: the scheduler and its workers) are started as the README shows
-them. ``qropt app`` serves until stopped: it runs until it answers ``/api/health`` at the address it prints (no
-browser opened), then is stopped with Ctrl-C and must exit 0. ``qropt bench`` and the ``python -m benchmarks``
-lines are the benchmarks' own (minutes long, run from the repository root): they are not run here."""
+pages' in name order), run from a directory outside the repository (holding a copy of ``problems/``, which the
+commands name): exit code 0, and every file the command names written and not empty (a folder it names: its
+files). ``BY_EXECUTABLE``, the commands that use a shell (``&&``, ``>``) and those below run as subprocesses of
+the installed executable; the others run the executable's function (``qropt.cli.main``) in a fresh process forked
+from one that has imported qropt (``tests.child.run_cli``), without the start-up's second or so each. A command
+that names a running Dask scheduler runs after the README's background lines (those ending in ``&``: the
+scheduler and its workers) are started as the README shows them. ``qropt app`` serves until stopped: it runs
+until it answers ``/api/health`` at the address it prints (no browser opened), then is stopped with Ctrl-C and
+must exit 0. ``qropt bench`` and the ``python -m benchmarks`` lines are the benchmarks' own (minutes long, run
+from the repository root): they are not run here."""
 
 from __future__ import annotations
 
@@ -17,10 +20,12 @@ import shutil
 import signal
 import socket
 import subprocess
-import time
 from pathlib import Path
 
 import pytest
+from distributed import Client
+
+from tests.child import run_cli
 
 ROOT = Path(__file__).resolve().parent.parent
 OUTPUT_FLAGS = ("--plot", "--csv", "--animate", "--dxf", "--svg", "--save", "-o")
@@ -69,8 +74,8 @@ def on_port(command: str, port: str, free: int) -> str:
 @contextlib.contextmanager
 def services(cwd, address):
     """The README's background lines running (in their own process groups) until the scheduler at ``address``
-    (tcp://host:port, the pages' port replaced by the caller with a free one) answers and has workers; stopped
-    afterwards."""
+    (tcp://host:port, the pages' port replaced by the caller with a free one) answers and has the workers they
+    start; stopped afterwards."""
     bindir = Path(shutil.which("qropt")).parent
     env = {**os.environ, "PATH": f"{bindir}{os.pathsep}{os.environ['PATH']}"}
     host, port = address.removeprefix("tcp://").split(":")
@@ -88,11 +93,9 @@ def services(cwd, address):
         for c in background_commands()
     ]
     try:
-        for _ in range(120):
-            with contextlib.suppress(OSError), socket.create_connection((host, int(port)), timeout=1):
-                break
-            time.sleep(0.5)
-        time.sleep(5)  # the workers connect
+        workers = sum(int(n) for n in re.findall(r"--nworkers (\d+)", " ".join(background_commands())))
+        with Client(address, timeout=60) as client:
+            client.wait_for_workers(workers, timeout=120)
         yield
     finally:
         for p in procs:
@@ -109,6 +112,7 @@ def outputs(command: str) -> list[str]:
 
 
 COMMANDS = readme_commands()
+BY_EXECUTABLE = ("qropt --version", "qropt synth")  # the installed executable itself (the others: see the docstring)
 
 
 def test_the_readme_shows_commands():
@@ -136,9 +140,13 @@ def test_readme_command_runs(command, workdir):
     if address:  # the scheduler on a free port, not the page's
         shell = on_port(shell, address.group(1), free_port())
         address = re.search(r"--scheduler (tcp://\S+)", shell)
-    with services(workdir, address.group(1)) if address else contextlib.nullcontext():
-        r = subprocess.run(shell, shell=True, cwd=workdir, capture_output=True, text=True, timeout=240)
-    assert r.returncode == 0, (command, r.stdout[-2000:], r.stderr[-2000:])
+    if address or command in BY_EXECUTABLE or re.search(r"[&|<>;]", command):
+        with services(workdir, address.group(1)) if address else contextlib.nullcontext():
+            r = subprocess.run(shell, shell=True, cwd=workdir, capture_output=True, text=True, timeout=240)
+        code, output = r.returncode, r.stdout + r.stderr
+    else:
+        code, output = run_cli(shlex.split(command)[1:], workdir, timeout=240)
+    assert code == 0, (command, output[-3000:])
     for name in outputs(command):
         path = workdir / name
         if path.is_dir():  # a set of files (qropt project --count): every one written
