@@ -7,9 +7,11 @@ worst row time, the statuses, and the median and worst ``design()`` time over th
 ``results/tasks.json`` and ``results/tasks.md``.
 
 Run: ``python -m benchmarks.tasks [--tasks 12] [--objectives max_gamma_min min_peak_accel] [--dynamic]
-[--workers K] [--gamma-min DEG]`` (repository root). ``--dynamic`` adds ``min_peak_torque`` with the default mass
-model below; ``--workers`` solves each task's rows in K worker processes (``design(..., workers=K)``;
-results/tasks_workers.json); ``--gamma-min`` bounds every row's transmission angle (results/tasks_gamma<DEG>.json).
+[--workers K] [--gamma-min DEG] [--settings NAME=VALUE ...]`` (repository root). ``--dynamic`` adds
+``min_peak_torque`` with the default mass model below; ``--workers`` solves each task's rows in K worker processes
+(``design(..., workers=K)``; results/tasks_workers.json); ``--gamma-min`` bounds every row's transmission angle
+(results/tasks_gamma<DEG>.json); ``--settings`` changes the search's numbers (``qropt.synthesis.search.Settings``,
+e.g. ``relifts=1``: results/tasks_gamma30_relifts1.json).
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from benchmarks.report import RESULTS, save
 from qropt import Solver
 from qropt.studies._design import TYPES, design
 from qropt.synthesis import criteria
+from qropt.synthesis.search import Settings
 
 SEED = 20261124
 MASSES = qropt.Masses.steel(4e-4, ram=20.0)  # steel links of 4 cm^2 (3.14 kg/m), a 20 kg ram
@@ -40,8 +43,10 @@ def tasks(n: int, seed: int = SEED) -> list[tuple[float, float]]:
     return [(round(float(1.1 + 1.9 * a), 3), round(float(0.05 * 100**b), 4)) for a, b in u]
 
 
-def run_objective(objective: str, task_list, dynamic: bool, workers: int | None = None, conditions=None) -> dict:
-    solver = Solver()
+def run_objective(
+    objective: str, task_list, dynamic: bool, workers: int | None = None, conditions=None, settings=None
+) -> dict:
+    solver = Solver(settings=settings)
     kw = {"masses": MASSES, "loads": LOADS, "omega2": OMEGA2} if dynamic else {}
     kw["workers"], kw["conditions"] = workers, conditions
     tr, s = task_list[0]
@@ -113,24 +118,49 @@ def main(argv=None) -> int:
     ap.add_argument("--dynamic", action="store_true", help="also min_peak_torque (steel links, 20 kg ram, 1000 N)")
     ap.add_argument("--workers", type=int, help="solve each task's rows in this many worker processes")
     ap.add_argument("--gamma-min", type=float, help="a transmission bound (deg) for every row")
+    ap.add_argument(
+        "--settings", nargs="+", default=[], metavar="NAME=VALUE", help="the search's numbers (qropt Settings)"
+    )
     args = ap.parse_args(argv)
     bound = None if args.gamma_min is None else {"gamma_min": math.radians(args.gamma_min)}
+    settings = _settings(args.settings)
     task_list = tasks(args.tasks)
     print(f"{len(task_list)} tasks: " + ", ".join(f"({a:g}, {b:g})" for a, b in task_list))
     results = {}
     for obj in args.objectives:  # a dynamic objective named here runs with the default masses too
         dynamic = criteria.of(obj).needs_masses
-        results[obj] = run_objective(obj, task_list, dynamic, args.workers, bound)
+        results[obj] = run_objective(obj, task_list, dynamic, args.workers, bound, settings)
     if args.dynamic and "min_peak_torque" not in results:
-        results["min_peak_torque"] = run_objective("min_peak_torque", task_list, True, args.workers, bound)
+        results["min_peak_torque"] = run_objective("min_peak_torque", task_list, True, args.workers, bound, settings)
     table = markdown(results, len(task_list))
     print(table)
     name = "tasks" if args.workers is None else "tasks_workers"
     name += "" if args.gamma_min is None else f"_gamma{args.gamma_min:g}"
+    name += "".join(f"_{a.replace('=', '')}" for a in args.settings)
     saved = {"tasks": task_list, "seed": SEED, "workers": args.workers, "gamma_min_deg": args.gamma_min}
+    saved["settings"] = {k: v for k, v in settings.to_dict().items() if v != getattr(Settings(), k)}
     save(f"{name}.json", {**saved, "results": results})
     (RESULTS / f"{name}.md").write_text(table)
     return 0
+
+
+def _settings(pairs) -> Settings:
+    """Settings from NAME=VALUE pairs (each value as the default's type)."""
+    given = {}
+    for pair in pairs:
+        name, _, value = pair.partition("=")
+        default = getattr(Settings(), name, None)
+        if default is None or not value:
+            raise SystemExit(f"--settings: {pair!r} is not NAME=VALUE of a Settings field")
+        try:
+            given[name] = type(default)(value)
+        except ValueError:
+            kind = "an integer" if isinstance(default, int) else "a number"
+            raise SystemExit(f"--settings: {name} is {kind}, got {value!r}") from None
+    try:
+        return Settings(**given)
+    except qropt.ProblemError as e:
+        raise SystemExit(f"--settings: {e}") from None
 
 
 if __name__ == "__main__":

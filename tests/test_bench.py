@@ -144,3 +144,21 @@ def test_strategies_summary_counts_rows_changed_by_leaving_a_strategy_out():
     assert "Sobol multi-start" not in [p.name for p in phase.stages]
     with pytest.raises(SystemExit, match="unknown strategies"):
         strategies.pipelines(["no such"])
+
+
+def test_the_tasks_benchmark_takes_the_searchs_numbers():
+    """``python -m benchmarks.tasks --settings NAME=VALUE ...``: each a Settings field in its default's type, the
+    others left at their defaults; anything else is one line naming it."""
+    from benchmarks.tasks import _settings
+    from qropt.synthesis.search import Settings
+
+    assert _settings(["relifts=1", "restart_violation=1e-5"]) == Settings(relifts=1, restart_violation=1e-5)
+    assert _settings([]) == Settings()
+    for bad, said in [
+        (["nope=1"], "'nope=1' is not NAME=VALUE of a Settings field"),
+        (["relifts"], "'relifts' is not NAME=VALUE"),
+        (["relifts=1.5"], "relifts is an integer, got '1.5'"),
+        (["relifts=0"], "relifts is a positive int, got 0"),
+    ]:
+        with pytest.raises(SystemExit, match=said):
+            _settings(bad)
