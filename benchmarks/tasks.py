@@ -28,7 +28,7 @@ from benchmarks.report import RESULTS, save
 from qropt import Solver
 from qropt.studies._design import TYPES, design
 from qropt.synthesis import criteria
-from qropt.synthesis.search import Settings
+from qropt.synthesis.settings import DEFAULT, Settings
 
 SEED = 20261124
 MASSES = qropt.Masses.steel(4e-4, ram=20.0)  # steel links of 4 cm^2 (3.14 kg/m), a 20 kg ram
@@ -138,7 +138,7 @@ def main(argv=None) -> int:
     name += "" if args.gamma_min is None else f"_gamma{args.gamma_min:g}"
     name += "".join(f"_{a.replace('=', '')}" for a in args.settings)
     saved = {"tasks": task_list, "seed": SEED, "workers": args.workers, "gamma_min_deg": args.gamma_min}
-    saved["settings"] = {k: v for k, v in settings.to_dict().items() if v != getattr(Settings(), k)}
+    saved["settings"] = {k: v for k, v in settings.to_dict().items() if v != getattr(DEFAULT, k)}
     save(f"{name}.json", {**saved, "results": results})
     (RESULTS / f"{name}.md").write_text(table)
     return 0
@@ -146,12 +146,12 @@ def main(argv=None) -> int:
 
 def _settings(pairs) -> Settings:
     """Settings from NAME=VALUE pairs (each value as the default's type)."""
-    given = {}
+    defaults, given = DEFAULT.to_dict(), {}
     for pair in pairs:
         name, _, value = pair.partition("=")
-        default = getattr(Settings(), name, None)
-        if default is None or not value:
+        if name not in defaults or not value:
             raise SystemExit(f"--settings: {pair!r} is not NAME=VALUE of a Settings field")
+        default = defaults[name]
         try:
             given[name] = type(default)(value)
         except ValueError:

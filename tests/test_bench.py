@@ -157,6 +157,7 @@ def test_the_tasks_benchmark_takes_the_searchs_numbers():
     for bad, said in [
         (["nope=1"], "'nope=1' is not NAME=VALUE of a Settings field"),
         (["relifts"], "'relifts' is not NAME=VALUE"),
+        (["to_dict=1"], "'to_dict=1' is not NAME=VALUE of a Settings field"),
         (["relifts=1.5"], "relifts is an integer, got '1.5'"),
         (["relifts=0"], "relifts is a positive int, got 0"),
     ]:

@@ -78,8 +78,9 @@ def services(cwd, address):
     start; stopped afterwards."""
     bindir = Path(shutil.which("qropt")).parent
     env = {**os.environ, "PATH": f"{bindir}{os.pathsep}{os.environ['PATH']}"}
-    host, port = address.removeprefix("tcp://").split(":")
-    page_port = re.search(r"--port (\d+)", " ".join(background_commands())).group(1)
+    port = address.rsplit(":", 1)[1]
+    lines = background_commands()
+    page_port = re.search(r"--port (\d+)", " ".join(lines)).group(1)
     procs = [
         subprocess.Popen(
             on_port(c, page_port, int(port)),
@@ -90,10 +91,10 @@ def services(cwd, address):
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
         )
-        for c in background_commands()
+        for c in lines
     ]
     try:
-        workers = sum(int(n) for n in re.findall(r"--nworkers (\d+)", " ".join(background_commands())))
+        workers = sum(int(n) for n in re.findall(r"--nworkers (\d+)", " ".join(lines)))
         with Client(address, timeout=60) as client:
             client.wait_for_workers(workers, timeout=120)
         yield
