@@ -140,6 +140,26 @@ def test_no_criterion_name_in_generic_search_code():
     assert found == []
 
 
+def test_a_bound_beyond_its_own_optimum_ends_the_solve_before_its_starts():
+    """The crank-rocker slider at TR 2.373 reaches a transmission angle of 14.63 deg at most (its max_gamma_min,
+    which the atlas holds). By the peak acceleration under a 30 deg bound the solve is infeasible before any start,
+    in the diagnosis's words, which the pipeline without the check gives after its starts have failed; under a
+    10 deg bound the check passes and the search runs."""
+    from qropt.synthesis.search.reach import BoundsInReach
+
+    p = type_problem("crank-rocker-slider", 2.373, 2.3207, objective="min_peak_accel", conditions={"gamma_min": 0.5236})
+    quick = Solver().solve(p)
+    assert quick.status == "infeasible" and "(14.63 deg)" in quick.message, quick.message
+    assert quick.stats["strategies"] == ["plan", "bounds in reach"] and quick.stats["starts"] == 0
+    without = Solver(starts_n=1, pipeline=[s for s in search.DEFAULT if not isinstance(s, BoundsInReach)])
+    slow = without.solve(p)
+    assert slow.status == "infeasible" and slow.message == quick.message
+    assert "bounds in reach" not in slow.stats["strategies"] and slow.stats["starts"] > 0
+    r = Solver(starts_n=1).solve(p.replace(conditions={"gamma_min": math.radians(10)}))
+    assert r.status == "optimal" and r.mechanism.gamma_min().value >= math.radians(10) - 1e-9, r.message
+    assert {"bounds in reach", "local solves"} <= set(r.stats["strategies"])
+
+
 def test_each_default_strategy_is_one_module_with_a_name():
     """One module per strategy in qropt/synthesis/search/, each strategy named, every name distinct."""
     stages = [*search.DEFAULT, *search.STARTS]

@@ -178,21 +178,28 @@ def searched(context, problem, plan, cands, claim, retry):
     return cands, claim, plan
 
 
-def bound_out_of_reach(context, problem, starts_n):
+def bound_problems(problem) -> list:
+    """(condition, criterion, problem) for each bound condition of ``problem``: the problem that optimises the
+    bound's criterion under the targets and the other conditions."""
+    out = []
+    for key, c in criteria.bounds().items():
+        if problem.conditions.get(key) is None:
+            continue
+        others = {k: v for k, v in problem.conditions.items() if k != key}
+        out.append((key, c, problem.replace(objective=c.objective, size=c.size or problem.size, conditions=others)))
+    return out
+
+
+def bound_out_of_reach(context, problem, starts_n, atlas_only: bool = False):
     """((message, {quantity: (low, high)}) if a bound condition is beyond what any design meeting the targets and
     the other conditions reaches (its best value, from a solve optimising it), else None; and the designs of those
-    solves that meet every bound, as starts)."""
+    solves that meet every bound, as starts). atlas_only: only the bounds whose own problem the atlas holds."""
     found = []
     tol = context.solver.tolerances["feasibility"]
-    for key, c in criteria.bounds().items():
-        bound = problem.conditions.get(key)
-        if bound is None:
+    for key, c, sub in bound_problems(problem):
+        if atlas_only and not atlas_.starts(sub).designs:
             continue
-        sub = problem.replace(
-            objective=c.objective,
-            size=c.size or problem.size,
-            conditions={k: v for k, v in problem.conditions.items() if k != key},
-        )
+        bound = problem.conditions[key]
         r = _sub(context, sub, starts_n=starts_n)
         if r.status not in ("optimal", "acceptable"):
             continue
@@ -247,4 +254,13 @@ def _dead_point_hint(problem) -> str:
     )
 
 
-__all__ = ["Diagnose", "Failed", "diagnose", "searched", "inside", "range_message"]
+__all__ = [
+    "Diagnose",
+    "Failed",
+    "diagnose",
+    "searched",
+    "inside",
+    "range_message",
+    "bound_problems",
+    "bound_out_of_reach",
+]

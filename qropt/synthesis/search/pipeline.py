@@ -24,6 +24,7 @@ from qropt.synthesis.search.local_solves import LocalSolves
 from qropt.synthesis.search.plan import Planned
 from qropt.synthesis.search.points import ClosedFormPoints
 from qropt.synthesis.search.proof import ProvedInfeasible
+from qropt.synthesis.search.reach import BoundsInReach
 from qropt.synthesis.search.refresh import Refresh
 from qropt.synthesis.search.related import Related
 from qropt.synthesis.search.scale import UnitScale
@@ -51,6 +52,7 @@ STARTS = (
 DEFAULT = (
     UnitScale(),  # far from unit scale: solved at unit scale, the Result scaled back
     Planned(),  # the plan of starts
+    BoundsInReach(),  # a bound beyond its own optimum, which the atlas holds: infeasible before any start
     Phase(STARTS),  # the multi-start
     Guarded(),  # a criterion seen badly near a toggle: the starts under a transmission guard, continued
     Evolution(),  # ... and descents from differential evolutions
