@@ -121,6 +121,7 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--settings", nargs="+", default=[], metavar="NAME=VALUE", help="the search's numbers (qropt Settings)"
     )
+    ap.add_argument("--name", help="the results' file name (default: tasks, with the workers, bound and settings)")
     args = ap.parse_args(argv)
     bound = None if args.gamma_min is None else {"gamma_min": math.radians(args.gamma_min)}
     settings = _settings(args.settings)
@@ -137,6 +138,7 @@ def main(argv=None) -> int:
     name = "tasks" if args.workers is None else "tasks_workers"
     name += "" if args.gamma_min is None else f"_gamma{args.gamma_min:g}"
     name += "".join(f"_{a.replace('=', '')}" for a in args.settings)
+    name = args.name or name
     saved = {"tasks": task_list, "seed": SEED, "workers": args.workers, "gamma_min_deg": args.gamma_min}
     saved["settings"] = {k: v for k, v in settings.to_dict().items() if v != getattr(DEFAULT, k)}
     save(f"{name}.json", {**saved, "results": results})

@@ -157,7 +157,8 @@ def test_a_bound_beyond_its_own_optimum_ends_the_solve_before_its_starts():
     assert "bounds in reach" not in slow.stats["strategies"] and slow.stats["starts"] > 0
     r = Solver(starts_n=1).solve(p.replace(conditions={"gamma_min": math.radians(10)}))
     assert r.status == "optimal" and r.mechanism.gamma_min().value >= math.radians(10) - 1e-9, r.message
-    assert {"bounds in reach", "local solves"} <= set(r.stats["strategies"])
+    assert "bounds in reach" in r.stats["strategies"]  # passed: the search goes on (from the atlas without it)
+    assert "without its bound gamma_min" in r.certificate.global_claim
 
 
 def test_each_default_strategy_is_one_module_with_a_name():

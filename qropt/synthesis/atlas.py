@@ -9,12 +9,14 @@ strokes, no targets, no name, no omega2). The atlas (``atlas.json`` beside this 
 benchmarks.atlas``) holds, per signature, node time ratios and at each node the best distinct certified designs
 of a many-start search, continued from node to node, lengths in strokes. A solve of a problem whose signature
 is in the atlas, at a TR inside its nodes, first starts from the designs of the two nodes around it
-(``starts``); only where none of them gives a certified design does it run the multi-start.
+(``starts``); only where none of them gives a certified design does it run the multi-start. A problem whose
+signature is in the atlas only without its bound conditions starts from that problem's designs.
 """
 
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import functools
 import json
 from dataclasses import dataclass
@@ -74,12 +76,14 @@ def signature(problem) -> str | None:
 @dataclass(frozen=True)
 class Starts:
     """A solve's starts from the atlas: (free values, branch) pairs in the problem's lengths, the node (0 or 1,
-    the lower or upper time ratio) each comes from, what they are, and the nodes' time ratios (``trs``)."""
+    the lower or upper time ratio) each comes from, what they are, the nodes' time ratios (``trs``), and the bound
+    conditions of the problem they were found without (``unbounded``)."""
 
     designs: tuple = ()
     how: str = ""
     nodes: tuple = ()
     trs: tuple = ()
+    unbounded: tuple = ()  # the problem's bound conditions the designs were found without (``starts``)
 
 
 @functools.cache
@@ -98,10 +102,29 @@ def _same(a: dict, b: dict) -> bool:
 
 def starts(problem) -> Starts:
     """The atlas's designs at the nodes around the problem's time ratio, scaled to its stroke and clipped to its
-    bounds; empty where its signature is not in the atlas or its TR is outside the nodes."""
+    bounds; where the atlas holds the problem only without its bound conditions, the designs of that problem
+    (``unbounded`` names the bounds: where its optimum meets them, it is the problem's); empty where neither is in
+    the atlas or the TR is outside the nodes."""
     key = signature(problem)
     entry = _entries().get(key) if key else None
-    return Starts() if entry is None else _around(problem, [entry])
+    if entry is not None:
+        return _around(problem, [entry])
+    loose = [k for k in problem.conditions if k in criteria.bounds()]
+    if not loose:
+        return Starts()
+    key = signature(unbounded(problem, loose))
+    entry = _entries().get(key) if key else None
+    if entry is None:
+        return Starts()
+    found = _around(problem, [entry], f" without its bound {' and '.join(loose)}")
+    return dataclasses.replace(found, unbounded=tuple(loose)) if found.designs else found
+
+
+def unbounded(problem, names):
+    """The problem without the bound conditions ``names``."""
+    if not names:
+        return problem
+    return problem.replace(conditions={k: v for k, v in problem.conditions.items() if k not in names})
 
 
 def related(problem) -> Starts:
@@ -129,8 +152,9 @@ def _by_shape() -> dict:
     return out
 
 
-def _around(problem, entries: list) -> Starts:
-    """The designs of entries (with the same nodes) at the nodes around the problem's TR (``starts``)."""
+def _around(problem, entries: list, without: str = "") -> Starts:
+    """The designs of entries (with the same nodes) at the nodes around the problem's TR (``starts``); without:
+    words after the objective, for designs found without the problem's bounds."""
     tr, nodes = float(problem.targets["time_ratio"]), entries[0]["nodes"]
     if not nodes[0] <= tr <= nodes[-1]:
         return Starts()
@@ -151,10 +175,11 @@ def _around(problem, entries: list) -> Starts:
                 node.append(n)
     at = " and ".join(f"{nodes[j]:g}" for j in around)
     by = " and ".join(e["objective"] for e in entries)
-    how = f"{len(out)} designs of the atlas at TR {at} by {by} (each node's best of a {entries[0]['starts']}-start"
+    how = f"{len(out)} designs of the atlas at TR {at} by {by}{without}"
+    how += f" (each node's best of a {entries[0]['starts']}-start"
     how += f" search, of the best of {entries[0]['shapes']:,} random shapes near it" if entries[0].get("shapes") else ""
     how += " and of solves from its neighbours' designs)"
     return Starts(tuple(out), how, tuple(node), tuple(float(nodes[j]) for j in around))
 
 
-__all__ = ["signature", "starts", "related", "Starts", "PATH"]
+__all__ = ["signature", "starts", "related", "unbounded", "Starts", "PATH"]

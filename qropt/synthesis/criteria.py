@@ -558,6 +558,21 @@ def violations(problem, m) -> dict:
     return out
 
 
+BINDS = 1e-6  # a bound met with less room than this (relative to the bound, absolute below 1) holds a design back
+
+
+def binding(problem, m, names) -> list[str]:
+    """The bound conditions among ``names`` that m meets with less room than ``BINDS``: those that can hold it
+    back from a better design."""
+    out = []
+    for key in names:
+        c, bound = bounds()[key], problem.conditions[key]
+        room = BINDS * max(1.0, abs(bound))
+        if c.violation(problem, m, bound + room if c.maximise else bound - room) > 0:
+            out.append(key)
+    return out
+
+
 def objective_of(problem, m) -> float | None:
     """The problem's objective of a mechanism, exactly; None without one."""
     c = of_problem(problem)

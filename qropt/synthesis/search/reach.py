@@ -18,7 +18,7 @@ class BoundsInReach(Stage):
     name = "bounds in reach"
 
     def accepts(self, problem, plan):
-        if plan is None or not (plan.spread and plan.searching) or plan.atlas.designs:
+        if plan is None or not (plan.spread and plan.searching) or (plan.atlas.designs and not plan.atlas.unbounded):
             return False  # a closed form or the atlas answers the problem itself as quickly
         return any(atlas_.starts(sub).designs for _, _, sub in bound_problems(problem))
 
