@@ -90,20 +90,19 @@ def test_a_solve_between_nodes_starts_from_the_atlas_and_is_as_good_as_the_multi
 def test_a_bounded_problem_starts_from_the_atlas_optima_without_its_bound():
     """The coupler slider by the peak acceleration under a transmission bound, which the atlas does not hold: its
     starts are the atlas's optima without the bound. Under 10 deg the unbounded optimum (23.55 deg) meets the bound,
-    so it is the bounded one's, in a few runs and no worse than a multi-start without the atlas; under 60 deg the
+    so it is the bounded one's (the bound cannot make it better), without the multi-start; under 60 deg the
     atlas's designs fall short of their nodes and the multi-start runs as well."""
     p = type_problem("coupler-slider", 1.83, 0.42, objective="min_peak_accel", conditions={"gamma_min": 0.1745})
     found = atlas.starts(p)
     assert found.unbounded == ("gamma_min",) and found.designs
     assert found.designs == atlas.starts(p.replace(conditions={})).designs
-    r, without = Solver().solve(p), Solver(atlas=False, starts_n=2).solve(p)
-    assert r.status == without.status == "optimal", (r.message, without.message)
+    r = Solver().solve(p)
+    assert r.status == "optimal", r.message
     assert "by min_peak_accel without its bound gamma_min" in r.certificate.global_claim
-    assert r.stats["ipopt_runs"] < without.stats["ipopt_runs"] / 2
-    assert r.objective <= without.objective + 1e-12
+    assert "Sobol multi-start" not in r.stats["strategies"]
     assert r.mechanism.gamma_min().value >= 0.1745 - 1e-9
     assert r.objective == pytest.approx(Solver().solve(p.replace(conditions={})).objective, rel=1e-9)
-    steep = Solver(starts_n=2).solve(p.replace(conditions={"gamma_min": 1.0472}))
+    steep = Solver(starts_n=1).solve(p.replace(conditions={"gamma_min": 1.0472}))
     assert steep.status == "optimal" and "Sobol multi-start" in steep.stats["strategies"], steep.message
     assert steep.mechanism.gamma_min().value >= 1.0472 - 1e-9
     assert "without its bound" not in steep.certificate.global_claim

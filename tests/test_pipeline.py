@@ -142,12 +142,12 @@ def test_no_criterion_name_in_generic_search_code():
 
 def test_a_bound_beyond_its_own_optimum_ends_the_solve_before_its_starts():
     """The crank-rocker slider at TR 2.373 reaches a transmission angle of 14.63 deg at most (its max_gamma_min,
-    which the atlas holds). By the peak acceleration under a 30 deg bound the solve is infeasible before any start,
+    which the atlas holds). By that criterion under a 30 deg bound the solve is infeasible before any start,
     in the diagnosis's words, which the pipeline without the check gives after its starts have failed; under a
     10 deg bound the check passes and the search runs."""
     from qropt.synthesis.search.reach import BoundsInReach
 
-    p = type_problem("crank-rocker-slider", 2.373, 2.3207, objective="min_peak_accel", conditions={"gamma_min": 0.5236})
+    p = type_problem("crank-rocker-slider", 2.373, 2.3207, objective="max_gamma_min", conditions={"gamma_min": 0.5236})
     quick = Solver().solve(p)
     assert quick.status == "infeasible" and "(14.63 deg)" in quick.message, quick.message
     assert quick.stats["strategies"] == ["plan", "bounds in reach"] and quick.stats["starts"] == 0
