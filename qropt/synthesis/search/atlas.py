@@ -1,6 +1,6 @@
 """The atlas's designs of the problem's shape (``qropt.synthesis.atlas``), solved first: where one certifies and
 none falls short of its nodes' designs, the rest of the starts phase does not run. Designs the atlas holds for the
-problem without its bound conditions are measured against their nodes' values without the bounds: a design that
+problem without its bound conditions are compared with their nodes' values without the bounds: a design that
 comes as close as they do and meets the bounds with room (none binds) is the unbounded problem's best, so it is the
 bounded one's; where a bound binds, the multi-start runs as well."""
 
