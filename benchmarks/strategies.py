@@ -7,8 +7,9 @@ strategy takes (``Result.stats['t_strategies']``) summed over the rows. A strate
 time. Writes ``results/strategies.json`` and ``results/strategies.md``.
 
 Run: ``python -m benchmarks.strategies [--tasks 12] [--objectives max_gamma_min min_peak_torque]
-[--leave-out evolution guard ...] [--types whitworth ...] [--evolutions K] [--name NAME]`` (repository root;
-``--types``: those rows only; ``--evolutions``: every Solver runs K evolutions where the evolution applies).
+[--leave-out evolution guard ...] [--types whitworth ...] [--evolutions K] [--gamma-min DEG] [--name NAME]``
+(repository root; ``--types``: those rows only; ``--evolutions``: every Solver runs K evolutions where the
+evolution applies; ``--gamma-min``: every row under that transmission bound).
 By ``min_peak_torque`` the rows use ``benchmarks.tasks``' mass model, loads and speed; a run of the 12 tasks by
 it takes hours on two cores.
 """
@@ -16,6 +17,7 @@ it takes hours on two cores.
 from __future__ import annotations
 
 import argparse
+import math
 import time
 
 from benchmarks.report import RESULTS, save
@@ -46,8 +48,11 @@ def pipelines(names: list[str]) -> dict:
     return {"default": list(search.DEFAULT), **{n: without(search.DEFAULT, n) for n in names}}
 
 
-def run(n_tasks: int, objectives: list[str], names: list[str], types=None, evolutions=None) -> list[dict]:
-    """One record per (pipeline, objective, task, row): status, objective value, seconds, strategy seconds."""
+def run(
+    n_tasks: int, objectives: list[str], names: list[str], types=None, evolutions=None, gamma_min=None
+) -> list[dict]:
+    """One record per (pipeline, objective, task, row): status, objective value, seconds, strategy seconds;
+    gamma_min: a transmission bound (deg) for every row."""
     from qropt import Solver
     from qropt.studies._design import design
     from qropt.synthesis import criteria
@@ -56,7 +61,9 @@ def run(n_tasks: int, objectives: list[str], names: list[str], types=None, evolu
     for label, pipeline in pipelines(names).items():
         solver = Solver(pipeline=pipeline, evolutions=evolutions)
         for objective in objectives:
-            kw = {} if criteria.of(objective).kinematic else DYNAMIC
+            kw = {} if criteria.of(objective).kinematic else dict(DYNAMIC)
+            if gamma_min is not None:
+                kw["conditions"] = {"gamma_min": math.radians(gamma_min)}
             for i, (tr, stroke) in enumerate(tasks(n_tasks)):
                 t = time.perf_counter()
                 cmp = design(tr, stroke, objective=objective, solver=solver, types=types, **kw)
@@ -141,11 +148,13 @@ def main(argv=None) -> None:
     )
     ap.add_argument("--types", nargs="+", default=None, help="these design rows only (default every type)")
     ap.add_argument("--evolutions", type=int, default=None, help="evolutions every Solver runs where they apply")
+    ap.add_argument("--gamma-min", type=float, help="a transmission bound (deg) for every row")
     ap.add_argument("--name", default="strategies", help="results/NAME.json and results/NAME.md")
     args = ap.parse_args(argv)
-    records = run(args.tasks, args.objectives, args.leave_out, args.types, args.evolutions)
+    records = run(args.tasks, args.objectives, args.leave_out, args.types, args.evolutions, args.gamma_min)
     s = summary(records)
-    save(f"{args.name}.json", {"tasks": args.tasks, "objectives": args.objectives, "summary": s, "rows": records})
+    saved = {"tasks": args.tasks, "objectives": args.objectives, "gamma_min_deg": args.gamma_min}
+    save(f"{args.name}.json", {**saved, "summary": s, "rows": records})
     (RESULTS / f"{args.name}.md").write_text(markdown(s))
     print(markdown(s))
 

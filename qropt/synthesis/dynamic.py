@@ -13,6 +13,7 @@ the exact one, so the NLP's value is the certified one.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import casadi
@@ -556,16 +557,20 @@ class PeakTorque(PeakOverTurn):
         return T, [T, -T]
 
 
-GAUSS_NODES = None  # the cycle module's Gauss-Legendre rule, read once
+COARSE_GAUSS = 12  # Gauss-Legendre nodes per stroke of a coarse formulation's quadrature (``Formulation.coarse``)
 
 
-def _nodes():
-    global GAUSS_NODES
-    if GAUSS_NODES is None:
-        from qropt.dynamics.cycle import GAUSS
+@functools.cache
+def _rule(n: int | None):
+    """The Gauss-Legendre rule of n nodes, or of the cycle module's (the certifier's) where n is None."""
+    from qropt.dynamics.cycle import GAUSS
 
-        GAUSS_NODES = np.polynomial.legendre.leggauss(GAUSS)
-    return GAUSS_NODES
+    return np.polynomial.legendre.leggauss(GAUSS if n is None else n)
+
+
+def quadrature_rule(f):
+    """The quadrature rule of formulation f: the certifier's, or the coarse one where f is coarse."""
+    return _rule(COARSE_GAUSS if f.coarse else None)
 
 
 class RmsTorque(_Squared):
@@ -573,6 +578,7 @@ class RmsTorque(_Squared):
     Gauss-Legendre rule on each stroke in the NLP as in the exact value; the NLP states the mean square."""
 
     name, unit, label = "rms_torque", "N m", "RMS crank torque"
+    coarse = True
 
     def value(self, problem, m):
         return math.sqrt(_cycle(problem, m).quadrature(lambda d: d.torque**2) / TWO_PI)
@@ -580,7 +586,7 @@ class RmsTorque(_Squared):
     def measure(self, f, z):
         s = _symbolic(f)
         total = 0
-        for out, w, arc in f.strokes(_nodes()):
+        for out, w, arc in f.strokes(quadrature_rule(f)):
             total += 0.5 * arc * w * s.torque(out) ** 2
         return total / TWO_PI
 
@@ -663,4 +669,4 @@ class PeakBearingForce(_Squared):
 for _c in (PeakTorque(), RmsTorque(), ShakingForce(), PeakBearingForce()):
     register(_c, built_in=True)
 
-__all__ = ["PeakTorque", "RmsTorque", "ShakingForce", "PeakBearingForce"]
+__all__ = ["PeakTorque", "RmsTorque", "ShakingForce", "PeakBearingForce", "quadrature_rule", "COARSE_GAUSS"]

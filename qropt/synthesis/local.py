@@ -61,12 +61,17 @@ class Candidate:
         return self.t_ipopt
 
 
+def _used(problem) -> list:
+    """The criteria a problem's NLP states: its objective's and its bounds'."""
+    used = [criteria.of_problem(problem)] + [c for k, c in criteria.bounds().items() if k in problem.conditions]
+    return [c for c in used if c is not None]
+
+
 def _dynamic_key(problem) -> tuple[tuple, tuple | None]:
     """What a criterion bakes into its NLP (any one what its ``baked`` says; a dynamic one also the masses, the loads
     and omega2), and the dynamic task the NLP belongs to: that key where a criterion needs masses (whatever the
     objective), else None."""
-    used = [criteria.of_problem(problem)] + [c for k, c in criteria.bounds().items() if k in problem.conditions]
-    used = [c for c in used if c is not None]
+    used = _used(problem)
     baked = tuple(b for c in used for b in c.baked(problem))
     if not any(c.needs_masses for c in used):
         return baked, None
@@ -89,10 +94,14 @@ class Formulations:
     def __len__(self):
         return len(self._built)
 
-    def get(self, problem, branch: dict, orientation: int, range_target=None, sense=1, guarded=None) -> Formulation:
+    def get(
+        self, problem, branch: dict, orientation: int, range_target=None, sense=1, guarded=None, coarse=False
+    ) -> Formulation:
         """guarded: with the rows that keep the output's reversals at its dead centres (default: unless its type
-        reverses once a turn by construction, ``Mechanism.SYNTHESIS.one_reversal``)."""
+        reverses once a turn by construction, ``Mechanism.SYNTHESIS.one_reversal``); coarse: its quadratures on
+        their coarse rule, where it states one (``Criterion.coarse``)."""
         guarded = not problem.mechanism.SYNTHESIS.one_reversal if guarded is None else guarded
+        coarse = coarse and range_target is None and any(c.coarse for c in _used(problem))
         c = problem.conditions
         bounds = tuple(k for k in c if k not in ("grashof", "linear", "ratio"))
         cond = (c.get("grashof"), bounds, repr(c.get("linear")), repr(c.get("ratio")))
@@ -111,6 +120,7 @@ class Formulations:
             range_target,
             sense,
             guarded,
+            coarse,
             *dynamic,
         )
         if task is not None:
@@ -121,7 +131,7 @@ class Formulations:
         f = self._built.get(key)
         if f is None:
             f = self._built[key] = Formulation(
-                problem, branch, orientation, range_target, sense, self.samples, self.extra, guarded
+                problem, branch, orientation, range_target, sense, self.samples, self.extra, guarded, coarse
             )
         return f
 
@@ -193,7 +203,7 @@ class LocalSolve:
             th0, orientation = starts_.dead_centre_start(
                 problem, values0, branch, targets, orientation, range_target, designs
             )
-            form = self.formulations.get(problem, branch, orientation, range_target, sense)
+            form = self.formulations.get(problem, branch, orientation, range_target, sense, coarse=True)
             samples, fractions = form.base_samples()
             used = used_f = form.n_base
             phi, box, turn = form.lifted_start(form.concrete(problem), values0, designs, th0)
@@ -270,9 +280,12 @@ class LocalSolve:
                 # sampled), from where it is
                 form = self.formulations.get(problem, branch, orientation, range_target, sense, guarded=True)
                 lbx, ubx = form.bounds(problem)
+            refining = form.coarse  # the coarse rule's optimum: on to the certifier's rule from there
+            if refining:
+                form = self.formulations.get(problem, branch, orientation, range_target, sense, guarded=form.guarded)
             if (turned or guarding) and m is not None:
                 w = form.with_turns(w, m, turned)
-            if not add and not frac and not tightened and not turned and not guarding:
+            if not add and not frac and not tightened and not turned and not guarding and not refining:
                 if run.status is Status.ACCEPTABLE and not polished and c.rounds < max_rounds:
                     # IPOPT's looser tolerance: once more from there, warm, to its own (the acceptable point kept)
                     polished, polish = True, (w, g, c.values, c.problem, m, info, run.status, run.message)

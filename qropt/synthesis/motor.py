@@ -42,7 +42,7 @@ class RmsMotorTorque(dynamic.RmsTorque):
     def measure(self, f, z):
         s = dynamic._symbolic(f)
         total = 0
-        for out, w, arc in f.strokes(dynamic._nodes()):
+        for out, w, arc in f.strokes(dynamic.quadrature_rule(f)):
             total += 0.5 * arc * w * f.drive.motor_torque(s.torque(out), f.omega2) ** 2
         return total / TWO_PI
 
