@@ -510,20 +510,18 @@ def test_the_exchange_lifts_the_largest_extremes_of_each_design_it_meets():
 
 
 def test_a_coarse_formulation_states_the_rms_torque_on_the_coarse_gauss_rule():
-    """A coarse formulation's RMS torque is the COARSE_GAUSS-node Gauss-Legendre rule on each stroke of the exact
+    """A coarse formulation's RMS torque is the Gauss-Legendre rule of its nodes on each stroke of the exact
     torque, and not the certifier's rule (which the fine formulation states)."""
     import casadi
 
-    from qropt.synthesis import dynamic
-
     p, m, f, w, pv, *_ = _at_random_design("coupler-slider", "min_rms_torque", 7)
-    coarse = Formulation(p, f.branch, f.orientation, coarse=True)
-    assert coarse.coarse and not f.coarse
+    coarse = Formulation(p, f.branch, f.orientation, coarse=12)
+    assert coarse.coarse == 12 and not f.coarse
 
     def value(form):
         return float(casadi.Function("f", [form.w_sym, form.p_sym], [form.f_sym])(w, pv))
 
-    x, wt = np.polynomial.legendre.leggauss(dynamic.COARSE_GAUSS)
+    x, wt = np.polynomial.legendre.leggauss(12)
     lo, length = m.working_arc()
     total = 0.0
     for start, arc in ((lo, length), (lo + length, 2 * np.pi - length)):
@@ -536,20 +534,21 @@ def test_a_coarse_formulation_states_the_rms_torque_on_the_coarse_gauss_rule():
     assert abs(value(coarse) - fine) > 1e-12 * fine
 
 
-def test_a_local_solve_goes_on_from_the_coarse_rule_to_the_certifiers(monkeypatch):
-    """A local solve of the RMS torque runs on the coarse rule first and certifies on the certifier's rule: the
-    same design (to 1e-8) as a local solve from the same start on the certifier's rule alone."""
-    from qropt.synthesis import dynamic
+def test_a_local_solve_goes_on_from_a_coarse_rule_to_the_certifiers():
+    """With ``Settings(coarse_nodes=12)`` a local solve of the RMS torque runs on that rule first and certifies on
+    the certifier's rule: the same design (to 1e-8) as the default local solve from the same start, which builds
+    no coarse formulation."""
+    from qropt.synthesis.search import Settings
 
     p, m, *_ = _at_random_design("drag-link-slider", "min_rms_torque", 7)
     start = {k: m.params[k] for k in p.free}
     branch = {k: v[0] for k, v in p.branches.items()}
-    solver = qropt.Solver()
+    solver = qropt.Solver(settings=Settings(coarse_nodes=12))
     c = solver.local(p, start, branch, p.targets)
     assert c.ok and len(c.ends) >= 2
-    assert any(f.coarse for f in solver._formulations._built.values())
+    assert any(f.coarse == 12 for f in solver._formulations._built.values())
     value = criteria.objective_of(p, c.mechanism)
-    monkeypatch.setattr(dynamic.RmsTorque, "coarse", False)
-    fine = qropt.Solver().local(p, start, branch, p.targets)
-    assert fine.ok
+    default = qropt.Solver()
+    fine = default.local(p, start, branch, p.targets)
+    assert fine.ok and not any(f.coarse for f in default._formulations._built.values())
     assert value == pytest.approx(criteria.objective_of(p, fine.mechanism), rel=1e-8)

@@ -80,8 +80,8 @@ class Criterion:
     guard: ClassVar[float | None] = None  # rad: a transmission angle below which the NLP does not see the criterion
     # well, so its landscape needs a global search: the guarded multi-start (gamma_min >= guard, its designs
     # continued to the problem) and, on a problem with free scale and crank, the differential evolution
-    coarse: ClassVar[bool] = False  # its NLP measure is a quadrature: a local solve runs on a coarse rule first and
-    # goes on to the certifier's rule from the coarse optimum (``Formulation.coarse``)
+    coarse: ClassVar[bool] = False  # its NLP measure is a Gauss-Legendre quadrature (``dynamic.quadrature_rule``): with
+    # ``Settings.coarse_nodes`` below the certifier's, a local solve runs on that rule first (``Formulation.coarse``)
     reported: ClassVar[bool] = True  # in every Result's quantities where it applies; False: in those of a problem
     # that uses it alone (its objective or a bound), e.g. a criterion with a parameter of the problem's own
     quantity = None  # a peak over the turn: the quantity of the cycle's dynamics whose peak it is (the SQP on the

@@ -557,9 +557,6 @@ class PeakTorque(PeakOverTurn):
         return T, [T, -T]
 
 
-COARSE_GAUSS = 12  # Gauss-Legendre nodes per stroke of a coarse formulation's quadrature (``Formulation.coarse``)
-
-
 @functools.cache
 def _rule(n: int | None):
     """The Gauss-Legendre rule of n nodes, or of the cycle module's (the certifier's) where n is None."""
@@ -569,8 +566,8 @@ def _rule(n: int | None):
 
 
 def quadrature_rule(f):
-    """The quadrature rule of formulation f: the certifier's, or the coarse one where f is coarse."""
-    return _rule(COARSE_GAUSS if f.coarse else None)
+    """The quadrature rule of formulation f: the certifier's, or its coarse rule of ``f.coarse`` nodes a stroke."""
+    return _rule(f.coarse or None)
 
 
 class RmsTorque(_Squared):
@@ -669,4 +666,4 @@ class PeakBearingForce(_Squared):
 for _c in (PeakTorque(), RmsTorque(), ShakingForce(), PeakBearingForce()):
     register(_c, built_in=True)
 
-__all__ = ["PeakTorque", "RmsTorque", "ShakingForce", "PeakBearingForce", "quadrature_rule", "COARSE_GAUSS"]
+__all__ = ["PeakTorque", "RmsTorque", "ShakingForce", "PeakBearingForce", "quadrature_rule"]

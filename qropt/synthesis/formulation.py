@@ -167,7 +167,7 @@ class Formulation:
         base_samples: int = BASE_SAMPLES,
         extra_samples: int = EXTRA_SAMPLES,
         guarded: bool = False,
-        coarse: bool = False,
+        coarse: int = 0,
     ):
         cls = self.mechanism = problem.mechanism
         self.guarded = guarded  # with rows that keep the output's reversals at its dead centres (``_guard_rows``)
@@ -182,7 +182,7 @@ class Formulation:
         self.objective = None if range_target else criteria.of_problem(problem)
         self.bound_keys = [k for k in criteria.bounds() if k in problem.conditions]
         used = ([self.objective] if self.objective else []) + [criteria.bounds()[k] for k in self.bound_keys]
-        self.coarse = coarse and any(c.coarse for c in used)  # its quadratures on their coarse rule
+        self.coarse = coarse if any(c.coarse for c in used) else 0  # nodes a stroke of its quadratures' coarse rule
         self.box = any(isinstance(c, criteria.Footprint) for c in used)
         self.dynamic = any(
             c.needs_masses for c in used

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from qropt.dynamics.cycle import GAUSS
 from qropt.errors import QroptError
 from qropt.synthesis import criteria, newton
 from qropt.synthesis import starts as starts_
@@ -95,13 +96,15 @@ class Formulations:
         return len(self._built)
 
     def get(
-        self, problem, branch: dict, orientation: int, range_target=None, sense=1, guarded=None, coarse=False
+        self, problem, branch: dict, orientation: int, range_target=None, sense=1, guarded=None, coarse=0
     ) -> Formulation:
         """guarded: with the rows that keep the output's reversals at its dead centres (default: unless its type
         reverses once a turn by construction, ``Mechanism.SYNTHESIS.one_reversal``); coarse: its quadratures on
-        their coarse rule, where it states one (``Criterion.coarse``)."""
+        a rule of that many nodes a stroke, where it states one (``Criterion.coarse``) and the rule is coarser
+        than the certifier's (0: the certifier's)."""
         guarded = not problem.mechanism.SYNTHESIS.one_reversal if guarded is None else guarded
-        coarse = coarse and range_target is None and any(c.coarse for c in _used(problem))
+        if not (0 < coarse < GAUSS and range_target is None and any(c.coarse for c in _used(problem))):
+            coarse = 0
         c = problem.conditions
         bounds = tuple(k for k in c if k not in ("grashof", "linear", "ratio"))
         cond = (c.get("grashof"), bounds, repr(c.get("linear")), repr(c.get("ratio")))
@@ -203,7 +206,9 @@ class LocalSolve:
             th0, orientation = starts_.dead_centre_start(
                 problem, values0, branch, targets, orientation, range_target, designs
             )
-            form = self.formulations.get(problem, branch, orientation, range_target, sense, coarse=True)
+            form = self.formulations.get(
+                problem, branch, orientation, range_target, sense, coarse=self.settings.coarse_nodes
+            )
             samples, fractions = form.base_samples()
             used = used_f = form.n_base
             phi, box, turn = form.lifted_start(form.concrete(problem), values0, designs, th0)

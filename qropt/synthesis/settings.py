@@ -64,6 +64,8 @@ class Settings:
     # the local solve (``local``, ``newton``)
     exchange_stuck: int = 3  # exchange rounds that end alike, in a row, after which the exchange loop stops
     restarts: int = 2  # runs continued from their last iterate when they hit the iteration limit near a design
+    coarse_nodes: int = 48  # Gauss-Legendre nodes a stroke of a quadrature's first runs (``Criterion.coarse``); as
+    # many as the certifier's rule (48) or more: no coarser rule
     relifts: int = 2  # runs of a dynamic objective continued, their extremes lifted anew, after the iteration limit
     restart_violation: float = 1e-6  # "near a design": no constraint violated by more than this
     newton_steps: int = 8  # Newton steps of a continuation from a neighbour's optimum, at most
