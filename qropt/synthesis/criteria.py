@@ -520,16 +520,23 @@ def of_problem(problem) -> Criterion | None:
     return of(problem.objective, problem.size) if problem.objective else None
 
 
+def used(problem, objective: bool = True) -> list[Criterion]:
+    """The criteria a problem's NLP states: its objective's (unless ``objective`` is False, as in a reachable
+    range's NLP) and its bound conditions', in that order."""
+    own = [of_problem(problem)] if objective and problem.objective else []
+    return own + [c for k, c in bounds().items() if k in problem.conditions]
+
+
 def reported(problem, kind) -> list[Criterion]:
     """The registered criteria a problem's results report for a mechanism of class ``kind``: those that apply to
     it, every ``reported`` one and one that is not where the problem's objective or a bound of its conditions uses
     it; one that needs masses only where the problem has masses or loads."""
-    used = {of_problem(problem)} | {c for k, c in bounds().items() if k in problem.conditions}
+    stated = used(problem)
     dynamic = problem.masses is not None or problem.loads is not None
     return [
         c
         for c in CRITERIA.values()
-        if (c.reported or c in used) and c.applies(kind) and (dynamic or not c.needs_masses)
+        if (c.reported or c in stated) and c.applies(kind) and (dynamic or not c.needs_masses)
     ]
 
 

@@ -181,7 +181,7 @@ class Formulation:
         self.n_samples = n = base_samples + extra_samples
         self.objective = None if range_target else criteria.of_problem(problem)
         self.bound_keys = [k for k in criteria.bounds() if k in problem.conditions]
-        used = ([self.objective] if self.objective else []) + [criteria.bounds()[k] for k in self.bound_keys]
+        used = criteria.used(problem, objective=not range_target)
         self.coarse = coarse if any(c.coarse for c in used) else 0  # nodes a stroke of its quadratures' coarse rule
         self.box = any(isinstance(c, criteria.Footprint) for c in used)
         self.dynamic = any(

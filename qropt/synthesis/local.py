@@ -62,17 +62,11 @@ class Candidate:
         return self.t_ipopt
 
 
-def _used(problem) -> list:
-    """The criteria a problem's NLP states: its objective's and its bounds'."""
-    used = [criteria.of_problem(problem)] + [c for k, c in criteria.bounds().items() if k in problem.conditions]
-    return [c for c in used if c is not None]
-
-
 def _dynamic_key(problem) -> tuple[tuple, tuple | None]:
     """What a criterion bakes into its NLP (any one what its ``baked`` says; a dynamic one also the masses, the loads
     and omega2), and the dynamic task the NLP belongs to: that key where a criterion needs masses (whatever the
     objective), else None."""
-    used = _used(problem)
+    used = criteria.used(problem)
     baked = tuple(b for c in used for b in c.baked(problem))
     if not any(c.needs_masses for c in used):
         return baked, None
@@ -103,7 +97,7 @@ class Formulations:
         a rule of that many nodes a stroke, where it states one (``Criterion.coarse``) and the rule is coarser
         than the certifier's (0: the certifier's)."""
         guarded = not problem.mechanism.SYNTHESIS.one_reversal if guarded is None else guarded
-        if not (0 < coarse < GAUSS and range_target is None and any(c.coarse for c in _used(problem))):
+        if not (0 < coarse < GAUSS and range_target is None and any(c.coarse for c in criteria.used(problem))):
             coarse = 0
         c = problem.conditions
         bounds = tuple(k for k in c if k not in ("grashof", "linear", "ratio"))

@@ -291,9 +291,7 @@ class Problem:
         if self.objective and not criteria.of(self.objective, self.size).applies(self.mechanism):
             c = criteria.of(self.objective, self.size)
             raise self._err(f"{c.why_not(self.mechanism)}: {self.objective} does not apply")
-        used = [criteria.of(self.objective, self.size)] if self.objective else []
-        used += [c for k, c in criteria.bounds().items() if k in self.conditions]
-        for c in used:
+        for c in criteria.used(self):
             why = c.check(self)
             if why:
                 raise self._err(why)
