@@ -7,16 +7,19 @@ worst row time, the statuses, and the median and worst ``design()`` time over th
 ``results/tasks.json`` and ``results/tasks.md`` after each objective (a stopped run keeps the objectives done).
 
 Run: ``python -m benchmarks.tasks [--tasks 12] [--objectives max_gamma_min min_peak_accel] [--dynamic]
-[--workers K] [--gamma-min DEG] [--settings NAME=VALUE ...]`` (repository root). ``--dynamic`` adds
-``min_peak_torque`` with the default mass model below; ``--workers`` solves each task's rows in K worker processes
-(``design(..., workers=K)``; results/tasks_workers.json); ``--gamma-min`` bounds every row's transmission angle
-(results/tasks_gamma<DEG>.json); ``--settings`` changes the search's numbers (``qropt.synthesis.search.Settings``,
-e.g. ``relifts=1``: results/tasks_gamma30_relifts1.json).
+[--workers K] [--gamma-min DEG] [--settings NAME=VALUE ...] [--ipopt NAME=JSON ...]`` (repository root).
+``--dynamic`` adds ``min_peak_torque`` with the default mass model below; ``--workers`` solves each task's rows
+in K worker processes (``design(..., workers=K)``; results/tasks_workers.json); ``--gamma-min`` bounds every
+row's transmission angle (results/tasks_gamma<DEG>.json); ``--settings`` changes the search's numbers
+(``qropt.synthesis.search.Settings``, e.g. ``relifts=1``: results/tasks_gamma30_relifts1.json); ``--ipopt``
+gives the Solver IPOPT options (CasADi's ``nlpsol`` options, each value JSON, e.g.
+``oracle_options={"cse": true}``).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import statistics
 import time
@@ -44,9 +47,15 @@ def tasks(n: int, seed: int = SEED) -> list[tuple[float, float]]:
 
 
 def run_objective(
-    objective: str, task_list, dynamic: bool, workers: int | None = None, conditions=None, settings=None
+    objective: str,
+    task_list,
+    dynamic: bool,
+    workers: int | None = None,
+    conditions=None,
+    settings=None,
+    ipopt_options=None,
 ) -> dict:
-    solver = Solver(settings=settings)
+    solver = Solver(settings=settings, ipopt_options=ipopt_options)
     kw = {"masses": MASSES, "loads": LOADS, "omega2": OMEGA2} if dynamic else {}
     kw["workers"], kw["conditions"] = workers, conditions
     tr, s = task_list[0]
@@ -121,8 +130,10 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--settings", nargs="+", default=[], metavar="NAME=VALUE", help="the search's numbers (qropt Settings)"
     )
+    ap.add_argument("--ipopt", nargs="+", default=[], metavar="NAME=JSON", help="IPOPT options (CasADi nlpsol's)")
     ap.add_argument("--name", help="the results' file name (default: tasks, with the workers, bound and settings)")
     args = ap.parse_args(argv)
+    ipopt_options = _ipopt(args.ipopt)
     bound = None if args.gamma_min is None else {"gamma_min": math.radians(args.gamma_min)}
     settings = _settings(args.settings)
     task_list = tasks(args.tasks)
@@ -133,12 +144,14 @@ def main(argv=None) -> int:
     name = args.name or name
     saved = {"tasks": task_list, "seed": SEED, "workers": args.workers, "gamma_min_deg": args.gamma_min}
     saved["settings"] = {k: v for k, v in settings.to_dict().items() if v != getattr(DEFAULT, k)}
+    saved["ipopt_options"] = ipopt_options
     objectives = list(args.objectives)
     if args.dynamic and "min_peak_torque" not in objectives:
         objectives.append("min_peak_torque")
     results = {}
     for obj in objectives:  # a dynamic objective runs with the default masses; the files hold each one done
-        results[obj] = run_objective(obj, task_list, criteria.of(obj).needs_masses, args.workers, bound, settings)
+        dynamic = criteria.of(obj).needs_masses
+        results[obj] = run_objective(obj, task_list, dynamic, args.workers, bound, settings, ipopt_options)
         save(f"{name}.json", {**saved, "results": results})
         (RESULTS / f"{name}.md").write_text(markdown(results, len(task_list)))
     print(markdown(results, len(task_list)))
@@ -162,6 +175,20 @@ def _settings(pairs) -> Settings:
         return Settings(**given)
     except qropt.ProblemError as e:
         raise SystemExit(f"--settings: {e}") from None
+
+
+def _ipopt(pairs) -> dict:
+    """IPOPT options from NAME=JSON pairs."""
+    given = {}
+    for pair in pairs:
+        name, _, value = pair.partition("=")
+        try:
+            given[name] = json.loads(value)
+        except json.JSONDecodeError:
+            raise SystemExit(f"--ipopt: {pair!r} is not NAME=JSON") from None
+        if not name:
+            raise SystemExit(f"--ipopt: {pair!r} is not NAME=JSON")
+    return given
 
 
 if __name__ == "__main__":

@@ -117,3 +117,26 @@ def test_a_run_whose_linear_solves_once_overflowed_ends():
     )
     ok, iterations = run_child(code, 120).split()
     assert int(iterations) > 0
+
+
+def test_common_subexpression_elimination_is_an_ipopt_option():
+    """``Solver(ipopt_options={"oracle_options": {"cse": True}})`` builds the NLP's functions with
+    common-subexpression elimination: a subexpression written twice (here sin(x y), as a formulation's rows repeat a
+    kinematic term) is computed once in the Hessian of the Lagrangian, which gives the values of the default one (to
+    rounding); the default builds them without it."""
+    w, p = casadi.SX.sym("w", 2), casadi.SX.sym("p")
+    f = casadi.sin(w[0] * w[1]) ** 2 + p * casadi.sin(w[0] * w[1]) * w[1]
+    g = casadi.vertcat(casadi.sin(w[0] * w[1]) + w[0], casadi.cos(w[0] * w[1]) * w[1])
+    hessians = {}
+    for name, options in (("default", None), ("cse", {"oracle_options": {"cse": True}})):
+        form = _Form(w_sym=w, p_sym=p, f_sym=f, g_sym=g, lbg=np.array([-1.0, -1.0]), ubg=np.array([1.0, 1.0]))
+        form.objective, form.nlp = None, {"x": w, "p": p, "f": f, "g": g}
+        hessians[name] = Ipopt(options).solver(form).get_function("nlp_hess_l")
+    plain = casadi.nlpsol("s", "ipopt", {"x": w, "p": p, "f": f, "g": g}, backends.IPOPT).get_function("nlp_hess_l")
+    assert hessians["default"].n_instructions() == plain.n_instructions()
+    assert hessians["cse"].n_instructions() < plain.n_instructions()
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        x, lam_g = rng.uniform(-2.0, 2.0, 2), rng.uniform(-1.0, 1.0, 2)
+        a, b = (np.array(hessians[k](x, 0.7, 1.3, lam_g)) for k in ("default", "cse"))
+        assert np.allclose(a, b, rtol=1e-13, atol=1e-13)

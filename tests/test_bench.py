@@ -163,3 +163,18 @@ def test_the_tasks_benchmark_takes_the_searchs_numbers():
     ]:
         with pytest.raises(SystemExit, match=said):
             _settings(bad)
+
+
+def test_the_tasks_benchmark_reads_ipopt_options():
+    """``python -m benchmarks.tasks --ipopt NAME=JSON ...``: each value JSON (an option's dict as well); a pair
+    without a name or with a value that is not JSON is one line, not a traceback."""
+    from benchmarks.tasks import _ipopt
+
+    assert _ipopt(['oracle_options={"cse": true}', "ipopt.max_iter=80"]) == {
+        "oracle_options": {"cse": True},
+        "ipopt.max_iter": 80,
+    }
+    assert _ipopt([]) == {}
+    for bad in (["oracle_options={cse}"], ["=1"], ["ipopt.tol"]):
+        with pytest.raises(SystemExit, match="is not NAME=JSON"):
+            _ipopt(bad)
