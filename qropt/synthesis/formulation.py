@@ -24,6 +24,7 @@ from typing import NamedTuple
 import casadi
 import numpy as np
 
+from qropt.dynamics.cycle import GAUSS
 from qropt.errors import QroptError
 from qropt.kinematics.closures import RIGHT_ANGLE, transmission_cos
 from qropt.kinematics.ops import CASADI
@@ -148,6 +149,15 @@ IPOPT = {
 }
 
 
+def coarse_nodes(problem, coarse: int, range_target=None) -> int:
+    """The nodes a stroke of the coarse rule an NLP of ``problem`` states: ``coarse`` where one of its criteria has
+    one (``Criterion.coarse``), it is coarser than the certifier's rule and the NLP is no reachable range's, else 0
+    (the certifier's)."""
+    if range_target is not None or not 0 < coarse < GAUSS:
+        return 0
+    return coarse if any(c.coarse for c in criteria.used(problem)) else 0
+
+
 class Formulation:
     """The NLP of one problem structure (type, free/fixed/target names, conditions' structure, objective, size,
     accel_over, branch signs, TR orientation; optionally a target to range). Nothing of a problem's numbers is
@@ -182,7 +192,7 @@ class Formulation:
         self.objective = None if range_target else criteria.of_problem(problem)
         self.bound_keys = [k for k in criteria.bounds() if k in problem.conditions]
         used = criteria.used(problem, objective=not range_target)
-        self.coarse = coarse if any(c.coarse for c in used) else 0  # nodes a stroke of its quadratures' coarse rule
+        self.coarse = coarse_nodes(problem, coarse, range_target)  # nodes a stroke of its quadratures' coarse rule
         self.box = any(isinstance(c, criteria.Footprint) for c in used)
         self.dynamic = any(
             c.needs_masses for c in used

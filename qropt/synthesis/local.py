@@ -13,13 +13,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from qropt.dynamics.cycle import GAUSS
 from qropt.errors import QroptError
 from qropt.synthesis import criteria, newton
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.backends import CONVERGED, Status
 from qropt.synthesis.certificate import Designs, certify, residuals, target_values
-from qropt.synthesis.formulation import TWO_PI, Formulation
+from qropt.synthesis.formulation import TWO_PI, Formulation, coarse_nodes
 from qropt.synthesis.settings import DEFAULT
 
 MEMO = 64  # problems a solver keeps derived problems of (a chart's tiles bring thousands)
@@ -97,8 +96,7 @@ class Formulations:
         a rule of that many nodes a stroke, where it states one (``Criterion.coarse``) and the rule is coarser
         than the certifier's (0: the certifier's)."""
         guarded = not problem.mechanism.SYNTHESIS.one_reversal if guarded is None else guarded
-        if not (0 < coarse < GAUSS and range_target is None and any(c.coarse for c in criteria.used(problem))):
-            coarse = 0
+        coarse = coarse_nodes(problem, coarse, range_target)
         c = problem.conditions
         bounds = tuple(k for k in c if k not in ("grashof", "linear", "ratio"))
         cond = (c.get("grashof"), bounds, repr(c.get("linear")), repr(c.get("ratio")))
