@@ -11,7 +11,9 @@ import pathlib
 import subprocess
 import sys
 import time
+import types
 
+import numpy as np
 import pytest
 
 import qropt
@@ -19,7 +21,7 @@ from benchmarks.tasks import LOADS, MASSES, OMEGA2
 from qropt import ProblemError, Solver
 from qropt.studies._design import TYPES, design, type_problem
 from qropt.synthesis import criteria, minimax, search, starts
-from qropt.synthesis.search import Settings
+from qropt.synthesis.search import Settings, diagnosis
 from qropt.synthesis.search.local_solves import LocalSolves
 from tests.toy_strategy import GridStarts
 
@@ -206,3 +208,63 @@ def test_a_time_limit_is_a_positive_number_of_seconds(bad):
         Solver().solve(type_problem("slider-crank", 1.5, 0.3), time_limit=bad)
     with pytest.raises(ProblemError, match="time_limit"):
         design(1.5, 0.3, time_limit=bad)
+
+
+def test_where_designs_exist_but_no_start_certifies_one_the_diagnosis_answers_by_descents():
+    """The crank shaper with a rod by peak bearing force at TR 2.373, 2.3207 m under 30 deg: the NLP's optima lie
+    beyond designs whose output turns back inside a stroke, so no start certifies one. The diagnosis's descents on
+    the exact objective (one evolution, few generations here) give a ``feasible`` design, checked by exact analysis:
+    the targets, the bound, and the peak bearing force against a dense grid of the inverse dynamics."""
+    problem = type_problem(
+        "crank-shaper-rod", 2.373, 2.3207, objective="min_peak_bearing_force", conditions={"gamma_min": 0.5236}, **KW
+    )
+    solver = Solver(
+        settings=Settings(evolution_generations=2, evolution_population=4, evolution_keep=1, descent_evals=200)
+    )
+    context = search.Context(solver, dict(problem.targets), 8, 0, solver.max_rounds)
+
+    def done(status, message, **kw):
+        return qropt.Result(status, message, stats={"t_total": 0.0})
+
+    r = diagnosis._descents(context, problem, "4 starts: why", done)
+    assert r.status == "feasible" and "(4 starts: why)" in r.message, r.message
+    m = r.mechanism
+    assert (m.time_ratio(), m.stroke()) == pytest.approx((2.373, 2.3207), rel=1e-9)
+    assert m.gamma_min().value >= 0.5236 - 1e-9
+    theta = np.linspace(0.0, 2 * np.pi, 20_001)
+    d = m.dynamics(theta, OMEGA2, masses=MASSES, loads=LOADS)
+    grid = max(np.hypot(*f.T).max() for k, f in d.joint_forces.items() if k != "slide")
+    assert grid <= r.objective <= grid * (1 + 1e-4)
+    assert diagnosis._descents(search.Context(Solver(evolution=False), {}, 8, 0, 5), problem, "", done) is None
+
+
+def test_a_failure_counts_its_starts_by_how_they_ended():
+    """``diagnosis.reasons``: the commonest reasons first, each with its count, the design a reason names as 'its
+    design' (so that the same reason at two designs is one)."""
+    ends = [
+        "CrankShaper(r1=1, r2=2) breaks: a crank-shaper needs crank r2 < centres r1",
+        "CrankShaper(r1=3, r2=4) breaks: a crank-shaper needs crank r2 < centres r1",
+        "the NLP's dead centres are local, not the global extremes",
+        "",
+    ]
+    cands = [
+        types.SimpleNamespace(info={"reason": w}, statuses=["Maximum_Iterations_Exceeded"], converged=False)
+        for w in ends
+    ]
+    tol = {"feasibility": 1e-9, "gap": 1e-9}
+    open_ = {"ok": True, "gap": 1e-3}
+    cands.append(types.SimpleNamespace(info=open_, statuses=["Solve_Succeeded"], converged=True, residuals={}))
+    missed = {"time_ratio (exact)": 1e-3, "stroke (exact)": 0.0}
+    cands.append(
+        types.SimpleNamespace(info={"ok": True}, statuses=["Solve_Succeeded"], converged=True, residuals=missed)
+    )
+    assert diagnosis.reasons(cands, tol, shown=5) == (
+        "2 starts: its design breaks: a crank-shaper needs crank r2 < centres r1; "
+        "1 start: Maximum_Iterations_Exceeded; "
+        "1 start: converged where the NLP's value and the exact one still differ (the exchange did not close); "
+        "1 start: converged where time_ratio (exact) is not met; "
+        "1 start: the NLP's dead centres are local, not the global extremes"
+    )
+    assert diagnosis.reasons(cands, tol, shown=1) == (
+        "2 starts: its design breaks: a crank-shaper needs crank r2 < centres r1"
+    )

@@ -211,6 +211,7 @@ class LocalSolve:
             samples, fractions = hint.blocks["samples"].copy(), hint.blocks["fractions"].copy()
             (used, used_f), box = hint.used, None
         lbx, ubx = form.bounds(problem)
+        moved, moved_f = np.full(samples.size, np.nan), np.full(fractions.size, np.nan)  # (``place``)
         c = Candidate(False, dict(values0), branch, orientation)
         gap_tol, feas_tol = self.tolerances["gap"], self.tolerances["feasibility"]
         g, info, m, restarts, polished, polish = None, {}, None, 0, False, None
@@ -294,8 +295,8 @@ class LocalSolve:
             rounds.append((info.get("ok"), info.get("reason"), run.f, np.sort(add), np.sort(frac)))
             if _stuck(rounds, self.settings.exchange_stuck):
                 break  # the same design and angles to add, ``exchange_stuck`` rounds running: the next ones are too
-            used = place(samples, used, add, TWO_PI, 0.05, form.n_base)
-            used_f = place(fractions, used_f, frac, 1.0, 0.01, form.n_base)
+            used = place(samples, used, add, TWO_PI, 0.05, form.n_base, moved)
+            used_f = place(fractions, used_f, frac, 1.0, 0.01, form.n_base, moved_f)
             if form.n_box and m is not None:  # each box side lifted at the coordinate that reaches it now
                 box = m.bounding_box()
                 w = form.with_box(w, box)
@@ -432,16 +433,26 @@ def _stuck(rounds, stuck: int) -> bool:
     return True
 
 
-def place(slots, used, new, period, near, base):
+def place(slots, used, new, period, near, base, before=None):
     """Put new sample angles into the extra slots: an angle close to an extra sample moves it there (the
     worst angle drifts as the design changes), others take free slots; with every slot taken, the nearest
-    extra sample moves (an angle the exact evaluation names is never dropped). Returns the slots in use."""
+    extra sample moves (an angle the exact evaluation names is never dropped). ``before``: each slot's angle
+    before its last move (NaN where it has not moved), kept here: an angle nearer a sample's former place than
+    to the sample takes a free slot instead (the worst angle swings between two places, and the NLP needs
+    both). Returns the slots in use."""
+
+    def apart(a, t):
+        return np.abs((a - t + period / 2) % period - period / 2)
+
     for t in new:
         extra = np.arange(base, used)
         if extra.size:
-            d = np.abs((slots[extra] - t + period / 2) % period - period / 2)
+            d = apart(slots[extra], t)
             k = int(np.argmin(d))
-            if d[k] < near or used == slots.size:
+            back = before is not None and apart(before[extra[k]], t) < d[k]  # False where it has not moved (NaN)
+            if (d[k] < near and not back) or used == slots.size:
+                if before is not None:
+                    before[extra[k]] = slots[extra[k]]
                 slots[extra[k]] = t
                 continue
         if used < slots.size:

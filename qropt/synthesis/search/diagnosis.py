@@ -9,7 +9,9 @@ In order, each step only where the ones before said nothing:
    closed form gives no design);
 3. a feasibility solve (no objective): a design meeting every target and condition found there starts one
    refinement of the objective, and otherwise makes the answer 'failed' (the optimum was not reached), never
-   'infeasible';
+   'infeasible'; where such designs exist and every refinement fails, descents on the exact objective from one
+   differential evolution (``descents.descended``) give the answer, 'feasible' (exact, not certified), where
+   they end at a valid design;
 4. where the closed forms gave the starts, one space-filling search of ``starts_n`` starts (they may have missed);
    where there are none or only starting points, one multi-start of ``wider`` times the starts (the spread starts may
    have been too few); it runs too where the multi-start's second pass finds fewer than ``thin`` certified designs.
@@ -21,14 +23,16 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import time
 
 from qropt.synthesis import atlas as atlas_
-from qropt.synthesis import criteria
+from qropt.synthesis import criteria, descents, evolution
 from qropt.synthesis import starts as starts_
 from qropt.synthesis.result import Result
 from qropt.synthesis.search import results
 from qropt.synthesis.search.base import STOP, Stage
+from qropt.synthesis.search.descended import descended
 
 
 class Failed(Stage):
@@ -44,8 +48,7 @@ class Failed(Stage):
         cands = pool.candidates
         stats = {**results.stats(context.solver, problem, cands, pool.plan), **pool.spent}
         stats["t_total"] = time.perf_counter() - context.t0
-        why = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
-        why = "; ".join(w for w in why[:3] if w)
+        why = reasons(cands, context.solver.tolerances)
         if late:
             msg = f"no certified design within the time limit ({len(cands)} local solves{': ' * bool(why)}{why})"
         else:
@@ -136,20 +139,66 @@ def diagnose(context, problem, plan, cands, claim, retry) -> Result:
             shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
             msg += (
                 f"; designs meeting every target and condition exist (one: {shown}), so the {problem.objective}"
-                " optimum was not reached (it may lie at a singular limit: a dead point, a link of zero "
-                "length or a bound)" + _dead_point_hint(problem)
+                f" optimum was not reached ({_SINGULAR})" + _dead_point_hint(problem)
             )
-            return done("failed", msg, reachable=reach)
+            why = f"none of {len(cands)} starts reaches a design ({how}); {_SINGULAR}"
+            return _descents(context, problem, why, done) or done("failed", msg, reachable=reach)
         # local runs prove nothing of the whole problem, wherever they end (a run that converges to a point the
         # exact evaluation refuses, even where designs exist): no design was found, none was proved absent
         return done("failed", msg + "; no design was found, none was proved absent", reachable=reach)
-    reasons = sorted({c.info.get("reason", "") or ", ".join(c.statuses[-1:]) for c in cands})
-    why = "; ".join(r for r in reasons[:3] if r)
+    why = reasons(cands, solver.tolerances)
     msg = f"no start converged to a certified design ({why}); " + "; ".join(msgs)
     if found:
         shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
         msg += f"; a design meeting every target and condition: {shown}" + _dead_point_hint(problem)
+        r = _descents(context, problem, f"no start converged to a certified design: {why}", done)
+        if r is not None:
+            return r
     return done("failed", msg, reachable=reach)
+
+
+def reasons(cands, tolerances: dict, shown: int = 3) -> str:
+    """Why the starts ended without a certified design: the ``shown`` commonest reasons, each with how many starts
+    ended so (``ended``)."""
+    count: dict = {}
+    for c in cands:
+        why = ended(c, tolerances)
+        if why:
+            count[why] = count.get(why, 0) + 1
+    common = sorted(count.items(), key=lambda kv: (-kv[1], kv[0]))[:shown]
+    return "; ".join(f"{n} start{'s' * (n != 1)}: {why}" for why, n in common)
+
+
+def ended(c, tolerances: dict) -> str:
+    """Why a start's candidate is not certified, in words that do not depend on its numbers: the certifier's reason
+    (the design it names as 'its design'), the row missed or the exchange left open at a converged end, else the
+    backend's last word."""
+    if c.info.get("reason"):
+        return _NAMED.sub("its design ", c.info["reason"])
+    if c.converged and c.info.get("ok"):
+        worst = max(c.residuals.items(), key=lambda kv: kv[1], default=("", 0.0))
+        if worst[1] > tolerances["feasibility"]:
+            return f"converged where {worst[0]} is not met"
+        if c.info.get("gap", 0.0) > tolerances["gap"]:
+            return "converged where the NLP's value and the exact one still differ (the exchange did not close)"
+    return ", ".join(c.statuses[-1:])
+
+
+_SINGULAR = "it may lie at a singular limit: a dead point, a link of zero length or a bound"
+_NAMED = re.compile(r"^[A-Za-z_]\w*\([^()]*\) ")  # a design's repr heading a reason
+
+
+def _descents(context, problem, why: str, done) -> Result | None:
+    """Where designs meet every target and condition but no start certified one: the best end of descents on the
+    exact objective from one differential evolution (``descents.descended``), as a ``feasible`` Result saying
+    ``why`` no start certified; None where the evolution does not apply, is switched off or ends nowhere valid."""
+    solver, s = context.solver, context.settings
+    if not (solver.evolution and evolution.applies(problem)) or context.out_of_time():
+        return None
+    ends = descents.descended(
+        problem, s.evolution_generations, context.seed, sqp=solver.sqp, deadline=context.deadline, settings=s
+    )
+    return descended(solver, problem, None, ends, why, done("failed", "").stats)
 
 
 def searched(context, problem, plan, cands, claim, retry):
