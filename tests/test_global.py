@@ -199,16 +199,8 @@ def test_an_exchange_whose_worst_angle_swings_between_two_places_closes():
     from benchmarks.tasks import LOADS, MASSES, OMEGA2
     from qropt import Solver
 
-    p = type_problem(
-        "drag-link-slider",
-        2.373,
-        2.3207,
-        objective="min_peak_bearing_force",
-        conditions={"gamma_min": np.radians(30)},
-        masses=MASSES,
-        loads=LOADS,
-        omega2=OMEGA2,
-    )
+    kw = {"masses": MASSES, "loads": LOADS, "omega2": OMEGA2, "conditions": {"gamma_min": np.radians(30)}}
+    p = type_problem("drag-link-slider", 2.373, 2.3207, objective="min_peak_bearing_force", **kw)
     solver = Solver(evolution=False)
     r = solver.solve(p, starts_n=0, extra_starts=[SWINGING_START], use_analytic=False, diagnose=False)
     assert r.status == "optimal" and r.certificate.rounds < solver.max_rounds, r.message

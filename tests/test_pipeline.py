@@ -226,7 +226,7 @@ def test_where_designs_exist_but_no_start_certifies_one_the_diagnosis_answers_by
     def done(status, message, **kw):
         return qropt.Result(status, message, stats={"t_total": 0.0})
 
-    r = diagnosis._descents(context, problem, "4 starts: why", done)
+    r = diagnosis._descents(context, problem, [], "4 starts: why", done)
     assert r.status == "feasible" and "(4 starts: why)" in r.message, r.message
     m = r.mechanism
     assert (m.time_ratio(), m.stroke()) == pytest.approx((2.373, 2.3207), rel=1e-9)
@@ -235,7 +235,7 @@ def test_where_designs_exist_but_no_start_certifies_one_the_diagnosis_answers_by
     d = m.dynamics(theta, OMEGA2, masses=MASSES, loads=LOADS)
     grid = max(np.hypot(*f.T).max() for k, f in d.joint_forces.items() if k != "slide")
     assert grid <= r.objective <= grid * (1 + 1e-4)
-    assert diagnosis._descents(search.Context(Solver(evolution=False), {}, 8, 0, 5), problem, "", done) is None
+    assert diagnosis._descents(search.Context(Solver(evolution=False), {}, 8, 0, 5), problem, [], "", done) is None
 
 
 def test_a_failure_counts_its_starts_by_how_they_ended():
@@ -246,6 +246,7 @@ def test_a_failure_counts_its_starts_by_how_they_ended():
         "CrankShaper(r1=3, r2=4) breaks: a crank-shaper needs crank r2 < centres r1",
         "the NLP's dead centres are local, not the global extremes",
         "",
+        "CrankShaper(r1=5, r2=4): the output reverses 2 times a turn",
     ]
     cands = [
         types.SimpleNamespace(info={"reason": w}, statuses=["Maximum_Iterations_Exceeded"], converged=False)
@@ -263,7 +264,7 @@ def test_a_failure_counts_its_starts_by_how_they_ended():
         "1 start: Maximum_Iterations_Exceeded; "
         "1 start: converged where the NLP's value and the exact one still differ (the exchange did not close); "
         "1 start: converged where time_ratio (exact) is not met; "
-        "1 start: the NLP's dead centres are local, not the global extremes"
+        "1 start: its design: the output reverses 2 times a turn"
     )
     assert diagnosis.reasons(cands, tol, shown=1) == (
         "2 starts: its design breaks: a crank-shaper needs crank r2 < centres r1"

@@ -16,7 +16,8 @@ In order, each step only where the ones before said nothing:
    where there are none or only starting points, one multi-start of ``wider`` times the starts (the spread starts may
    have been too few); it runs too where the multi-start's second pass finds fewer than ``thin`` certified designs.
 Every other solve here runs the pipeline without diagnosis and with at most ``diagnosis_starts`` space-filling
-starts (``Settings``), so a diagnosis costs at most (bounds + 4) solves and ``range_solves`` local solves per target.
+starts (``Settings``), so a diagnosis costs at most (bounds + 4) solves, ``range_solves`` local solves per target and,
+where its descents run, one differential evolution and its descents.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ from qropt.synthesis.result import Result
 from qropt.synthesis.search import results
 from qropt.synthesis.search.base import STOP, Stage
 from qropt.synthesis.search.descended import descended
+from qropt.synthesis.search.evolution import Evolution
 
 
 class Failed(Stage):
@@ -63,7 +65,8 @@ class Diagnose(Stage):
     name = "diagnosis"
 
     def run(self, problem, pool, context):
-        pool.result = diagnose(context, problem, pool.plan, pool.candidates, pool.claim, pool.retry)
+        evolved = bool(pool.ends) or any(name == Evolution.name for name, _ in pool.ran)
+        pool.result = diagnose(context, problem, pool.plan, pool.candidates, pool.claim, pool.retry, evolved)
         return STOP
 
 
@@ -72,8 +75,9 @@ def _sub(context, problem, **kw):
     return context.sub(problem, max_rounds=context.solver.max_rounds, diagnose=False, **kw)
 
 
-def diagnose(context, problem, plan, cands, claim, retry) -> Result:
-    """No certified design among ``cands`` (from ``plan``; ``retry``: the multi-start's second pass, or None)."""
+def diagnose(context, problem, plan, cands, claim, retry, evolved: bool = False) -> Result:
+    """No certified design among ``cands`` (from ``plan``; ``retry``: the multi-start's second pass, or None;
+    evolved: the solve's own evolution ran, so the diagnosis does not descend from one again)."""
     solver, targets, seed, t0 = context.solver, context.targets, context.seed, context.t0
     s = context.settings
     n = min(context.starts_n, s.diagnosis_starts)
@@ -139,10 +143,12 @@ def diagnose(context, problem, plan, cands, claim, retry) -> Result:
             shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
             msg += (
                 f"; designs meeting every target and condition exist (one: {shown}), so the {problem.objective}"
-                f" optimum was not reached ({_SINGULAR})" + _dead_point_hint(problem)
+                f" optimum was not reached (it {_SINGULAR})" + _dead_point_hint(problem)
             )
-            why = f"none of {len(cands)} starts reaches a design ({how}); {_SINGULAR}"
-            return _descents(context, problem, why, done) or done("failed", msg, reachable=reach)
+            why = f"none of {len(cands)} starts reaches a design meeting the targets and conditions together ({how})"
+            why += f"; the optimum {_SINGULAR}"
+            descended = None if evolved else _descents(context, problem, found, why, done)
+            return descended or done("failed", msg, reachable=reach)
         # local runs prove nothing of the whole problem, wherever they end (a run that converges to a point the
         # exact evaluation refuses, even where designs exist): no design was found, none was proved absent
         return done("failed", msg + "; no design was found, none was proved absent", reachable=reach)
@@ -151,7 +157,11 @@ def diagnose(context, problem, plan, cands, claim, retry) -> Result:
     if found:
         shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
         msg += f"; a design meeting every target and condition: {shown}" + _dead_point_hint(problem)
-        r = _descents(context, problem, f"no start converged to a certified design: {why}", done)
+        r = (
+            None
+            if evolved
+            else _descents(context, problem, found, f"no start converged to a certified design: {why}", done)
+        )
         if r is not None:
             return r
     return done("failed", msg, reachable=reach)
@@ -170,11 +180,10 @@ def reasons(cands, tolerances: dict, shown: int = 3) -> str:
 
 
 def ended(c, tolerances: dict) -> str:
-    """Why a start's candidate is not certified, in words that do not depend on its numbers: the certifier's reason
-    (the design it names as 'its design'), the row missed or the exchange left open at a converged end, else the
-    backend's last word."""
+    """Why a start's candidate is not certified: the certifier's reason (the design it names first as 'its
+    design'), the row missed or the exchange left open at a converged end, else the backend's last word."""
     if c.info.get("reason"):
-        return _NAMED.sub("its design ", c.info["reason"])
+        return _NAMED.sub("its design", c.info["reason"])
     if c.converged and c.info.get("ok"):
         worst = max(c.residuals.items(), key=lambda kv: kv[1], default=("", 0.0))
         if worst[1] > tolerances["feasibility"]:
@@ -184,20 +193,20 @@ def ended(c, tolerances: dict) -> str:
     return ", ".join(c.statuses[-1:])
 
 
-_SINGULAR = "it may lie at a singular limit: a dead point, a link of zero length or a bound"
-_NAMED = re.compile(r"^[A-Za-z_]\w*\([^()]*\) ")  # a design's repr heading a reason
+_SINGULAR = "may lie at a singular limit: a dead point, a link of zero length or a bound"
+_NAMED = re.compile(r"^[A-Za-z_]\w*\([^()]*\)(?=[ :])")  # a design's repr heading a reason
 
 
-def _descents(context, problem, why: str, done) -> Result | None:
-    """Where designs meet every target and condition but no start certified one: the best end of descents on the
-    exact objective from one differential evolution (``descents.descended``), as a ``feasible`` Result saying
-    ``why`` no start certified; None where the evolution does not apply, is switched off or ends nowhere valid."""
+def _descents(context, problem, found: list, why: str, done) -> Result | None:
+    """Where designs meet every target and condition (``found``, free-parameter dicts) but no start certified one:
+    the best end of descents on the exact objective from them and from one differential evolution's designs
+    (``descents.descents``), as a ``feasible`` Result saying ``why`` no start certified; None where the evolution
+    does not apply, is switched off or ends nowhere valid."""
     solver, s = context.solver, context.settings
     if not (solver.evolution and evolution.applies(problem)) or context.out_of_time():
         return None
-    ends = descents.descended(
-        problem, s.evolution_generations, context.seed, sqp=solver.sqp, deadline=context.deadline, settings=s
-    )
+    designs = list(found) + (evolution.evolve(problem, s.evolution_generations, context.seed, settings=s) or [])
+    ends = descents.descents(problem, designs, sqp=solver.sqp, deadline=context.deadline, settings=s)
     return descended(solver, problem, None, ends, why, done("failed", "").stats)
 
 
