@@ -285,8 +285,11 @@ def descend(problem, design: dict, evals: int | None = None, settings: Settings 
         return f
 
     z0 = np.array([math.log(design[k]) if log[k] else design[k] for k in names])
+    if not math.isfinite(cost(z0)):  # no exact value at the start: nothing to descend from
+        return None
     opts = {"maxfev": evals or settings.descent_evals, "xatol": 1e-9, "fatol": 1e-12, "adaptive": True}
-    minimize(cost, z0, method="Nelder-Mead", options=opts)
+    with np.errstate(invalid="ignore"):  # a simplex with several points without a value (inf - inf)
+        minimize(cost, z0, method="Nelder-Mead", options=opts)
     return best[0]
 
 
