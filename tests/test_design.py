@@ -331,7 +331,7 @@ def test_a_design_that_exists_is_never_called_infeasible(monkeypatch):
     from qropt.synthesis.search import diagnosis
 
     handed = []
-    monkeypatch.setattr(diagnosis, "_descents", lambda context, problem, found, why, done: handed.append((found, why)))
+    monkeypatch.setattr(diagnosis, "_descents", lambda context, problem, found, why, *rest: handed.append((found, why)))
     r = qropt.solve(type_problem("drag-link-slider", TR, STROKE, objective="min_size", size="longest"))
     assert r.status == "failed" and "designs meeting every target and condition exist" in r.message
     assert len(handed) == 1 and handed[0][0] and "the optimum may lie at a singular limit" in handed[0][1]

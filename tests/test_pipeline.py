@@ -222,11 +222,7 @@ def test_where_designs_exist_but_no_start_certifies_one_the_diagnosis_answers_by
         settings=Settings(evolution_generations=2, evolution_population=4, evolution_keep=1, descent_evals=200)
     )
     context = search.Context(solver, dict(problem.targets), 8, 0, solver.max_rounds)
-
-    def done(status, message, **kw):
-        return qropt.Result(status, message, stats={"t_total": 0.0})
-
-    r = diagnosis._descents(context, problem, [], "4 starts: why", done)
+    r = diagnosis._descents(context, problem, [], "4 starts: why", lambda: {"t_total": 0.0})
     assert r.status == "feasible" and "(4 starts: why)" in r.message, r.message
     m = r.mechanism
     assert (m.time_ratio(), m.stroke()) == pytest.approx((2.373, 2.3207), rel=1e-9)
@@ -235,7 +231,9 @@ def test_where_designs_exist_but_no_start_certifies_one_the_diagnosis_answers_by
     d = m.dynamics(theta, OMEGA2, masses=MASSES, loads=LOADS)
     grid = max(np.hypot(*f.T).max() for k, f in d.joint_forces.items() if k != "slide")
     assert grid <= r.objective <= grid * (1 + 1e-4)
-    assert diagnosis._descents(search.Context(Solver(evolution=False), {}, 8, 0, 5), problem, [], "", done) is None
+    assert r.stats["t_total"] == 0.0 and r.stats["origin"] == "descent"
+    assert diagnosis._descents(context, problem, [], "", dict, evolved=True) is None  # the solve's own evolution ran
+    assert diagnosis._descents(search.Context(Solver(evolution=False), {}, 8, 0, 5), problem, [], "", dict) is None
 
 
 def test_a_failure_counts_its_starts_by_how_they_ended():

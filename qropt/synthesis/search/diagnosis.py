@@ -34,7 +34,6 @@ from qropt.synthesis.result import Result
 from qropt.synthesis.search import results
 from qropt.synthesis.search.base import STOP, Stage
 from qropt.synthesis.search.descended import descended
-from qropt.synthesis.search.evolution import Evolution
 
 
 class Failed(Stage):
@@ -65,7 +64,7 @@ class Diagnose(Stage):
     name = "diagnosis"
 
     def run(self, problem, pool, context):
-        evolved = bool(pool.ends) or any(name == Evolution.name for name, _ in pool.ran)
+        evolved = "t_evolution" in pool.spent  # (set where the ``Evolution`` strategy ran one)
         pool.result = diagnose(context, problem, pool.plan, pool.candidates, pool.claim, pool.retry, evolved)
         return STOP
 
@@ -82,10 +81,13 @@ def diagnose(context, problem, plan, cands, claim, retry, evolved: bool = False)
     s = context.settings
     n = min(context.starts_n, s.diagnosis_starts)
 
+    def stats():
+        out = results.stats(solver, problem, cands, plan)
+        out["t_total"] = time.perf_counter() - t0
+        return out
+
     def done(status, msg, **kw):
-        stats = results.stats(solver, problem, cands, plan)
-        stats["t_total"] = time.perf_counter() - t0
-        return Result(status, msg, stats=stats, units=problem.units, **kw)
+        return Result(status, msg, stats=stats(), units=problem.units, **kw)
 
     beyond, found = bound_out_of_reach(context, problem, n)
     if beyond:
@@ -147,8 +149,7 @@ def diagnose(context, problem, plan, cands, claim, retry, evolved: bool = False)
             )
             why = f"none of {len(cands)} starts reaches a design meeting the targets and conditions together ({how})"
             why += f"; the optimum {_SINGULAR}"
-            descended = None if evolved else _descents(context, problem, found, why, done)
-            return descended or done("failed", msg, reachable=reach)
+            return _descents(context, problem, found, why, stats, evolved) or done("failed", msg, reachable=reach)
         # local runs prove nothing of the whole problem, wherever they end (a run that converges to a point the
         # exact evaluation refuses, even where designs exist): no design was found, none was proved absent
         return done("failed", msg + "; no design was found, none was proved absent", reachable=reach)
@@ -157,11 +158,7 @@ def diagnose(context, problem, plan, cands, claim, retry, evolved: bool = False)
     if found:
         shown = ", ".join(f"{k}={v:.6g}" for k, v in found[0].items())
         msg += f"; a design meeting every target and condition: {shown}" + _dead_point_hint(problem)
-        r = (
-            None
-            if evolved
-            else _descents(context, problem, found, f"no start converged to a certified design: {why}", done)
-        )
+        r = _descents(context, problem, found, f"no start converged to a certified design: {why}", stats, evolved)
         if r is not None:
             return r
     return done("failed", msg, reachable=reach)
@@ -197,17 +194,18 @@ _SINGULAR = "may lie at a singular limit: a dead point, a link of zero length or
 _NAMED = re.compile(r"^[A-Za-z_]\w*\([^()]*\)(?=[ :])")  # a design's repr heading a reason
 
 
-def _descents(context, problem, found: list, why: str, done) -> Result | None:
+def _descents(context, problem, found: list, why: str, stats, evolved: bool = False) -> Result | None:
     """Where designs meet every target and condition (``found``, free-parameter dicts) but no start certified one:
     the best end of descents on the exact objective from them and from one differential evolution's designs
-    (``descents.descents``), as a ``feasible`` Result saying ``why`` no start certified; None where the evolution
-    does not apply, is switched off or ends nowhere valid."""
+    (``descents.descents``), as a ``feasible`` Result saying ``why`` no start certified, with ``stats()`` (the
+    solve's statistics at its end); None where the evolution does not apply, is switched off, already ran in this
+    solve (``evolved``: the same seed gives the same designs) or ends nowhere valid."""
     solver, s = context.solver, context.settings
-    if not (solver.evolution and evolution.applies(problem)) or context.out_of_time():
+    if evolved or not (solver.evolution and evolution.applies(problem)) or context.out_of_time():
         return None
     designs = list(found) + (evolution.evolve(problem, s.evolution_generations, context.seed, settings=s) or [])
     ends = descents.descents(problem, designs, sqp=solver.sqp, deadline=context.deadline, settings=s)
-    return descended(solver, problem, None, ends, why, done("failed", "").stats)
+    return descended(solver, problem, None, ends, why, stats())
 
 
 def searched(context, problem, plan, cands, claim, retry):
