@@ -193,3 +193,40 @@ def test_a_descents_end_stands_only_where_it_beats_every_certified_design():
     assert stood.status == "feasible" and stood.objective == pytest.approx(ends[0].value, rel=1e-12)
     assert [x.status for x in stood.local_optima] == ["local_optimum"]
     assert stood.local_optima[0].objective == worse.objective
+
+
+_TURNS_BACK = {  # where the SQP on the exact peak ended: the coupler slider by peak torque at TR 2.848, 0.834 m
+    "r1": 2.9931518200422618,
+    "r2": 0.809781580903104,
+    "r3": 1.433493973390875,
+    "r4": 3.303357589771022,
+    "r5": 1.3112728693395832,
+    "r6": 1.707383429667817,
+    "h": 0.6052913935756883,
+    "beta": 0.6211700864647173,
+}
+
+
+def test_a_descents_end_whose_ram_turns_back_inside_a_stroke_does_not_stand():
+    """This end of the SQP on the exact peak (under a 30 deg bound) meets TR and stroke, 1585.63 N m, below the
+    certified 1585.96: its ram turns back inside the rising stroke by 1.0e-5 of its travel, which ``dead_centres``
+    takes as a dwell (``cycle.DWELL``): a descent on exact values walks into that tolerance. A dense grid of the
+    ram's positions shows the turn back, ``dwells`` counts it, and the end does not stand."""
+    from qropt import Solver
+    from qropt.examples import paper_mechanism
+    from qropt.kinematics.cycle import DWELL
+    from qropt.synthesis.certificate import objective_value, quantities
+
+    p = type_problem("coupler-slider", 2.848, 0.834, **KW, conditions={"gamma_min": math.radians(30)})
+    m = p.build(_TURNS_BACK, {"sigma": -1.0, "sigma_slider": 1.0})
+    assert (m.time_ratio(), m.stroke(), m.dead_centres().reversals) == pytest.approx((2.848, 0.834, 1), rel=1e-9)
+    t = np.linspace(0.0, 2 * np.pi, 2_000_001)
+    x = m.positions(t).x
+    turns = np.nonzero(np.diff(np.sign(np.diff(x))))[0]  # where the ram's motion changes direction
+    assert turns.size == 4  # the two dead centres and a turn back and forth
+    back = np.abs(np.diff(x[turns])).min()  # m: the shortest travel between two of them
+    assert 0 < back < DWELL * m.stroke() and back > 0.5 * DWELL * m.stroke()
+    assert m.dwells() == 1 and paper_mechanism().dwells() == 0
+    value = objective_value(p, quantities(p, m))
+    assert value == pytest.approx(1585.6258, abs=1e-4)  # N m
+    assert descended(Solver(), p, None, [evolution.End(value, _TURNS_BACK, "")], "how", {}) is None

@@ -460,6 +460,7 @@ class Mechanism:
                 margins.append((least[m], float(cycle.grid(q.shape[1])[at])))
         tmax, xmax, tmin, xmin = cycle.dwells(res[0].theta, res[0].value, res[1].theta, res[1].value)
         return {
+            "dwells": res[0].theta.size - tmax.size,
             "max": (tmax, xmax),
             "min": (tmin, xmin),
             "gamma": gammas,
@@ -487,6 +488,12 @@ class Mechanism:
     def dead_centres(self) -> DeadCentres:
         """Exact crank angles of the largest and smallest output (zero output velocity)."""
         return self._dead_centres
+
+    def dwells(self) -> int:
+        """How many times the output turns back inside a stroke by less than ``cycle.DWELL`` of its travel, which
+        ``dead_centres`` takes as dwells, not reversals (0: it turns back nowhere)."""
+        self.dead_centres()  # a full turn with regular extremes, or its error
+        return self._cycle["dwells"]
 
     def stroke_angles(self) -> tuple[float, float]:
         """(a, b): crank turn (rad) from theta_max to theta_min counter-clockwise, and the rest.

@@ -42,6 +42,8 @@ def descended(solver, problem, r, ends: list, how: str, stats: dict | None = Non
         d = end.design
         try:
             m = problem.build(d, branch)
+            if m.dwells():  # a descent on exact values walks into the dwell tolerance: its ram turns back there
+                continue
             q = quantities(problem, m)
             res = residuals(problem, {}, m, problem.targets)
         except QroptError:
