@@ -1,8 +1,9 @@
 """The best descent's end (the pool's ends: the evolution's and the SQP's) that meets every target, condition,
-rule and bound exactly, as a ``feasible`` Result where it beats the best certified design by more than ``stands``
-(relative): the design is exact, not certified by the NLP (its certificate's ``local`` says what holds at the end);
-the certified designs stay as its local optima. Not for a free counterweight (the descents keep it at its start).
-Ends the pipeline where a Result stands."""
+rule and bound exactly, its output turning back nowhere inside a stroke (``Mechanism.dwells``), as a ``feasible``
+Result where it beats the best certified design by more than ``stands`` (relative): the design is exact, not
+certified by the NLP (its certificate's ``local`` says what holds at the end); the certified designs stay as its
+local optima. Not for a free counterweight (the descents keep it at its start). Ends the pipeline where a Result
+stands."""
 
 from __future__ import annotations
 
@@ -42,7 +43,7 @@ def descended(solver, problem, r, ends: list, how: str, stats: dict | None = Non
         d = end.design
         try:
             m = problem.build(d, branch)
-            if m.dwells():  # a descent on exact values walks into the dwell tolerance: its ram turns back there
+            if m.dwells():  # a descent on exact values walks into the dwell tolerance: its output turns back there
                 continue
             q = quantities(problem, m)
             res = residuals(problem, {}, m, problem.targets)
