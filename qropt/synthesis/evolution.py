@@ -74,10 +74,11 @@ def applies(problem) -> bool:
 
 def value(problem, design: dict, branch: dict | None = None) -> float | None:
     """The exact objective of a design (free parameters; the first branch unless given), minimised (negated
-    where it is maximised); None where it does not build, its analysis fails or it breaks a bound condition."""
+    where it is maximised); None where it does not build, its analysis fails, it breaks a bound condition or its
+    output turns back inside a stroke (``Mechanism.dwells``: a descent would walk into the dwell tolerance)."""
     try:
         m = problem.build(design, branch or starts_.branches(problem)[0])
-        if any(v > 0.0 for v in criteria.violations(problem, m).values()):
+        if m.dwells() or any(v > 0.0 for v in criteria.violations(problem, m).values()):
             return None
         v = criteria.objective_of(problem, m)
     except QroptError:
